@@ -1,0 +1,112 @@
+r"""Linear ADRC heading controller: ESO (7)/(7a) + disturbance-cancelling PD law (7d).
+
+Source: Zwierzewicz et al. (2021), Sections 2 and 5, eqs (5)-(7d), gains (38).
+
+Control law, as steerlab implements it by default (``law="stable"``)::
+
+    u = ( Kp wrap_to_pi(psi_ref - psi) - Kd (xh2 - r_ref) - xh3 ) / c0        (7d, corrected)
+    Kp = 36 / T_settle^2,   Kd = 12 / T_settle                                (38, corrected)
+
+With the disturbance cancelled (``xh3 = x3``) the loop is ``x1'' = Kp (y_d - x1) - Kd x1'``:
+a double pole at ``-6 / T_settle`` (damping 1), the rule of Herbst (2013), the paper's
+reference [30] for (38).
+
+The paper as printed is inconsistent, and steerlab does not hide it:
+
+* (2), (5), (6) and (7d) print ``+ Kd x2`` (``law="printed"``). With ``x1'' = u`` that gives
+  ``s^2 - Kd s + Kp``: a closed loop with poles in the right half-plane, which diverges.
+  It is available as ``law="printed"`` so the divergence can be shown.
+* (38) prints ``Kd = 2 / T_settle``. With ``Kp = 36/T^2`` that is ``s^2 + (2/T) s + 36/T^2``:
+  natural frequency ``6/T`` and damping ``zeta = 1/6`` — an oscillatory loop that does not
+  settle in ``T_settle``. Herbst's rule, which (38)'s ``Kp`` follows, has ``Kd = 12/T``.
+  ``kd_rule="printed"`` gives ``Kd = 2/T`` (with the stable sign) for comparison.
+
+``c0`` is the rudder efficiency ``b2`` of (37), in steerlab's sign (positive; the paper's
+``c0 = -9.18e-4`` is for its rudder sign, delta < 0 to starboard). The ESO is fed the
+controller's own (limited) order ``u``; the measured heading enters the error, as in (7d).
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numba
+import numpy as np
+
+from steerlab.angles import wrap_to_pi
+from steerlab.control.estimators import PAPER_L, eso_step
+from steerlab.errors import InputError, require_finite_range
+from steerlab.units import rad
+
+A_C0, A_KP, A_KD, A_KDSIGN, A_L1, A_L2, A_L3, A_UMAX = 0, 1, 2, 3, 4, 5, 6, 7
+N_PARAMS = 8
+N_STATE = 3  # ESO estimate [psi_hat (rad), r_hat (rad/s), total disturbance (rad/s^2)]
+
+LAWS = ("stable", "printed")
+KD_RULES = ("herbst", "printed")
+
+
+def adrc_gains(T_settle: float, kd_rule: str = "herbst") -> tuple[float, float]:
+    """PD gains of eq (38) for a settling time ``T_settle`` [s]: ``(Kp [1/s^2], Kd [1/s])``.
+
+    ``kd_rule="herbst"``: ``Kd = 12/T`` (double pole at -6/T, damping 1; Herbst 2013).
+    ``kd_rule="printed"``: ``Kd = 2/T`` as printed in (38) (damping 1/6).
+    """
+    require_finite_range("controller.T_settle", T_settle, 0.0, lo_open=True)
+    if kd_rule not in KD_RULES:
+        raise InputError("controller.kd_rule", f"must be one of {KD_RULES}, got {kd_rule!r}")
+    kp = 36.0 / T_settle**2
+    kd = (12.0 if kd_rule == "herbst" else 2.0) / T_settle
+    return kp, kd
+
+
+class ADRC(NamedTuple):
+    """Linear ADRC parameters."""
+
+    c0: float                      #: rudder efficiency b2, steerlab sign [1/s^2]
+    Kp: float                      #: [1/s^2]
+    Kd: float                      #: [1/s]
+    L: tuple = PAPER_L             #: ESO gains [1/s, 1/s^2, 1/s^3]
+    law: str = "stable"            #: "stable" (-Kd x2) or "printed" (+Kd x2, diverges)
+    u_max: float = rad(35.0)       #: output limit [rad]
+
+    @classmethod
+    def from_settling_time(cls, T_settle: float, c0: float, L=PAPER_L, law: str = "stable",
+                           kd_rule: str = "herbst", u_max: float = rad(35.0)) -> "ADRC":
+        """Gains by (38) for ``T_settle`` [s] (paper's nominal choice: 150 s)."""
+        kp, kd = adrc_gains(T_settle, kd_rule)
+        return cls(c0=c0, Kp=kp, Kd=kd, L=tuple(float(v) for v in L), law=law, u_max=u_max)
+
+    def pack(self) -> np.ndarray:
+        require_finite_range("controller.c0", self.c0)
+        if self.c0 == 0.0:
+            raise InputError("controller.c0", "must be non-zero (rudder efficiency b2 [1/s^2])")
+        require_finite_range("controller.Kp", self.Kp, 0.0)
+        require_finite_range("controller.Kd", self.Kd, 0.0)
+        if len(self.L) != 3:
+            raise InputError("controller.L", f"needs 3 observer gains, got {len(self.L)}")
+        for i, li in enumerate(self.L):
+            require_finite_range(f"controller.L[{i}]", li, 0.0, lo_open=True)
+        require_finite_range("controller.u_max", self.u_max, 0.0, lo_open=True)
+        if self.law not in LAWS:
+            raise InputError("controller.law", f"must be one of {LAWS}, got {self.law!r}")
+        sign = -1.0 if self.law == "stable" else 1.0
+        return np.array([self.c0, self.Kp, self.Kd, sign, *self.L, self.u_max], dtype=np.float64)
+
+    def init_state(self, x0, ref0) -> np.ndarray:
+        """ESO starts at the measured heading and yaw rate with no disturbance estimate."""
+        return np.array([x0[2], x0[5], 0.0])
+
+
+@numba.njit(cache=True)
+def adrc_update(z, p, t, x, ref, h):
+    """One ADRC sample: law (7d) on the current estimate, then the ESO (7a) advances."""
+    y = x[2]
+    c0 = p[A_C0]
+    e = wrap_to_pi(ref[0] - y)
+    u0 = p[A_KP] * e + p[A_KDSIGN] * p[A_KD] * (z[1] - ref[1])
+    u = (u0 - z[2]) / c0
+    umax = p[A_UMAX]
+    u = min(max(u, -umax), umax)
+    eso_step(z, c0, p[A_L1], p[A_L2], p[A_L3], y, u, h)
+    return u

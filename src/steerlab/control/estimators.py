@@ -1,0 +1,74 @@
+r"""Extended state observer (ESO) of linear ADRC and its gain design.
+
+Source: Zwierzewicz et al. (2021), Section 2, eqs (4), (7), (7a). The plant is seen as the
+chain of integrators with a lumped "total disturbance" ``x3``::
+
+    x1' = x2,  x2' = x3 + c0 u,  x3' = 0,  y = x1           (7)
+    xh' = A xh + B u + L (y - C xh)                           (7a)
+
+steerlab integrates (7a) with forward Euler at the controller sample time ``h`` (the usual
+discrete ESO); the innovation ``y - xh1`` is wrapped to [-pi, pi) because y is a heading.
+
+Observer gains ``L``: the paper's ``[1.0484, 0.44955, 0.001]`` (tuned by LQR with undisclosed
+weights, Section 5), or computed here by python-control: LQR on the dual system
+(``control.lqr(A.T, C.T, Q, R)``) or pole placement (``control.acker``; e.g. the
+"bandwidth" choice of a triple pole at ``-omega_o``, Gao 2003).
+"""
+
+from __future__ import annotations
+
+import control
+import numba
+import numpy as np
+
+from steerlab.angles import wrap_to_pi
+
+PAPER_L = (1.0484, 0.44955, 0.001)
+"""Observer gains of Zwierzewicz et al. (2021), Section 5."""
+
+
+def eso_matrices(c0: float = 1.0):
+    """``A, B, C`` of eq (7) for the third-order ESO."""
+    A = np.array([[0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [0.0, 0.0, 0.0]])
+    B = np.array([[0.0], [c0], [0.0]])
+    C = np.array([[1.0, 0.0, 0.0]])
+    return A, B, C
+
+
+def eso_gains_lqr(q=(1.0, 1.0, 1.0), r: float = 1.0) -> np.ndarray:
+    """Observer gains by LQR on the dual system (python-control ``lqr``).
+
+    ``q`` are the diagonal state weights, ``r`` the output weight.
+    """
+    A, _, C = eso_matrices()
+    K, _, _ = control.lqr(A.T, C.T, np.diag(q), np.array([[r]]))
+    return np.asarray(K, dtype=float).ravel()
+
+
+def eso_gains_poles(poles) -> np.ndarray:
+    """Observer gains placing the ESO poles (python-control ``acker``; repeated poles allowed)."""
+    A, _, C = eso_matrices()
+    K = control.acker(A.T, C.T, list(poles))
+    return np.asarray(K, dtype=float).ravel()
+
+
+def eso_gains_bandwidth(omega_o: float) -> np.ndarray:
+    """Triple observer pole at ``-omega_o`` [rad/s]: ``L = [3 w, 3 w^2, w^3]``."""
+    return eso_gains_poles([-omega_o] * 3)
+
+
+def eso_poles(L) -> np.ndarray:
+    """Poles of ``A - L C``: roots of ``s^3 + l1 s^2 + l2 s + l3``."""
+    return np.roots([1.0, L[0], L[1], L[2]])
+
+
+@numba.njit(cache=True)
+def eso_step(xh, c0, l1, l2, l3, y, u, h):
+    """Advance the ESO estimate ``xh = [x1, x2, x3]`` in place by one Euler step of (7a)."""
+    e = wrap_to_pi(y - xh[0])
+    x1 = xh[0]
+    x2 = xh[1]
+    x3 = xh[2]
+    xh[0] = wrap_to_pi(x1 + h * (x2 + l1 * e))
+    xh[1] = x2 + h * (x3 + c0 * u + l2 * e)
+    xh[2] = x3 + h * (l3 * e)

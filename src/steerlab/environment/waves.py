@@ -1,0 +1,66 @@
+r"""Coloured wave noise of Zwierzewicz et al. (2021), eq (39).
+
+White noise with sample time ``Ts`` and noise power ``P`` (Simulink's band-limited white
+noise: a zero-order-held sequence of independent normal samples with variance ``P / Ts``,
+i.e. a two-sided PSD of ``P``) drives the band-pass filter::
+
+    G(s) = 10.8 s / (s^2 + 0.672 s + 2.6729)          (eq 39; peak at 1.635 rad/s)
+
+The output is an equivalent rudder angle [rad]. The filter is discretised exactly with a
+zero-order hold at the simulation step ``dt`` (python-control ``c2d``), which is exact here
+because the input is constant over each step (``Ts`` is a multiple of ``dt``). Stationary
+standard deviation for the defaults: ``sqrt(P b^2 / (2 a1)) = 0.093 rad`` (5.3 deg).
+"""
+
+from __future__ import annotations
+
+import math
+
+import control
+import numpy as np
+from scipy.signal import lfilter
+
+from steerlab.errors import InputError, require_finite_range
+
+EQ39_NUM = (10.8, 0.0)
+EQ39_DEN = (1.0, 0.672, 2.6729)
+
+
+def held_white_noise(n_steps: int, dt: float, rng: np.random.Generator,
+                     sample_time: float = 0.5, power: float = 1e-4) -> np.ndarray:
+    """Zero-order-held white noise on the simulation grid ``k*dt``, ``k = 0..n_steps``."""
+    require_finite_range("waves.sample_time", sample_time, 0.0, lo_open=True)
+    require_finite_range("waves.power", power, 0.0)
+    ratio = sample_time / dt
+    hold = int(round(ratio))
+    if hold < 1 or abs(ratio - hold) > 1e-9 * max(1.0, ratio):
+        raise InputError("waves.sample_time",
+                         f"must be a positive integer multiple of dt={dt} s, got {sample_time} s")
+    n_samples = n_steps // hold + 1
+    samples = rng.standard_normal(n_samples) * math.sqrt(power / sample_time)
+    return np.repeat(samples, hold)[: n_steps + 1]
+
+
+def band_pass_eq39(dt: float, num=EQ39_NUM, den=EQ39_DEN):
+    """ZOH discretisation of eq (39) at step ``dt``: returns ``(b, a)`` for ``lfilter``."""
+    sysd = control.c2d(control.tf(list(num), list(den)), dt, method="zoh")
+    b = np.asarray(sysd.num[0][0], dtype=float)
+    a = np.asarray(sysd.den[0][0], dtype=float)
+    return b, a
+
+
+def coloured_noise(n_steps: int, dt: float, rng: np.random.Generator,
+                   sample_time: float = 0.5, power: float = 1e-4) -> np.ndarray:
+    """Eq (39) wave disturbance on the grid ``k*dt`` [rad]; starts from rest at t = 0."""
+    white = held_white_noise(n_steps, dt, rng, sample_time, power)
+    b, a = band_pass_eq39(dt)
+    # ZOH discretisation: output k depends on inputs up to k-1 (b[0] == 0)
+    return lfilter(b, a, white)
+
+
+def stationary_std_eq39(power: float = 1e-4, num=EQ39_NUM, den=EQ39_DEN) -> float:
+    """Stationary std [rad] of eq (39) driven by white noise of two-sided PSD ``power``.
+
+    For ``G = b s / (s^2 + a1 s + a0)``: ``var = P b^2 / (2 a1)``.
+    """
+    return math.sqrt(power * num[0] ** 2 / (2.0 * den[1]))

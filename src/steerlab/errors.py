@@ -1,0 +1,34 @@
+"""The one exception type for bad user input."""
+
+
+class InputError(ValueError):
+    """Bad input: names the offending field and the allowed range.
+
+    The CLI turns it into a one-line message and exit code 2, with nothing written to
+    the output directory.
+    """
+
+    def __init__(self, field: str, message: str):
+        self.field = field
+        self.message = message
+        super().__init__(f"{field}: {message}")
+
+
+def require_finite_range(field: str, value, lo=None, hi=None, lo_open=False, hi_open=False):
+    """Raise :class:`InputError` unless ``value`` is a finite number within the range."""
+    import math
+
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise InputError(field, f"must be a number, got {value!r}") from None
+    lo_s = "-inf" if lo is None else repr(lo)
+    hi_s = "inf" if hi is None else repr(hi)
+    rng = f"{'(' if lo_open or lo is None else '['}{lo_s}, {hi_s}{')' if hi_open or hi is None else ']'}"
+    if not math.isfinite(v):
+        raise InputError(field, f"must be finite, got {v!r}; allowed range {rng}")
+    if lo is not None and (v < lo or (lo_open and v == lo)):
+        raise InputError(field, f"{v!r} is out of range; allowed range {rng}")
+    if hi is not None and (v > hi or (hi_open and v == hi)):
+        raise InputError(field, f"{v!r} is out of range; allowed range {rng}")
+    return v

@@ -1,0 +1,1 @@
+"""Guidance: references for the heading controller."""

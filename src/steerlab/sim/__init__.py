@@ -1,0 +1,1 @@
+"""Simulation: scenarios, the readable loop, the compiled (batch) engine and results."""

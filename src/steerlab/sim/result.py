@@ -1,0 +1,90 @@
+"""Result of a run: time series with fixed axes, names and units; CSV / Parquet export."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from steerlab.angles import wrap_to_pi
+from steerlab.environment.channels import CHANNEL_NAMES, CHANNEL_UNITS
+
+
+@dataclass
+class Result:
+    """One run. Axis 0 of every array is time (``n_steps + 1`` rows, ``t_k = k dt``).
+
+    Attributes
+    ----------
+    time : (N,) [s]
+    states : (N, nx) plant states, columns ``state_names`` (last column: rudder angle delta)
+    delta_cmd : (N,) rudder order held over step k [rad]
+    psi_ref, r_ref : (N,) reference heading [rad] and rate [rad/s]
+    disturbance : (N, n_channels) see :mod:`steerlab.environment.channels`
+    """
+
+    time: np.ndarray
+    states: np.ndarray
+    state_names: tuple
+    state_units: tuple
+    delta_cmd: np.ndarray
+    psi_ref: np.ndarray
+    r_ref: np.ndarray
+    disturbance: np.ndarray
+    meta: dict = field(default_factory=dict)
+
+    def col(self, name: str) -> np.ndarray:
+        return self.states[:, self.state_names.index(name)]
+
+    @property
+    def psi(self):
+        return self.col("psi")
+
+    @property
+    def r(self):
+        return self.col("r")
+
+    @property
+    def delta(self):
+        return self.col("delta")
+
+    @property
+    def heading_error(self):
+        """``wrap_to_pi(psi_ref - psi)`` [rad]."""
+        return wrap_to_pi(self.psi_ref - self.psi)
+
+    @property
+    def dt(self) -> float:
+        return float(self.time[1] - self.time[0]) if len(self.time) > 1 else math.nan
+
+    def columns(self) -> dict:
+        """Flat column dict ``name [unit] -> array`` in export order."""
+        cols = {"time [s]": self.time}
+        for n, u, c in zip(self.state_names, self.state_units, self.states.T):
+            cols[f"{n} [{u}]"] = c
+        cols["delta_cmd [rad]"] = self.delta_cmd
+        cols["psi_ref [rad]"] = self.psi_ref
+        cols["r_ref [rad/s]"] = self.r_ref
+        for n, u, c in zip(CHANNEL_NAMES, CHANNEL_UNITS, self.disturbance.T):
+            cols[f"{n} [{u}]"] = c
+        return cols
+
+    def to_csv(self, path) -> Path:
+        path = Path(path)
+        cols = self.columns()
+        data = np.column_stack(list(cols.values()))
+        np.savetxt(path, data, delimiter=",", header=",".join(cols), comments="", fmt="%.10g")
+        return path
+
+    def to_parquet(self, path) -> Path:
+        """Write Parquet (needs the optional ``pyarrow``)."""
+        try:
+            import pyarrow as pa
+            import pyarrow.parquet as pq
+        except ImportError as err:  # pragma: no cover - depends on the environment
+            raise RuntimeError("Parquet export needs pyarrow: pip install 'steerlab[parquet]'") from err
+        path = Path(path)
+        pq.write_table(pa.table({k: np.asarray(v) for k, v in self.columns().items()}), path)
+        return path

@@ -1,0 +1,176 @@
+"""Scenario: a frozen, validated description of one closed-loop run, loaded from TOML.
+
+Degrees, knots and rpm appear only here (the edge); :func:`steerlab.sim.setup.build` turns a
+scenario into SI arrays for the engines. Example (the bundled default)::
+
+    name = "esso-adrc-course-change-waves"
+    seed = 1
+    dt = 0.1            # s
+    duration = 3000.0   # s
+
+    [ship]
+    model = "esso"
+    speed_kn = 16.0
+
+    [gear]              # eq (15) defaults: 35 deg, 2.33 deg/s, 1 s
+    delta_max_deg = 35.0
+
+    [controller]
+    type = "adrc"       # or "pid"
+    T_settle = 150.0    # s
+    c0 = "estimate"     # eq (29); "exact" (linearisation) or a number [1/s^2], steerlab sign
+
+    [guidance]
+    psi0_deg = 0.0
+    changes = [{ t = 100.0, psi_deg = 20.0 }]
+
+    [environment]
+    waves = true
+"""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from pathlib import Path
+from typing import Annotated, Literal, Optional, Union
+
+from pydantic import BaseModel, ConfigDict, Field, ValidationError
+
+from steerlab.errors import InputError
+
+
+class _Frozen(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
+
+
+class ShipConfig(_Frozen):
+    model: str = "esso"
+    speed_kn: float = Field(16.0, gt=0.0, le=40.0, description="approach speed [kn]")
+    rpm: Optional[float] = Field(None, gt=0.0, le=1000.0,
+                                 description="propeller rate [rpm]; default: the rate that holds speed_kn")
+
+
+class GearConfig(_Frozen):
+    delta_max_deg: float = Field(35.0, gt=0.0, le=90.0)
+    rate_max_deg_s: float = Field(2.33, gt=0.0, le=100.0)
+    T_sg: float = Field(1.0, gt=0.0, le=100.0, description="servo time constant [s]")
+    dead_zone_deg: float = Field(0.0, ge=0.0, le=10.0)
+
+
+class PIDConfig(_Frozen):
+    type: Literal["pid"]
+    Kp: float = Field(3.81, ge=0.0, le=1e4)
+    Ki: float = Field(0.00547, ge=0.0, le=1e4)
+    Kd: float = Field(3.95, ge=0.0, le=1e5)
+    u_max_deg: Optional[float] = Field(None, gt=0.0, le=90.0, description="default: gear limit")
+    sample_time: Optional[float] = Field(None, gt=0.0, le=60.0, description="default: dt")
+
+
+class ADRCConfig(_Frozen):
+    type: Literal["adrc"]
+    T_settle: float = Field(150.0, gt=0.0, le=1e5, description="settling time of (38) [s]")
+    c0: Union[float, Literal["estimate", "exact"]] = "estimate"
+    observer: Literal["paper", "bandwidth", "lqr"] = "paper"
+    observer_bandwidth: float = Field(0.5, gt=0.0, le=100.0, description="[rad/s] for observer='bandwidth'")
+    lqr_q: tuple[float, float, float] = (1.0, 1.0, 1.0)
+    lqr_r: float = Field(1.0, gt=0.0)
+    L: Optional[tuple[float, float, float]] = None
+    law: Literal["stable", "printed"] = "stable"
+    kd_rule: Literal["herbst", "printed"] = "herbst"
+    u_max_deg: Optional[float] = Field(None, gt=0.0, le=90.0)
+    sample_time: Optional[float] = Field(None, gt=0.0, le=60.0)
+
+
+ControllerConfig = Annotated[Union[PIDConfig, ADRCConfig], Field(discriminator="type")]
+
+
+class CourseChange(_Frozen):
+    t: float = Field(ge=0.0, description="time of the change [s]")
+    psi_deg: float = Field(ge=-360.0, le=360.0, description="new set heading [deg]")
+
+
+class GuidanceConfig(_Frozen):
+    psi0_deg: float = Field(0.0, ge=-360.0, le=360.0)
+    rate_max_deg_s: float = Field(0.0, ge=0.0, le=10.0, description="0 = step set-point")
+    changes: tuple[CourseChange, ...] = ()
+
+
+class EnvironmentConfig(_Frozen):
+    constant_rudder_deg: float = Field(0.0, ge=-60.0, le=60.0)
+    constant_start: float = Field(0.0, ge=0.0)
+    waves: bool = False
+    wave_sample_time: float = Field(0.5, gt=0.0, le=60.0)
+    wave_power: float = Field(1e-4, ge=0.0, le=1.0)
+
+
+class Scenario(_Frozen):
+    name: str = "scenario"
+    description: str = ""
+    seed: int = Field(0, ge=0, le=2**63 - 1)
+    dt: float = Field(0.1, gt=0.0, le=10.0, description="integration step [s]")
+    duration: float = Field(3000.0, gt=0.0, le=1e6, description="[s]")
+    ship: ShipConfig = ShipConfig()
+    gear: GearConfig = GearConfig()
+    controller: ControllerConfig = Field(default_factory=lambda: ADRCConfig(type="adrc"))
+    guidance: GuidanceConfig = GuidanceConfig()
+    environment: EnvironmentConfig = EnvironmentConfig()
+
+    @property
+    def n_steps(self) -> int:
+        return int(math.ceil(self.duration / self.dt - 1e-9))
+
+    def replace(self, **changes) -> "Scenario":
+        """A validated copy with top-level fields replaced (nested: pass whole sub-configs)."""
+        return scenario_from_dict({**self.model_dump(), **_dump(changes)})
+
+
+def _dump(d):
+    return {k: (v.model_dump() if isinstance(v, BaseModel) else v) for k, v in d.items()}
+
+
+def _format_validation_error(err: ValidationError) -> InputError:
+    first = err.errors()[0]
+    loc = ".".join(str(p) for p in first["loc"] if not (isinstance(p, str) and p in ("pid", "adrc")))
+    msg = first["msg"]
+    ctx = first.get("ctx") or {}
+    bounds = [f"{k.replace('_', ' ')} {v}" for k, v in ctx.items() if k in ("gt", "ge", "lt", "le")]
+    if bounds:
+        msg += f" (allowed: {', '.join(bounds)})"
+    if first["type"] == "union_tag_invalid":
+        loc = loc or "controller.type"
+    more = len(err.errors()) - 1
+    if more:
+        msg += f" [and {more} more problem{'s' if more > 1 else ''}]"
+    return InputError(loc or "scenario", msg)
+
+
+def scenario_from_dict(data: dict) -> Scenario:
+    """Validate a plain dict (as parsed from TOML) into a :class:`Scenario`."""
+    try:
+        return Scenario.model_validate(data)
+    except ValidationError as err:
+        raise _format_validation_error(err) from None
+
+
+def load_scenario(path) -> Scenario:
+    """Load and validate a scenario TOML file; raises :class:`InputError` on any problem."""
+    p = Path(path)
+    try:
+        text = p.read_text(encoding="utf-8")
+    except OSError as err:
+        raise InputError("scenario", f"cannot read {str(p)!r}: {err.strerror}") from None
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as err:
+        raise InputError("scenario", f"malformed TOML in {p.name}: {err}") from None
+    return scenario_from_dict(data)
+
+
+def default_scenario_path() -> Path:
+    return Path(__file__).resolve().parent.parent / "scenarios" / "default.toml"
+
+
+def default_scenario() -> Scenario:
+    """The bundled default: Esso tanker + ADRC, 20 deg course change, then course keeping in waves."""
+    return load_scenario(default_scenario_path())

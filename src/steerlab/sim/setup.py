@@ -1,0 +1,99 @@
+"""Turn a validated :class:`~steerlab.sim.scenario.Scenario` into SI arrays for the engines."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from steerlab.control import adrc, pid
+from steerlab.control.estimators import PAPER_L, eso_gains_bandwidth, eso_gains_lqr
+from steerlab.control.registry import ControllerSpec, get_controller
+from steerlab.environment.disturbance import Disturbance, build_disturbance
+from steerlab.errors import InputError
+from steerlab.guidance.reference_models import course_schedule
+from steerlab.ships.registry import ShipSpec, get_ship
+from steerlab.steering_gear import SteeringGear
+from steerlab.units import knots_to_ms, rad
+
+
+@dataclass(frozen=True)
+class SimSetup:
+    """Everything an engine needs for one run, in SI; arrays are packed kernel records."""
+
+    ship: ShipSpec
+    controller: ControllerSpec
+    ps: np.ndarray      # ship parameters
+    pg: np.ndarray      # steering-gear parameters
+    pc: np.ndarray      # controller parameters
+    gd: np.ndarray      # guidance schedule
+    x0: np.ndarray      # plant state [ship states..., delta]
+    z0: np.ndarray      # controller state
+    w: np.ndarray       # disturbances (n_steps + 1, channels)
+    dt: float
+    nc: int             # controller sample = nc * dt
+    n_steps: int
+    name: str = "scenario"
+    seed: int = 0
+
+    @property
+    def state_names(self):
+        return tuple(self.ship.state_names) + ("delta",)
+
+    @property
+    def state_units(self):
+        return tuple(self.ship.state_units) + ("rad",)
+
+
+def controller_params(cfg, ship: ShipSpec, speed: float, gear: SteeringGear):
+    """Packed parameters and the initial-state builder for a controller config."""
+    u_max = rad(cfg.u_max_deg) if cfg.u_max_deg is not None else gear.delta_max
+    if cfg.type == "pid":
+        c = pid.PID(Kp=cfg.Kp, Ki=cfg.Ki, Kd=cfg.Kd, u_max=u_max)
+        return c, c.pack()
+    if cfg.type == "adrc":
+        c0 = cfg.c0 if isinstance(cfg.c0, float) else ship.b2(speed, cfg.c0)
+        if cfg.L is not None:
+            L = cfg.L
+        elif cfg.observer == "paper":
+            L = PAPER_L
+        elif cfg.observer == "bandwidth":
+            L = eso_gains_bandwidth(cfg.observer_bandwidth)
+        else:
+            L = eso_gains_lqr(cfg.lqr_q, cfg.lqr_r)
+        c = adrc.ADRC.from_settling_time(cfg.T_settle, c0, L=L, law=cfg.law, kd_rule=cfg.kd_rule,
+                                         u_max=u_max)
+        return c, c.pack()
+    raise InputError("controller.type", f"unknown controller {cfg.type!r}")  # pragma: no cover
+
+
+def build(scenario) -> SimSetup:
+    """Validate the combination and pack the arrays (raises :class:`InputError`)."""
+    s = scenario
+    ship = get_ship(s.ship.model)
+    ctrl_spec = get_controller(s.controller.type)
+    speed = knots_to_ms(s.ship.speed_kn)
+    ps = ship.pack(speed, s.ship.rpm)
+    gear = SteeringGear(rad(s.gear.delta_max_deg), rad(s.gear.rate_max_deg_s), s.gear.T_sg,
+                        rad(s.gear.dead_zone_deg))
+    pg = gear.pack()
+    ctrl, pc = controller_params(s.controller, ship, speed, gear)
+    ts = s.controller.sample_time if s.controller.sample_time is not None else s.dt
+    nc = int(round(ts / s.dt))
+    if nc < 1 or abs(nc * s.dt - ts) > 1e-9 * max(ts, 1.0):
+        raise InputError("controller.sample_time", f"must be a positive multiple of dt={s.dt} s, got {ts} s")
+    psi0 = rad(s.guidance.psi0_deg)
+    gd = course_schedule(psi0, [(c.t, rad(c.psi_deg)) for c in s.guidance.changes],
+                         rad(s.guidance.rate_max_deg_s))
+    n_steps = s.n_steps
+    if n_steps > 50_000_000:
+        raise InputError("duration", f"duration/dt = {n_steps} steps; allowed at most 50000000")
+    x0 = np.zeros(ship.n_states + 1)
+    x0[2] = psi0
+    x0[3] = speed
+    z0 = ctrl.init_state(x0, (psi0, 0.0))
+    dist = Disturbance(rad(s.environment.constant_rudder_deg), s.environment.constant_start,
+                       s.environment.waves, s.environment.wave_sample_time, s.environment.wave_power)
+    w = build_disturbance(dist, n_steps, s.dt, s.seed)
+    return SimSetup(ship, ctrl_spec, ps, pg, pc, gd, x0, np.asarray(z0, dtype=float), w, s.dt, nc,
+                    n_steps, s.name, s.seed)

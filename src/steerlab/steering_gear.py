@@ -1,0 +1,69 @@
+r"""Steering gear: rudder saturation, rate limit, servo lag and an optional dead zone.
+
+Source: Zwierzewicz et al. (2021), eq (15) (after Fossen 1994)::
+
+    |delta| <= delta_max,   |delta'| <= rate_max,
+    delta' = sat_{rate_max}( (delta_ord - delta) / T_SG )
+
+with delta_max = 35 deg, rate_max = 2.33 deg/s and T_SG = 1 s for the Esso tanker. The
+ordered angle is first limited to +-delta_max. A dead zone ``dead_zone`` [rad] (Morawski &
+Pomirski) makes the gear ignore orders closer than that to the present angle.
+
+The rudder angle is a continuous state of the plant: the engine integrates ``gear_rate``
+together with the ship (RK4 over the joint state) and then clamps the angle to +-delta_max.
+Because each RK4 stage slope is limited to +-rate_max, so is their weighted mean: the
+rate limit holds exactly per step.
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numba
+import numpy as np
+
+from steerlab.errors import require_finite_range
+from steerlab.units import rad
+
+G_DMAX, G_RATE, G_TSG, G_DEAD = 0, 1, 2, 3
+N_PARAMS = 4
+
+
+class SteeringGear(NamedTuple):
+    """Steering-gear parameters (SI)."""
+
+    delta_max: float = rad(35.0)   #: rudder limit [rad] (eq 15: 35 deg)
+    rate_max: float = rad(2.33)    #: rudder rate limit [rad/s] (eq 15: 2.33 deg/s)
+    T_sg: float = 1.0              #: servo time constant [s] (eq 15: 1 s)
+    dead_zone: float = 0.0         #: dead zone [rad] (0 = none)
+
+    def validated(self) -> "SteeringGear":
+        require_finite_range("gear.delta_max", self.delta_max, 0.0, rad(90.0), lo_open=True)
+        require_finite_range("gear.rate_max", self.rate_max, 0.0, lo_open=True)
+        require_finite_range("gear.T_sg", self.T_sg, 0.0, lo_open=True)
+        require_finite_range("gear.dead_zone", self.dead_zone, 0.0, self.delta_max)
+        return self
+
+    def pack(self) -> np.ndarray:
+        g = self.validated()
+        return np.array([g.delta_max, g.rate_max, g.T_sg, g.dead_zone], dtype=np.float64)
+
+
+@numba.njit(cache=True)
+def gear_rate(delta, delta_cmd, g):
+    """Rudder rate [rad/s] of eq (15) for angle ``delta`` and order ``delta_cmd`` [rad]."""
+    dmax = g[G_DMAX]
+    cmd = min(max(delta_cmd, -dmax), dmax)
+    err = cmd - delta
+    if abs(err) <= g[G_DEAD]:
+        return 0.0
+    rate = err / g[G_TSG]
+    rmax = g[G_RATE]
+    return min(max(rate, -rmax), rmax)
+
+
+@numba.njit(cache=True)
+def gear_clamp(delta, g):
+    """Clamp a rudder angle to +-delta_max."""
+    dmax = g[G_DMAX]
+    return min(max(delta, -dmax), dmax)
