@@ -18,7 +18,8 @@ class ShipSpec:
     """A ship model as the engine sees it.
 
     ``pack(speed [m/s], rpm [rev/min] or None) -> params``; ``b2_exact(speed)`` and
-    ``dims`` (c_B, L [m], B [m]) feed the ADRC design (``c0``), steerlab sign.
+    ``dims`` (c_B, L [m], B [m]) feed the ADRC design (``c0``), steerlab sign;
+    ``linearise(speed) -> (A1, B1)`` is the sway-yaw linear model on ``[v, r]``, steerlab sign.
     """
 
     name: str
@@ -31,6 +32,7 @@ class ShipSpec:
     b2_exact: Callable
     dims: tuple
     source: str
+    linearise: Callable | None = None
 
     def b2(self, speed: float, method: str) -> float:
         """Rudder efficiency [1/s^2], steerlab sign: ``exact`` (linearisation) or ``estimate`` (eq 29)."""
@@ -63,6 +65,7 @@ SHIPS = {
         b2_exact=_esso_b2,
         dims=(_T.c_B, _T.L, _T.B),
         source="Zwierzewicz, Dorobczynski, Artyszuk, Energies 14 (2021) 7937, Sec. 3.1",
+        linearise=esso_3dof.linearise,
     ),
 }
 

@@ -137,8 +137,8 @@ def _format_validation_error(err: ValidationError) -> InputError:
     bounds = [f"{k.replace('_', ' ')} {v}" for k, v in ctx.items() if k in ("gt", "ge", "lt", "le")]
     if bounds:
         msg += f" (allowed: {', '.join(bounds)})"
-    if first["type"] == "union_tag_invalid":
-        loc = loc or "controller.type"
+    if first["type"] in ("union_tag_invalid", "union_tag_not_found"):
+        loc = f"{loc}.type" if loc else "controller.type"
     more = len(err.errors()) - 1
     if more:
         msg += f" [and {more} more problem{'s' if more > 1 else ''}]"

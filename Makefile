@@ -1,0 +1,15 @@
+# Convenience targets; the README's two commands are what they run.
+PY ?= python3
+
+.PHONY: demo test bench experiment
+demo:
+	$(PY) -m pip install -e . && $(PY) -m steerlab run --out out/default
+
+test:
+	$(PY) -m pip install -e ".[test]" && $(PY) -m pytest -q
+
+bench:
+	$(PY) -m steerlab bench --json
+
+experiment:
+	$(PY) -m steerlab experiment zwierzewicz2021 --out out/zwierzewicz2021

@@ -1,0 +1,292 @@
+"""steerlab command line: thin layer that parses, builds a scenario, runs and reports.
+
+Every command accepts ``--help`` with examples. Bad input (unknown ship or controller,
+out-of-range or NaN fields, malformed TOML) prints one line naming the field and the allowed
+range and exits with code 2, leaving nothing in ``--out``: outputs are written to a staging
+directory first and moved into place only when everything succeeded.
+"""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import json
+import math
+import os
+import shutil
+import sys
+import time
+from pathlib import Path
+
+from steerlab.errors import InputError
+
+EXIT_BAD_INPUT = 2
+
+
+def _progress(quiet: bool):
+    start = time.perf_counter()
+
+    def say(msg: str) -> None:
+        if not quiet:
+            print(f"[{time.perf_counter() - start:6.1f} s] {msg}", file=sys.stderr, flush=True)
+
+    return say
+
+
+@contextlib.contextmanager
+def staged_output(out_dir: Path):
+    """Write into a hidden sibling directory; move the files into ``out_dir`` only on success."""
+    out_dir = Path(out_dir)
+    if out_dir.exists() and not out_dir.is_dir():
+        raise InputError("--out", f"{str(out_dir)!r} exists and is not a directory")
+    parent = out_dir.resolve().parent
+    try:
+        parent.mkdir(parents=True, exist_ok=True)
+    except OSError as err:
+        raise InputError("--out", f"cannot create {str(parent)!r}: {err.strerror}") from None
+    stage = parent / f".{out_dir.name}.partial-{os.getpid()}"
+    shutil.rmtree(stage, ignore_errors=True)
+    stage.mkdir()
+    try:
+        yield stage
+    except BaseException:
+        shutil.rmtree(stage, ignore_errors=True)
+        raise
+    out_dir.mkdir(parents=True, exist_ok=True)
+    for item in stage.iterdir():
+        target = out_dir / item.name
+        if target.is_dir():
+            shutil.rmtree(target)
+        os.replace(item, target)
+    stage.rmdir()
+
+
+def _json_default(o):
+    try:
+        import numpy as np
+
+        if isinstance(o, np.generic):
+            return o.item()
+        if isinstance(o, np.ndarray):
+            return o.tolist()
+    except ImportError:  # pragma: no cover
+        pass
+    if isinstance(o, complex):
+        return [o.real, o.imag]
+    raise TypeError(f"not JSON serialisable: {type(o)}")
+
+
+def _clean(o):
+    """NaN/inf -> None so the JSON is standard."""
+    if isinstance(o, float) and not math.isfinite(o):
+        return None
+    if isinstance(o, dict):
+        return {k: _clean(v) for k, v in o.items()}
+    if isinstance(o, (list, tuple)):
+        return [_clean(v) for v in o]
+    return o
+
+
+def dump_json(obj, path: Path | None = None) -> str:
+    text = json.dumps(_clean(json.loads(json.dumps(obj, default=_json_default))), indent=2)
+    if path is not None:
+        Path(path).write_text(text + "\n", encoding="utf-8")
+    return text
+
+
+# ---------------------------------------------------------------- commands
+
+
+def cmd_run(args) -> int:
+    from steerlab.metrics import METRIC_UNITS, compute_metrics
+    from steerlab.report import format_metrics_table, write_run_report
+    from steerlab.sim.engine import simulate
+    from steerlab.sim.scenario import default_scenario, default_scenario_path, load_scenario
+    from steerlab.sim.setup import build
+
+    say = _progress(args.quiet)
+    path = Path(args.scenario) if args.scenario else default_scenario_path()
+    scenario = load_scenario(path) if args.scenario else default_scenario()
+    if args.seed is not None:
+        scenario = scenario.replace(seed=args.seed)
+    if not (args.lam >= 0.0 and math.isfinite(args.lam)):
+        raise InputError("--lambda", f"must be a finite number >= 0, got {args.lam}")
+    say(f"scenario {scenario.name!r} from {path}")
+    setup = build(scenario)
+    say(f"simulating {setup.n_steps} steps of {setup.dt} s with the {args.engine} engine "
+        f"({setup.ship.name} + {setup.controller.name}; first call compiles, a few seconds)")
+    result = simulate(setup, engine=args.engine)
+    metrics = compute_metrics(result, lam=args.lam)
+    say("writing time series, metrics, figures and report")
+    with staged_output(Path(args.out)) as stage:
+        result.to_csv(stage / "timeseries.csv")
+        if args.parquet:
+            result.to_parquet(stage / "timeseries.parquet")
+        dump_json({"scenario": scenario.name, "seed": scenario.seed, "engine": args.engine,
+                   "metrics": metrics, "units": {k: METRIC_UNITS.get(k, "") for k in metrics}},
+                  stage / "metrics.json")
+        (stage / "scenario.json").write_text(scenario.model_dump_json(indent=2) + "\n", encoding="utf-8")
+        write_run_report(stage, result, metrics, scenario)
+    print(format_metrics_table(metrics))
+    say(f"wrote {args.out}/report.html")
+    return 0
+
+
+def cmd_experiment(args) -> int:
+    from steerlab.experiments import EXPERIMENTS
+
+    if args.name not in EXPERIMENTS:
+        raise InputError("experiment", f"unknown experiment {args.name!r}; known: {sorted(EXPERIMENTS)}")
+    say = _progress(args.quiet)
+    run = EXPERIMENTS[args.name]["run"]
+    with staged_output(Path(args.out)) as stage:
+        rows = run(stage, progress=say, quick=args.quick)
+    width = max(len(str(r["quantity"])) for r in rows)
+    print(f"{'quantity':<{width}}  {'paper':>14}  {'steerlab':>14}  unit")
+    for r in rows:
+        print(f"{r['quantity']:<{width}}  {_fmt(r['paper']):>14}  {_fmt(r['steerlab']):>14}  {r['unit']}")
+    say(f"wrote {args.out}/comparison.json and the figures")
+    return 0
+
+
+def _fmt(v) -> str:
+    if isinstance(v, float):
+        return f"{v:.4g}"
+    return str(v)
+
+
+def cmd_linearize(args) -> int:
+    from steerlab.ships.linear_analysis import linear_summary
+    from steerlab.units import knots_to_ms
+
+    if not (math.isfinite(args.speed_kn) and 0.0 < args.speed_kn <= 40.0):
+        raise InputError("--speed-kn", f"must be in (0, 40] kn, got {args.speed_kn}")
+    summary = linear_summary(args.ship, knots_to_ms(args.speed_kn))
+    summary["speed_kn"] = args.speed_kn
+    if args.json:
+        print(dump_json(summary))
+        return 0
+    s = summary
+    print(f"{s['ship']} at {args.speed_kn:g} kn ({s['speed_m_s']:.4f} m/s), state [v, r]")
+    print(f"A1 = [[{s['A1'][0][0]: .5e}, {s['A1'][0][1]: .5e}],\n      [{s['A1'][1][0]: .5e}, {s['A1'][1][1]: .5e}]]")
+    print(f"B1 = [{s['B1'][0]: .5e}, {s['B1'][1]: .5e}]   (steerlab sign: delta > 0 to starboard)")
+    print("eigenvalues: " + ", ".join(f"{e[0]:.5g}{e[1]:+.3g}j" for e in s["eigenvalues"])
+          + ("  -> open-loop UNSTABLE" if s["open_loop_unstable"] else "  -> open-loop stable"))
+    print(f"b2 exact    = {s['b2_exact']:.4e} 1/s^2  (paper sign {s['b2_exact_paper']:.4e})")
+    print(f"b2 eq (29)  = {s['b2_estimate_eq29']:.4e} 1/s^2  (paper sign {s['b2_estimate_eq29_paper']:.4e})")
+    print(f"a0 (eq 36)  = {s['a0']:.4e} 1/s  ({'stable' if s['zero_dynamics_stable'] else 'unstable'} zero dynamics)")
+    print(f"Nomoto K = {s['nomoto_K']:.4g} 1/s, T = {s['nomoto_T']:.4g} s "
+          f"(T1 {s['nomoto_T1']:.4g}, T2 {s['nomoto_T2']:.4g}, T3 {s['nomoto_T3']:.4g} s)")
+    return 0
+
+
+def cmd_bench(args) -> int:
+    from steerlab.bench import run_bench
+
+    if args.n_batch < 1 or args.n_batch > 100_000:
+        raise InputError("--n-batch", f"must be in [1, 100000], got {args.n_batch}")
+    if args.repeats < 1 or args.repeats > 100:
+        raise InputError("--repeats", f"must be in [1, 100], got {args.repeats}")
+    say = _progress(args.quiet)
+    out = run_bench(n_batch=args.n_batch, repeats=args.repeats, progress=say)
+    if args.json:
+        print(dump_json(out))
+    else:
+        for k, v in out.items():
+            print(f"{k:<34} {_fmt(v)}")
+    return 0
+
+
+# ---------------------------------------------------------------- parser
+
+EXAMPLES = {
+    "run": """examples:
+  steerlab run --out out/default            # bundled default: Esso tanker + ADRC, 20 deg change, waves
+  steerlab run my_scenario.toml --out out/mine --parquet
+  steerlab run --seed 7 --engine readable --out out/seed7""",
+    "experiment": """examples:
+  steerlab experiment zwierzewicz2021 --out out/zw2021
+  steerlab experiment zwierzewicz2021 --quick --out /tmp/zw-quick""",
+    "linearize": """examples:
+  steerlab linearize esso --speed-kn 16 --json
+  steerlab linearize esso --speed-kn 10""",
+    "bench": """examples:
+  steerlab bench --json
+  steerlab bench --n-batch 200 --repeats 3""",
+}
+
+
+def build_parser() -> argparse.ArgumentParser:
+    fmt = argparse.RawDescriptionHelpFormatter
+    p = argparse.ArgumentParser(
+        prog="steerlab", formatter_class=fmt,
+        description="steerlab: design, tune, assess and run ship autopilots.",
+        epilog="examples:\n  steerlab run --out out/default\n  steerlab experiment zwierzewicz2021 --out out/zw"
+               "\n  steerlab linearize esso --speed-kn 16 --json\n  steerlab bench --json\n\n"
+               "Run 'steerlab COMMAND --help' for a command's options.")
+    p.add_argument("--version", action="version", version=_version())
+    sub = p.add_subparsers(dest="command", metavar="COMMAND")
+    sub.required = True
+
+    r = sub.add_parser("run", help="run one scenario and write metrics, time series, figures and a report",
+                       description="Run one scenario (TOML); without a file, the bundled default.",
+                       epilog=EXAMPLES["run"], formatter_class=fmt)
+    r.add_argument("scenario", nargs="?", help="scenario TOML file (default: the bundled default scenario)")
+    r.add_argument("--out", required=True, help="output directory")
+    r.add_argument("--engine", choices=("compiled", "readable"), default="compiled")
+    r.add_argument("--seed", type=int, default=None, help="override the scenario's seed")
+    r.add_argument("--lambda", dest="lam", type=float, default=0.1,
+                   help="rudder weight of the speed-loss criterion J (default 0.1)")
+    r.add_argument("--parquet", action="store_true", help="also write timeseries.parquet (needs pyarrow)")
+    r.add_argument("--quiet", action="store_true", help="no progress messages")
+    r.set_defaults(func=cmd_run)
+
+    e = sub.add_parser("experiment", help="reproduce a paper's results next to the published numbers",
+                       description="Reproduce a paper: figures plus comparison.json (paper vs steerlab).",
+                       epilog=EXAMPLES["experiment"], formatter_class=fmt)
+    e.add_argument("name", help="experiment name, e.g. zwierzewicz2021")
+    e.add_argument("--out", required=True, help="output directory")
+    e.add_argument("--quick", action="store_true", help="shorter runs (for smoke tests)")
+    e.add_argument("--quiet", action="store_true")
+    e.set_defaults(func=cmd_experiment)
+
+    lz = sub.add_parser("linearize", help="linear sway-yaw model, b2, zero dynamics and Nomoto K, T",
+                        description="Linearise a ship at a speed (Zwierzewicz et al. 2021, eqs 16-18, 29, 36).",
+                        epilog=EXAMPLES["linearize"], formatter_class=fmt)
+    lz.add_argument("ship", help="ship name, e.g. esso")
+    lz.add_argument("--speed-kn", type=float, default=16.0, help="speed [kn] (default 16)")
+    lz.add_argument("--json", action="store_true", help="print JSON")
+    lz.set_defaults(func=cmd_linearize)
+
+    b = sub.add_parser("bench", help="speed benchmark W1 (single run, batch, plain-Python reference)",
+                       description="Workload W1: Esso + gear + PID, RK4, dt 0.1 s, 3000 s, 20 deg change.",
+                       epilog=EXAMPLES["bench"], formatter_class=fmt)
+    b.add_argument("--n-batch", type=int, default=1000, help="runs in the batch (default 1000)")
+    b.add_argument("--repeats", type=int, default=5, help="timing repeats, median reported (default 5)")
+    b.add_argument("--json", action="store_true", help="print JSON")
+    b.add_argument("--quiet", action="store_true")
+    b.set_defaults(func=cmd_bench)
+    return p
+
+
+def _version() -> str:
+    from steerlab import __version__
+
+    return f"steerlab {__version__}"
+
+
+def main(argv=None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    try:
+        return args.func(args)
+    except InputError as err:
+        print(f"steerlab: error: {err}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    except KeyboardInterrupt:
+        print("steerlab: interrupted", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())
