@@ -70,7 +70,7 @@ def test_same_scenario_same_bytes(tmp_path):
 ])
 def test_bad_scenario_exit_2_nothing_written(tmp_path, capsys, kwargs, field):
     out = tmp_path / "out"
-    assert main(["run", str(_scenario(tmp_path, **kwargs)), "--out", str(out)]) == 2
+    assert main(["run", str(_scenario(tmp_path, **kwargs)), "--out", str(out), "--quiet"]) == 2
     err = capsys.readouterr().err
     assert field in err and err.startswith("steerlab: error:")
     assert "Traceback" not in err

@@ -1,0 +1,465 @@
+"""Figures and a static HTML report of one run; a plain-text metrics table for the terminal.
+
+Everything is drawn with matplotlib's Agg canvas (:class:`matplotlib.figure.Figure` +
+:class:`~matplotlib.backends.backend_agg.FigureCanvasAgg`), never through ``pyplot``: nothing
+depends on a display, no global figure registry grows, and a figure is freed as soon as it
+goes out of scope. Degrees appear only here (the edge); the :class:`~steerlab.sim.result.Result`
+stays SI / radians.
+
+The HTML page is self-contained: inline CSS, images by relative links to the PNGs written
+next to it, no scripts and no internet assets. All text is HTML-escaped.
+"""
+
+from __future__ import annotations
+
+import html
+import math
+from numbers import Integral, Real
+from pathlib import Path
+
+import numpy as np
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.figure import Figure
+
+from steerlab.environment.channels import W_RUDDER
+from steerlab.metrics import METRIC_UNITS
+
+R2D = 180.0 / math.pi
+
+FIGURE_NAMES = ("heading.png", "rudder.png", "yaw_rate.png", "track.png")
+"""The files :func:`write_run_figures` writes, in order."""
+
+TIME_SERIES_SIZE = (8.0, 3.5)
+"""Figure size of the time-series plots [in]."""
+
+TRACK_SIZE = (6.5, 6.5)
+"""Figure size of the track plot [in]."""
+
+DPI = 110
+
+_META_KEYS = ("name", "ship", "controller", "engine", "dt", "controller_sample_time",
+              "duration", "n_steps", "seed")
+
+_FIGURE_ALT = {
+    "heading.png": "Heading psi and reference heading psi_ref [deg] versus time",
+    "rudder.png": "Rudder order, actual rudder angle and disturbance (equivalent rudder) [deg] versus time",
+    "yaw_rate.png": "Yaw rate r and reference rate r_ref [deg/s] versus time",
+    "track.png": "Ship track, east versus north",
+}
+
+
+# --------------------------------------------------------------------------------------------
+# figures
+# --------------------------------------------------------------------------------------------
+
+def _new_figure(figsize=TIME_SERIES_SIZE):
+    """A figure on its own Agg canvas and one axes.
+
+    Returns
+    -------
+    fig : matplotlib.figure.Figure
+    ax : matplotlib.axes.Axes
+    """
+    fig = Figure(figsize=figsize, dpi=DPI, layout="constrained")
+    FigureCanvasAgg(fig)
+    ax = fig.add_subplot()
+    ax.grid(True, alpha=0.4)
+    return fig, ax
+
+
+def _save(fig, path: Path) -> Path:
+    """Write ``fig`` as PNG and release its artists.
+
+    Parameters
+    ----------
+    fig : matplotlib.figure.Figure
+    path : pathlib.Path
+
+    Returns
+    -------
+    pathlib.Path
+        ``path``.
+    """
+    fig.savefig(path, dpi=DPI, format="png")
+    fig.clear()
+    return path
+
+
+def _title(ax, title: str, what: str) -> None:
+    """Axes title ``"<title> - <what>"``; user text is never parsed as mathtext."""
+    ax.set_title(f"{title} - {what}" if title else what, parse_math=False)
+
+
+def unwrapped_heading_deg(psi, psi_ref):
+    """Continuous (unwrapped) headings in degrees, on the same branch.
+
+    Both series are unwrapped with :func:`numpy.unwrap`, then ``psi`` is shifted by a whole
+    number of turns so that it starts within 180 deg of ``psi_ref``: a 359 -> 1 deg change
+    plots as a 2 deg step and the two curves never sit a full turn apart.
+
+    Parameters
+    ----------
+    psi, psi_ref : (N,) array_like
+        Heading and reference heading [rad].
+
+    Returns
+    -------
+    psi_deg, psi_ref_deg : (N,) numpy.ndarray
+        [deg].
+    """
+    ref_u = np.unwrap(np.asarray(psi_ref, dtype=float))
+    psi_u = np.unwrap(np.asarray(psi, dtype=float))
+    if len(psi_u):
+        psi_u = psi_u + 2.0 * math.pi * np.round((ref_u[0] - psi_u[0]) / (2.0 * math.pi))
+    return psi_u * R2D, ref_u * R2D
+
+
+def plot_heading(path: Path, result, title: str = "") -> Path:
+    """Heading and reference heading [deg] versus time.
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        PNG to write.
+    result : steerlab.sim.result.Result
+    title : str, optional
+
+    Returns
+    -------
+    pathlib.Path
+    """
+    psi_deg, ref_deg = unwrapped_heading_deg(result.psi, result.psi_ref)
+    fig, ax = _new_figure()
+    ax.plot(result.time, ref_deg, "--", color="0.35", lw=1.2, label="psi_ref (set heading)")
+    ax.plot(result.time, psi_deg, color="C0", lw=1.2, label="psi (heading)")
+    ax.set_xlabel("time [s]")
+    ax.set_ylabel("heading [deg]")
+    ax.legend(loc="best")
+    _title(ax, title, "heading")
+    return _save(fig, path)
+
+
+def plot_rudder(path: Path, result, title: str = "") -> Path:
+    """Rudder order, actual rudder angle and (if non-zero) the equivalent-rudder disturbance [deg].
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        PNG to write.
+    result : steerlab.sim.result.Result
+    title : str, optional
+
+    Returns
+    -------
+    pathlib.Path
+    """
+    fig, ax = _new_figure()
+    dist = np.asarray(result.disturbance)
+    if dist.ndim == 2 and dist.shape[1] > W_RUDDER and np.any(dist[:, W_RUDDER] != 0.0):
+        # drawn first and light: wave noise would otherwise hide the rudder curves
+        ax.plot(result.time, dist[:, W_RUDDER] * R2D, color="C2", lw=0.7, alpha=0.45, zorder=1,
+                label="disturbance (equiv. rudder)")
+    ax.plot(result.time, result.delta_cmd * R2D, color="C1", lw=1.0, alpha=0.9, zorder=2,
+            label="delta_cmd (order)")
+    ax.plot(result.time, result.delta * R2D, color="C0", lw=1.3, zorder=3, label="delta (actual)")
+    ax.axhline(0.0, color="0.5", lw=0.6)
+    ax.set_xlabel("time [s]")
+    ax.set_ylabel("rudder angle [deg]")
+    ax.legend(loc="best")
+    _title(ax, title, "rudder")
+    return _save(fig, path)
+
+
+def plot_yaw_rate(path: Path, result, title: str = "") -> Path:
+    """Yaw rate and reference rate [deg/s] versus time.
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        PNG to write.
+    result : steerlab.sim.result.Result
+    title : str, optional
+
+    Returns
+    -------
+    pathlib.Path
+    """
+    fig, ax = _new_figure()
+    ax.plot(result.time, result.r_ref * R2D, "--", color="0.35", lw=1.2, label="r_ref (reference)")
+    ax.plot(result.time, result.r * R2D, color="C0", lw=1.2, label="r (yaw rate)")
+    ax.axhline(0.0, color="0.5", lw=0.6)
+    ax.set_xlabel("time [s]")
+    ax.set_ylabel("yaw rate [deg/s]")
+    ax.legend(loc="best")
+    _title(ax, title, "yaw rate")
+    return _save(fig, path)
+
+
+def plot_track(path: Path, result, title: str = "") -> Path:
+    """Track: east (horizontal) versus north (vertical), equal aspect, start/end markers.
+
+    Metres for tracks up to 5 km across, kilometres beyond. A ship model without position
+    states (``x_n``, ``y_e``) gets a placeholder figure saying so, so the report's links hold.
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        PNG to write.
+    result : steerlab.sim.result.Result
+    title : str, optional
+
+    Returns
+    -------
+    pathlib.Path
+    """
+    fig, ax = _new_figure(TRACK_SIZE)
+    _title(ax, title, "track")
+    if not {"x_n", "y_e"} <= set(result.state_names):
+        ax.text(0.5, 0.5, "no position states (x_n, y_e) in this ship model",
+                ha="center", va="center", transform=ax.transAxes)
+        ax.set_axis_off()
+        return _save(fig, path)
+    north = result.col("x_n")
+    east = result.col("y_e")
+    extent = max(np.ptp(north), np.ptp(east)) if len(north) else 0.0
+    scale, unit = (1e-3, "km") if extent > 5000.0 else (1.0, "m")
+    ax.plot(east * scale, north * scale, color="C0", lw=1.2, label="track")
+    ax.plot(east[0] * scale, north[0] * scale, "o", color="C2", ms=7, label="start")
+    ax.plot(east[-1] * scale, north[-1] * scale, "s", color="C3", ms=7, label="end")
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.set_xlabel(f"east y_e [{unit}]")
+    ax.set_ylabel(f"north x_n [{unit}]")
+    ax.legend(loc="best")
+    return _save(fig, path)
+
+
+_PLOTTERS = {
+    "heading.png": plot_heading,
+    "rudder.png": plot_rudder,
+    "yaw_rate.png": plot_yaw_rate,
+    "track.png": plot_track,
+}
+
+
+def write_run_figures(out_dir: Path, result, title: str = "") -> list[Path]:
+    """Write the run's PNG figures into ``out_dir`` (created if missing).
+
+    Parameters
+    ----------
+    out_dir : pathlib.Path
+        Output folder.
+    result : steerlab.sim.result.Result
+        The run.
+    title : str, optional
+        Prefix of every plot title (plain text, not mathtext).
+
+    Returns
+    -------
+    list of pathlib.Path
+        ``heading.png``, ``rudder.png``, ``yaw_rate.png``, ``track.png`` in ``out_dir``.
+    """
+    out_dir = Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    return [_PLOTTERS[name](out_dir / name, result, title) for name in FIGURE_NAMES]
+
+
+# --------------------------------------------------------------------------------------------
+# metrics formatting
+# --------------------------------------------------------------------------------------------
+
+def _missing_text(name: str, metrics: dict) -> str:
+    """What a ``None`` / NaN metric means: ``"not settled"`` for a settling time, else ``"n/a"``.
+
+    ``settling_time_2pct_s`` is also ``None`` when the run has no set-point change (then the
+    step metrics such as ``rise_time_s`` / ``overshoot_pct`` are ``None`` too): that is "n/a".
+    """
+    if name == "settling_time_1deg_s":
+        return "not settled"
+    if name == "settling_time_2pct_s":
+        has_step = metrics.get("overshoot_pct") is not None
+        return "not settled" if has_step else "n/a"
+    return "n/a"
+
+
+def format_value(value) -> str:
+    """A metric value as text: integers as is, floats to about 4 significant digits.
+
+    Parameters
+    ----------
+    value : int, float, bool, str or None
+
+    Returns
+    -------
+    str
+        ``"n/a"`` for ``None`` and NaN.
+    """
+    if value is None:
+        return "n/a"
+    if isinstance(value, bool):
+        return "yes" if value else "no"
+    if isinstance(value, Integral):
+        return str(int(value))
+    if isinstance(value, Real):
+        v = float(value)
+        if math.isnan(v):
+            return "n/a"
+        if math.isinf(v):
+            return "inf" if v > 0 else "-inf"
+        if v == 0.0:
+            return "0"
+        a = abs(v)
+        if a >= 1e7 or a < 1e-4:
+            return f"{v:.3e}"
+        decimals = min(6, max(0, 3 - math.floor(math.log10(a))))
+        return f"{v:.{decimals}f}"
+    return str(value)
+
+
+def _metric_rows(metrics: dict) -> list[tuple[str, str, str]]:
+    """``(name, value text, unit)`` for every metric, in dict order."""
+    rows = []
+    for name, value in metrics.items():
+        missing = value is None or (isinstance(value, float) and math.isnan(value))
+        text = _missing_text(name, metrics) if missing else format_value(value)
+        rows.append((str(name), text, METRIC_UNITS.get(name, "")))
+    return rows
+
+
+def format_metrics_table(metrics: dict) -> str:
+    """A plain-text table ``name | value | unit``, one line per metric (for the terminal).
+
+    Parameters
+    ----------
+    metrics : dict
+        As returned by :func:`steerlab.metrics.compute_metrics`.
+
+    Returns
+    -------
+    str
+        Aligned lines without a header, joined by newlines (no trailing newline). Values are
+        right-aligned; ``None`` shows as ``not settled`` (settling times) or ``n/a``.
+    """
+    rows = _metric_rows(metrics)
+    if not rows:
+        return ""
+    w_name = max(len(r[0]) for r in rows)
+    w_val = max(len(r[1]) for r in rows)
+    return "\n".join(f"{n:<{w_name}}  {v:>{w_val}}  {u}".rstrip() for n, v, u in rows)
+
+
+# --------------------------------------------------------------------------------------------
+# HTML
+# --------------------------------------------------------------------------------------------
+
+_CSS = """
+body { font-family: system-ui, -apple-system, "Segoe UI", Helvetica, Arial, sans-serif;
+       max-width: 60rem; margin: 2rem auto; padding: 0 1rem; color: #222; line-height: 1.4; }
+h1 { font-size: 1.6rem; margin-bottom: 0.2rem; }
+h2 { font-size: 1.2rem; margin-top: 2rem; border-bottom: 1px solid #ddd; }
+p.description { color: #555; margin-top: 0; }
+table { border-collapse: collapse; margin: 0.5rem 0; }
+th, td { padding: 0.2rem 0.8rem; border-bottom: 1px solid #eee; text-align: left; }
+td.value { text-align: right; font-variant-numeric: tabular-nums; }
+th { background: #f4f4f4; }
+figure { margin: 1rem 0; }
+figure img { max-width: 100%; height: auto; border: 1px solid #eee; }
+figcaption { color: #555; font-size: 0.9rem; }
+pre { background: #f7f7f7; padding: 0.8rem; overflow-x: auto; font-size: 0.85rem; }
+""".strip()
+
+
+def _e(x) -> str:
+    """HTML-escaped text of anything."""
+    return html.escape(str(x), quote=True)
+
+
+def _meta_items(result, scenario) -> list[tuple[str, str]]:
+    """``(key, text)`` pairs of the run's meta data shown in the report."""
+    meta = dict(result.meta)
+    if "duration" not in meta:
+        meta["duration"] = (scenario.duration if scenario is not None
+                            else float(result.time[-1] - result.time[0]) if len(result.time) else None)
+    units = {"dt": " s", "controller_sample_time": " s", "duration": " s"}
+    items = []
+    for key in _META_KEYS:
+        if key in meta and meta[key] is not None:
+            value = meta[key]
+            text = f"{value:g}" if isinstance(value, float) else format_value(value)
+            items.append((key, text + units.get(key, "")))
+    return items
+
+
+def _html_meta(result, scenario) -> str:
+    rows = "\n".join(f"<tr><th>{_e(k)}</th><td>{_e(v)}</td></tr>" for k, v in _meta_items(result, scenario))
+    return f"<h2>Run</h2>\n<table class=\"meta\">\n{rows}\n</table>"
+
+
+def _html_metrics(metrics: dict) -> str:
+    rows = "\n".join(f"<tr><td>{_e(n)}</td><td class=\"value\">{_e(v)}</td><td>{_e(u)}</td></tr>"
+                     for n, v, u in _metric_rows(metrics))
+    return ("<h2>Metrics</h2>\n<table class=\"metrics\">\n"
+            "<tr><th>metric</th><th>value</th><th>unit</th></tr>\n" f"{rows}\n</table>")
+
+
+def _html_figures(paths) -> str:
+    parts = ["<h2>Figures</h2>"]
+    for p in paths:
+        alt = _FIGURE_ALT.get(p.name, p.stem)
+        parts.append(f"<figure><img src=\"{_e(p.name)}\" alt=\"{_e(alt)}\">"
+                     f"<figcaption>{_e(alt)}</figcaption></figure>")
+    return "\n".join(parts)
+
+
+def _scenario_text(scenario) -> str:
+    """The scenario as indented JSON (pydantic) or its ``repr``."""
+    dump = getattr(scenario, "model_dump_json", None)
+    return dump(indent=2) if callable(dump) else repr(scenario)
+
+
+def _html_scenario(scenario) -> str:
+    if scenario is None:
+        return ""
+    return f"<h2>Scenario</h2>\n<pre>{_e(_scenario_text(scenario))}</pre>"
+
+
+def write_run_report(out_dir: Path, result, metrics: dict, scenario=None,
+                     title: str | None = None) -> Path:
+    """Write the run's figures and a self-contained ``report.html`` into ``out_dir``.
+
+    Parameters
+    ----------
+    out_dir : pathlib.Path
+        Output folder (created if missing).
+    result : steerlab.sim.result.Result
+        The run.
+    metrics : dict
+        As returned by :func:`steerlab.metrics.compute_metrics`.
+    scenario : steerlab.sim.scenario.Scenario, optional
+        Shown (name, description, full settings) when given.
+    title : str, optional
+        Page and plot title; default: the scenario name, else ``result.meta["name"]``.
+
+    Returns
+    -------
+    pathlib.Path
+        ``out_dir / "report.html"``.
+    """
+    out_dir = Path(out_dir)
+    if title is None:
+        title = getattr(scenario, "name", None) or result.meta.get("name") or "steerlab run"
+    figures = write_run_figures(out_dir, result, title)
+    description = getattr(scenario, "description", "") if scenario is not None else ""
+    name = getattr(scenario, "name", None) or result.meta.get("name", "")
+    body = [f"<h1>{_e(title)}</h1>"]
+    if name and name != title:
+        body.append(f"<p class=\"description\">scenario: {_e(name)}</p>")
+    if description:
+        body.append(f"<p class=\"description\">{_e(description)}</p>")
+    body += [_html_meta(result, scenario), _html_metrics(metrics), _html_figures(figures),
+             _html_scenario(scenario)]
+    page = ("<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
+            f"<title>{_e(title)}</title>\n<style>\n{_CSS}\n</style>\n</head>\n<body>\n"
+            + "\n".join(b for b in body if b) + "\n</body>\n</html>\n")
+    path = out_dir / "report.html"
+    path.write_text(page, encoding="utf-8")
+    return path
