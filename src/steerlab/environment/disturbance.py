@@ -37,7 +37,7 @@ class Disturbance:
     wave_power: float = 1e-4
 
     def validated(self) -> "Disturbance":
-        require_finite_range("environment.constant_rudder_deg", self.constant_rudder, -np.pi / 2, np.pi / 2)
+        require_finite_range("environment.constant_rudder [rad]", self.constant_rudder, -np.pi / 2, np.pi / 2)
         require_finite_range("environment.constant_start", self.constant_start, 0.0)
         require_finite_range("environment.wave_sample_time", self.wave_sample_time, 0.0, lo_open=True)
         require_finite_range("environment.wave_power", self.wave_power, 0.0)

@@ -8,8 +8,13 @@ i.e. a two-sided PSD of ``P``) drives the band-pass filter::
 
 The output is an equivalent rudder angle [rad]. The filter is discretised exactly with a
 zero-order hold at the simulation step ``dt`` (python-control ``c2d``), which is exact here
-because the input is constant over each step (``Ts`` is a multiple of ``dt``). Stationary
-standard deviation for the defaults: ``sqrt(P b^2 / (2 a1)) = 0.093 rad`` (5.3 deg).
+because the input is constant over each step (``Ts`` is a multiple of ``dt``).
+
+Output level: for ideal white noise of PSD ``P`` the stationary standard deviation would be
+``sqrt(P b^2 / (2 a1)) = 0.093 rad`` (5.3 deg, :func:`stationary_std_eq39`). The held
+(band-limited) noise has less power near the filter's 1.6 rad/s peak — the hold's
+``sinc`` roll-off — so the generated sequence has about 4.9 deg (numerical integration of
+``|G|^2`` against the held-noise spectrum; :func:`held_noise_std_eq39`; the tests check the sequence against it).
 """
 
 from __future__ import annotations
@@ -46,6 +51,9 @@ def band_pass_eq39(dt: float, num=EQ39_NUM, den=EQ39_DEN):
     sysd = control.c2d(control.tf(list(num), list(den)), dt, method="zoh")
     b = np.asarray(sysd.num[0][0], dtype=float)
     a = np.asarray(sysd.den[0][0], dtype=float)
+    # python-control drops the leading zero of a strictly proper numerator; lfilter needs it
+    # (otherwise output k would see input k: the sequence would run one step early)
+    b = np.concatenate([np.zeros(len(a) - len(b)), b])
     return b, a
 
 
@@ -64,3 +72,26 @@ def stationary_std_eq39(power: float = 1e-4, num=EQ39_NUM, den=EQ39_DEN) -> floa
     For ``G = b s / (s^2 + a1 s + a0)``: ``var = P b^2 / (2 a1)``.
     """
     return math.sqrt(power * num[0] ** 2 / (2.0 * den[1]))
+
+
+def held_noise_std_eq39(sample_time: float = 0.5, power: float = 1e-4, num=EQ39_NUM, den=EQ39_DEN) -> float:
+    """Time-averaged std [rad] of eq (39) driven by *held* white noise (what steerlab generates).
+
+    The held sequence (variance ``P/Ts`` per sample) has the averaged spectrum
+    ``P sinc^2(w Ts / 2)``, so ``var = (1/pi) int_0^inf |G(jw)|^2 P sinc^2(w Ts/2) dw``.
+    """
+    from scipy.integrate import quad
+
+    b = num[0]
+    a1, a0 = den[1], den[2]
+
+    def integrand(w):
+        g2 = (b * w) ** 2 / ((a0 - w * w) ** 2 + (a1 * w) ** 2)
+        x = 0.5 * w * sample_time
+        s = 1.0 if x == 0.0 else math.sin(x) / x
+        return g2 * s * s
+
+    peak = math.sqrt(a0)
+    val = sum(quad(integrand, lo, hi, limit=200)[0]
+              for lo, hi in ((0.0, peak), (peak, 20 * peak), (20 * peak, math.inf)))
+    return math.sqrt(power * val / math.pi)

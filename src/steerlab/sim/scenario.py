@@ -35,7 +35,7 @@ import tomllib
 from pathlib import Path
 from typing import Annotated, Literal, Optional, Union
 
-from pydantic import BaseModel, ConfigDict, Field, ValidationError
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
 
 from steerlab.errors import InputError
 
@@ -80,6 +80,15 @@ class ADRCConfig(_Frozen):
     kd_rule: Literal["herbst", "printed"] = "herbst"
     u_max_deg: Optional[float] = Field(None, gt=0.0, le=90.0)
     sample_time: Optional[float] = Field(None, gt=0.0, le=60.0)
+
+    @field_validator("c0", mode="before")
+    @classmethod
+    def _c0_number_or_method(cls, v):
+        if isinstance(v, str) and v in ("estimate", "exact"):
+            return v
+        if isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) and v != 0:
+            return float(v)
+        raise ValueError(f"must be a finite non-zero number [1/s^2], 'estimate' or 'exact'; got {v!r}")
 
 
 ControllerConfig = Annotated[Union[PIDConfig, ADRCConfig], Field(discriminator="type")]
@@ -129,9 +138,15 @@ def _dump(d):
     return {k: (v.model_dump() if isinstance(v, BaseModel) else v) for k, v in d.items()}
 
 
+def _is_union_member_tag(part) -> bool:
+    """pydantic puts the tried union member in ``loc`` ('adrc', 'float', "literal['a','b']")."""
+    return isinstance(part, str) and (part in ("pid", "adrc", "float", "int", "str")
+                                      or part.startswith("literal["))
+
+
 def _format_validation_error(err: ValidationError) -> InputError:
     first = err.errors()[0]
-    loc = ".".join(str(p) for p in first["loc"] if not (isinstance(p, str) and p in ("pid", "adrc")))
+    loc = ".".join(str(p) for p in first["loc"] if not _is_union_member_tag(p))
     msg = first["msg"]
     ctx = first.get("ctx") or {}
     bounds = [f"{k.replace('_', ' ')} {v}" for k, v in ctx.items() if k in ("gt", "ge", "lt", "le")]
@@ -139,7 +154,7 @@ def _format_validation_error(err: ValidationError) -> InputError:
         msg += f" (allowed: {', '.join(bounds)})"
     if first["type"] in ("union_tag_invalid", "union_tag_not_found"):
         loc = f"{loc}.type" if loc else "controller.type"
-    more = len(err.errors()) - 1
+    more = len({tuple(x for x in e["loc"] if not _is_union_member_tag(x)) for e in err.errors()}) - 1
     if more:
         msg += f" [and {more} more problem{'s' if more > 1 else ''}]"
     return InputError(loc or "scenario", msg)

@@ -92,6 +92,10 @@ def build(scenario) -> SimSetup:
     x0[2] = psi0
     x0[3] = speed
     z0 = ctrl.init_state(x0, (psi0, 0.0))
+    ws = s.environment.wave_sample_time
+    if s.environment.waves and abs(ws / s.dt - round(ws / s.dt)) > 1e-9 * max(1.0, ws / s.dt):
+        raise InputError("environment.wave_sample_time",
+                         f"must be a positive integer multiple of dt={s.dt} s, got {ws} s")
     dist = Disturbance(rad(s.environment.constant_rudder_deg), s.environment.constant_start,
                        s.environment.waves, s.environment.wave_sample_time, s.environment.wave_power)
     w = build_disturbance(dist, n_steps, s.dt, s.seed)
