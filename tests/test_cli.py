@@ -138,3 +138,12 @@ def test_help_has_examples(cmd, capsys):
         main([cmd, "--help"])
     assert exc.value.code == 0
     assert "examples:" in capsys.readouterr().out
+
+
+def test_experiment_quick_via_cli(tmp_path, capsys):
+    out = tmp_path / "zw"
+    assert main(["experiment", "zwierzewicz2021", "--quick", "--quiet", "--out", str(out)]) == 0
+    rows = json.loads((out / "comparison.json").read_text())
+    assert all(set(r) == {"quantity", "paper", "steerlab", "unit", "note"} for r in rows)
+    assert "b2" in capsys.readouterr().out
+    assert sorted(p.name for p in out.glob("*.png"))

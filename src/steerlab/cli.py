@@ -138,7 +138,7 @@ def cmd_experiment(args) -> int:
     if args.name not in EXPERIMENTS:
         raise InputError("experiment", f"unknown experiment {args.name!r}; known: {sorted(EXPERIMENTS)}")
     say = _progress(args.quiet)
-    run = EXPERIMENTS[args.name]["run"]
+    run = EXPERIMENTS[args.name].run
     with staged_output(Path(args.out)) as stage:
         rows = run(stage, progress=say, quick=args.quick)
     width = max(len(str(r["quantity"])) for r in rows)
