@@ -3,7 +3,7 @@ import math
 import numpy as np
 import pytest
 
-from steerlab.angles import wrap_to_2pi, wrap_to_pi
+from steerlab.angles import wrap_to_2pi, wrap_to_pi, wrap_to_pi_array
 from steerlab.units import KNOT, deg, knots_to_ms, ms_to_knots, rad, rpm_to_rps, rps_to_rpm
 
 
@@ -30,7 +30,7 @@ def test_wrap_to_pi_values(angle, expected):
 
 def test_wrap_to_pi_range_and_equivalence_on_arrays():
     a = np.linspace(-50.0, 50.0, 10001)
-    w = wrap_to_pi(a)
+    w = wrap_to_pi_array(a)
     assert w.shape == a.shape
     assert np.all(w >= -math.pi) and np.all(w < math.pi)
     # same angle modulo 2 pi

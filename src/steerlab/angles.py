@@ -12,9 +12,19 @@ def wrap_to_pi(angle):
     A 359 deg -> 1 deg course change is therefore a +2 deg turn:
     ``wrap_to_pi(radians(1) - radians(359)) == radians(2)``.
     """
-    return (angle + math.pi) % (2.0 * math.pi) - math.pi
+    a = angle + math.pi
+    if 0.0 <= a < 2.0 * math.pi:       # fast path, bit-identical: fmod(a, 2 pi) == a here
+        return a - math.pi
+    return a % (2.0 * math.pi) - math.pi
 
 
 def wrap_to_2pi(angle: float) -> float:
     """Wrap an angle [rad] to [0, 2*pi) (a compass heading)."""
     return angle % (2.0 * math.pi)
+
+
+def wrap_to_pi_array(angle):
+    """:func:`wrap_to_pi` for numpy arrays (the kernel itself is scalar): same numbers."""
+    import numpy as np
+
+    return (np.asarray(angle, dtype=float) + math.pi) % (2.0 * math.pi) - math.pi

@@ -19,7 +19,7 @@ import math
 
 import numpy as np
 
-from steerlab.angles import wrap_to_pi
+from steerlab.angles import wrap_to_pi, wrap_to_pi_array
 from steerlab.metrics_online import (M_ABS_DELTA, M_D2_DEG, M_DURATION, M_E2_DEG, M_IAE, M_ISE, M_ITAE,
                                      M_MAX_ABS_E, M_REVERSALS, M_TRAVEL)
 
@@ -62,7 +62,7 @@ def last_setpoint_change(time, psi_ref):
 
     With a rate-limited reference the change starts where psi_ref starts to move.
     """
-    d = np.abs(wrap_to_pi(np.diff(psi_ref)))
+    d = np.abs(wrap_to_pi_array(np.diff(psi_ref)))
     moving = np.nonzero(d > 1e-12)[0]
     if len(moving) == 0:
         return None
@@ -90,7 +90,7 @@ def step_metrics(time, psi, psi_ref) -> dict:
     """Overshoot, rise and settling times about the last set-point change (None if n/a)."""
     out = {"overshoot_deg": None, "overshoot_pct": None, "rise_time_s": None,
            "settling_time_2pct_s": None, "settling_time_1deg_s": None}
-    e = wrap_to_pi(psi_ref - psi)
+    e = wrap_to_pi_array(psi_ref - psi)
     change = last_setpoint_change(time, psi_ref)
     if change is None:
         out["settling_time_1deg_s"] = _last_outside(time, np.abs(e) > math.radians(1.0), float(time[0]))
@@ -98,7 +98,7 @@ def step_metrics(time, psi, psi_ref) -> dict:
     t_c, before, step = change
     sel = time >= t_c
     tt = time[sel]
-    p = wrap_to_pi(psi[sel] - before) / step      # normalised response, 1 = new heading
+    p = wrap_to_pi_array(psi[sel] - before) / step      # normalised response, 1 = new heading
     peak = float(np.max(p))
     out["overshoot_pct"] = max(0.0, (peak - 1.0) * 100.0)
     out["overshoot_deg"] = max(0.0, (peak - 1.0) * abs(step) * R2D)

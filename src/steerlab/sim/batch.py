@@ -81,7 +81,7 @@ def simulate_batch(setups: list[SimSetup], record_every: int | None = None) -> B
     out_cmd = np.empty((n, n_rec))
     out_ref = np.empty((n, n_rec, 2))
     acc = np.zeros((n, N_ACC))
-    run_batch = batch_loop(s0.ship.rhs, s0.controller.update)
+    run_batch = batch_loop(s0.ship.rhs, s0.controller.update, nx)
     run_batch(X, Z, PS, PG, PC, GD, W, w_index, s0.dt, s0.nc, N, rec, out_x, out_cmd, out_ref, acc)
     time = np.arange(n_rec) * rec * s0.dt
     return BatchResult(acc, X, time, out_x, out_cmd, out_ref, s0.state_names)

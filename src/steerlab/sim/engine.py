@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from steerlab.angles import wrap_to_pi
+from steerlab.angles import wrap_to_pi_array
 from steerlab.guidance.reference_models import course_reference
 from steerlab.metrics_online import accumulate, new_accumulator
 from steerlab.sim.kernels import closed_loop, plant_step
@@ -67,7 +67,7 @@ def simulate_readable(scenario_or_setup) -> Result:
 def simulate_compiled(scenario_or_setup) -> Result:
     """The compiled closed loop (numba), recording every step."""
     s = _as_setup(scenario_or_setup)
-    run = closed_loop(s.ship.rhs, s.controller.update)
+    run = closed_loop(s.ship.rhs, s.controller.update, s.x0.shape[0])
     x = s.x0.copy()
     z = s.z0.copy()
     N = s.n_steps
@@ -94,7 +94,7 @@ def simulate(scenario_or_setup, engine: str = "compiled") -> Result:
 def online_metrics_from_result(res: Result) -> np.ndarray:
     """Integral metrics of a recorded run through the same accumulator the batch engine uses."""
     acc = new_accumulator()
-    e = wrap_to_pi(res.psi_ref - res.psi)
+    e = wrap_to_pi_array(res.psi_ref - res.psi)
     d = res.delta
     dt = res.dt
     for k in range(len(res.time) - 1):

@@ -5,41 +5,106 @@ One definition, two speeds: :func:`plant_step` builds the RK4 step of ship + ste
 engine. The readable engine (:mod:`steerlab.sim.engine`) calls the very same ``plant_step``
 and controller/guidance kernels from Python. Factories are memoised per combination, so
 each combination compiles once per process (numba cannot disk-cache closures).
+
+How the fused loop is made fast (and why the numbers do not change)
+--------------------------------------------------------------------
+* Every kernel (ship, gear, controller, guidance, metrics) is compiled once more **from its
+  own Python function** (``kernel.py_func``) with LLVM-level forced inlining and without
+  reference counting (:func:`_fused`). Numba otherwise compiles each kernel into its own
+  library and calls it through a real call (arrays exploded into ~7 words each) with an
+  atomic incref/decref of every array argument and every array view. The physics is still
+  written once; only the compilation flags differ. No ``fastmath``: the same IEEE operations
+  in the same order, so the fused loop and the readable loop give bit-identical results.
+* Factories may be specialised on the plant state size ``nx`` so that the short per-state
+  loops of the RK4 step unroll instead of being vectorised with run-time alias checks.
+* The guidance (:func:`~steerlab.guidance.reference_models.course_reference`) is a pure
+  function of time, so the loop evaluates it for a block of upcoming controller samples at
+  a time (same ``t = k * dt``, same numbers) rather than interleaved with the RK4 step.
+* Sample and record decisions use counters instead of integer ``%`` per step.
 """
 
 from __future__ import annotations
 
+import types
 from functools import lru_cache
 
 import numba
 import numpy as np
+from numba.core.registry import CPUDispatcher
 
 from steerlab.angles import wrap_to_pi
 from steerlab.guidance.reference_models import course_reference
 from steerlab.metrics_online import accumulate
 from steerlab.steering_gear import gear_clamp, gear_rate
 
+REF_BLOCK = 64
+"""Guidance samples evaluated ahead at a time by the compiled loop."""
+
 
 @lru_cache(maxsize=None)
-def plant_step(ship_rhs):
-    """RK4 step of the plant ``[ship states..., delta]`` with the rudder order held (ZOH)."""
+def _fuse_options() -> dict:
+    """Numba options for kernels that are inlined into the fused loop.
 
-    @numba.njit
+    ``forceinline`` marks the function ``alwaysinline`` for LLVM; ``_nrt=False`` compiles it
+    without reference counting (these kernels never allocate; the loop's scratch arrays are
+    allocated by the caller). Falls back to plain ``njit`` if this numba rejects the options.
+    """
+    opts = {"forceinline": True, "_nrt": False}
+    try:
+        probe = numba.njit(**opts)(_probe_kernel)
+        probe(np.zeros(2))
+    except Exception:  # pragma: no cover - depends on the numba version
+        return {}
+    return opts
+
+
+def _probe_kernel(a):
+    a[1] = a[0] + 1.0
+
+
+def _jit_fused(fn):
+    return numba.njit(**_fuse_options())(fn)
+
+
+@lru_cache(maxsize=None)
+def _fused(kernel):
+    """The same kernel, compiled from its own Python function for the fused loop.
+
+    Kernels it calls through module globals (e.g. ``adrc_update`` -> ``eso_step``) are fused
+    the same way, recursively, by rebinding those names in a copy of the function. Under
+    ``NUMBA_DISABLE_JIT=1`` kernels are plain functions and are returned as they are.
+    """
+    py = getattr(kernel, "py_func", None)
+    if py is None or not isinstance(kernel, CPUDispatcher):
+        return kernel
+    g = py.__globals__
+    subs = {name: _fused(g[name]) for name in py.__code__.co_names
+            if isinstance(g.get(name), CPUDispatcher)}
+    if subs:
+        py = types.FunctionType(py.__code__, {**g, **subs}, py.__name__, py.__defaults__,
+                                py.__closure__)
+    return _jit_fused(py)
+
+
+@lru_cache(maxsize=None)
+def _plant_kernels(ship_rhs, nx: int = 0):
+    """``(rk4, rk4_step)`` for a ship model; ``nx > 0`` specialises on the plant state size."""
+    ship = _fused(ship_rhs)
+    rate = _fused(gear_rate)
+    clamp = _fused(gear_clamp)
+    NX = nx
+
+    @_jit_fused
     def plant_rhs(t, x, delta_cmd, w, ps, pg, dx):
-        nd = x.shape[0] - 1
+        nd = (x.shape[0] if NX == 0 else NX) - 1
         delta = x[nd]
-        ship_rhs(t, x, delta, w, ps, dx)
-        dx[nd] = gear_rate(delta, delta_cmd, pg)
+        ship(t, x, delta, w, ps, dx)
+        dx[nd] = rate(delta, delta_cmd, pg)
 
-    @numba.njit
-    def rk4_step(t, x, delta_cmd, w, ps, pg, dt, work):
-        """Advance ``x`` in place by one RK4 step; ``work`` is a (5, nx) scratch array."""
-        nx = x.shape[0]
-        k1 = work[0]
-        k2 = work[1]
-        k3 = work[2]
-        k4 = work[3]
-        xt = work[4]
+    @_jit_fused
+    def rk4(t, x, delta_cmd, w, ps, pg, dt, k1, k2, k3, k4, xt):
+        """Advance ``x`` in place by one RK4 step; ``k1..k4``, ``xt`` are (nx,) scratch."""
+        nx = x.shape[0] if NX == 0 else NX
         h2 = 0.5 * dt
         plant_rhs(t, x, delta_cmd, w, ps, pg, k1)
         for i in range(nx):
@@ -54,13 +119,27 @@ def plant_step(ship_rhs):
         s = dt / 6.0
         for i in range(nx):
             x[i] += s * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
-        x[nx - 1] = gear_clamp(x[nx - 1], pg)
+        x[nx - 1] = clamp(x[nx - 1], pg)
 
-    return rk4_step
+    @numba.njit
+    def rk4_step(t, x, delta_cmd, w, ps, pg, dt, work):
+        """Advance ``x`` in place by one RK4 step; ``work`` is a (5, nx) scratch array."""
+        rk4(t, x, delta_cmd, w, ps, pg, dt, work[0], work[1], work[2], work[3], work[4])
+
+    return rk4, rk4_step
+
+
+def plant_step(ship_rhs):
+    """RK4 step of the plant ``[ship states..., delta]`` with the rudder order held (ZOH).
+
+    ``rk4_step(t, x, delta_cmd, w_row, ps, pg, dt, work)`` advances ``x`` in place;
+    ``work`` is a (5, nx) scratch array.
+    """
+    return _plant_kernels(ship_rhs)[1]
 
 
 @lru_cache(maxsize=None)
-def closed_loop(ship_rhs, ctrl_update):
+def closed_loop(ship_rhs, ctrl_update, nx: int | None = None):
     """Compiled closed loop for one (ship, controller) pair.
 
     ``run(x, z, ps, pg, pc, gd, w, dt, nc, n_steps, rec_every, out_x, out_cmd, out_ref, acc)``
@@ -69,47 +148,96 @@ def closed_loop(ship_rhs, ctrl_update):
     held in between. Rows ``0, rec_every, 2*rec_every, ...`` (and the final row, if it falls on
     that grid) are written to the ``out_*`` arrays (pass ``rec_every > n_steps`` and 1-row
     arrays to record only the start); the integral metrics accumulate into ``acc``.
-    """
-    rk4_step = plant_step(ship_rhs)
 
-    @numba.njit
-    def run(x, z, ps, pg, pc, gd, w, dt, nc, n_steps, rec_every, out_x, out_cmd, out_ref, acc):
-        nx = x.shape[0]
-        work = np.empty((5, nx))
-        ref = np.zeros(2)
+    ``nx`` (the plant state size, ship states + rudder), when given, specialises the loop on
+    it (faster); ``run`` then raises ``ValueError`` for a state of another size.
+    """
+    NX = 0 if nx is None else int(nx)
+    rk4 = _plant_kernels(ship_rhs, NX)[0]
+    update = _fused(ctrl_update)
+    reference = _fused(course_reference)
+    acc_step = _fused(accumulate)
+    wrap = _fused(wrap_to_pi)
+    RB = REF_BLOCK
+
+    @_jit_fused
+    def loop(x, z, ps, pg, pc, gd, w, dt, nc, n_steps, rec_every, out_x, out_cmd, out_ref, acc,
+             k1, k2, k3, k4, xt, ref, rbuf):
+        nx = x.shape[0] if NX == 0 else NX
         cmd = 0.0
         h = nc * dt
-        j = 0
+        j = 0   # next output row
+        kc = 0  # steps since the last controller sample (sample when 0)
+        kr = 0  # steps since the last recorded row (record when 0)
+        nb = 0  # guidance samples held in rbuf
+        ib = 0  # next one to use
         for k in range(n_steps + 1):
             t = k * dt
-            if k % nc == 0:
-                course_reference(t, gd, ref)
-                cmd = ctrl_update(z, pc, t, x, ref, h)
-            if k % rec_every == 0:
+            sample = kc == 0
+            if sample:
+                if ib == nb:
+                    # the guidance is a pure function of time: evaluate the next block of
+                    # sample instants ahead (t computed exactly as below: kk * dt)
+                    nb = 0
+                    kk = k
+                    while nb < RB and kk <= n_steps:
+                        reference(kk * dt, gd, rbuf[nb])
+                        nb += 1
+                        kk += nc
+                    ib = 0
+                ref[0] = rbuf[ib, 0]
+                ref[1] = rbuf[ib, 1]
+                ib += 1
+            # heading error for the metrics, taken before the controller (which writes only
+            # its own state), so that the compiler can share it with the controller's own
+            e = wrap(ref[0] - x[2])
+            if sample:
+                cmd = update(z, pc, t, x, ref, h)
+            kc += 1
+            if kc == nc:
+                kc = 0
+            if kr == 0:
                 for i in range(nx):
                     out_x[j, i] = x[i]
                 out_cmd[j] = cmd
                 out_ref[j, 0] = ref[0]
                 out_ref[j, 1] = ref[1]
                 j += 1
+            kr += 1
+            if kr == rec_every:
+                kr = 0
             if k == n_steps:
                 break
-            e = wrap_to_pi(ref[0] - x[2])
             delta = x[nx - 1]
-            rk4_step(t, x, cmd, w[k], ps, pg, dt, work)
-            accumulate(acc, t, e, delta, x[nx - 1], dt)
+            rk4(t, x, cmd, w[k], ps, pg, dt, k1, k2, k3, k4, xt)
+            acc_step(acc, t, e, delta, x[nx - 1], dt)
+
+    @numba.njit
+    def run(x, z, ps, pg, pc, gd, w, dt, nc, n_steps, rec_every, out_x, out_cmd, out_ref, acc):
+        nx = x.shape[0]
+        if NX != 0 and nx != NX:
+            raise ValueError("plant state size differs from the one this loop was built for")
+        k1 = np.empty(nx)
+        k2 = np.empty(nx)
+        k3 = np.empty(nx)
+        k4 = np.empty(nx)
+        xt = np.empty(nx)
+        ref = np.zeros(2)
+        rbuf = np.empty((RB, 2))
+        loop(x, z, ps, pg, pc, gd, w, dt, nc, n_steps, rec_every, out_x, out_cmd, out_ref, acc,
+             k1, k2, k3, k4, xt, ref, rbuf)
 
     return run
 
 
 @lru_cache(maxsize=None)
-def batch_loop(ship_rhs, ctrl_update):
+def batch_loop(ship_rhs, ctrl_update, nx: int | None = None):
     """Parallel batch over scenarios (numba ``prange``) around :func:`closed_loop`.
 
     Per-run 2-D inputs have a leading run axis; ``w`` is a stack of disturbance sequences
     shared by index ``w_index[i]`` (so 1000 runs in the same sea store it once).
     """
-    run = closed_loop(ship_rhs, ctrl_update)
+    run = closed_loop(ship_rhs, ctrl_update, nx)
 
     @numba.njit(parallel=True)
     def run_batch(X, Z, PS, PG, PC, GD, W, w_index, dt, nc, n_steps, rec_every,

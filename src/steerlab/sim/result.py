@@ -8,7 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
-from steerlab.angles import wrap_to_pi
+from steerlab.angles import wrap_to_pi_array
 from steerlab.environment.channels import CHANNEL_NAMES, CHANNEL_UNITS
 
 
@@ -53,7 +53,7 @@ class Result:
     @property
     def heading_error(self):
         """``wrap_to_pi(psi_ref - psi)`` [rad]."""
-        return wrap_to_pi(self.psi_ref - self.psi)
+        return wrap_to_pi_array(self.psi_ref - self.psi)
 
     @property
     def dt(self) -> float:
