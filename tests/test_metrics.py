@@ -251,3 +251,13 @@ def test_compute_metrics_same_for_both_engines(scenario):
         else:
             assert mr[k] == pytest.approx(mc[k], rel=1e-12, abs=1e-12), k
     assert mc["rudder_reversals"] > 10 and mc["speed_loss_J"] > 0
+
+
+def test_settling_time_from_onset():
+    from steerlab.metrics import settling_time
+
+    t = np.arange(0.0, 100.0, 1.0)
+    e = np.where((t >= 20) & (t < 50), 3.0, 0.2)
+    assert settling_time(t, e, 1.0, t0=20.0) == pytest.approx(30.0)   # outside 20..49, inside from 50
+    assert settling_time(t, e, 1.0, t0=60.0) == 0.0                   # never outside after t0
+    assert settling_time(t, np.full_like(t, 2.0), 1.0) is None        # never settles

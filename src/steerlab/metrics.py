@@ -86,6 +86,17 @@ def _last_outside(time, outside, t0):
     return float(time[idx[-1] + 1] - t0)
 
 
+def settling_time(time, error, band, t0: float = 0.0):
+    """Time [s] from ``t0`` until ``|error|`` stays within ``band`` (same units as ``error``).
+
+    ``None`` if it is still outside the band at the end of the record; ``0.0`` if it never
+    leaves the band after ``t0``. Use ``t0`` = the onset of a disturbance to time its rejection.
+    """
+    time = np.asarray(time)
+    sel = time >= t0
+    return _last_outside(time[sel], np.abs(np.asarray(error)[sel]) > band, t0)
+
+
 def step_metrics(time, psi, psi_ref) -> dict:
     """Overshoot, rise and settling times about the last set-point change (None if n/a)."""
     out = {"overshoot_deg": None, "overshoot_pct": None, "rise_time_s": None,

@@ -59,7 +59,8 @@ from typing import Callable, Optional
 import numpy as np
 
 from steerlab.control.estimators import PAPER_L, eso_poles
-from steerlab.metrics import compute_metrics, step_metrics
+from steerlab.environment.waves import held_noise_std_eq39
+from steerlab.metrics import compute_metrics, settling_time, step_metrics
 from steerlab.ships import esso_3dof
 from steerlab.ships.b2_estimate import b2_estimate_paper
 from steerlab.ships.registry import get_ship
@@ -147,18 +148,6 @@ def _row(quantity: str, paper, steerlab, unit: str, note: str) -> dict:
     return {"quantity": quantity, "paper": paper, "steerlab": steerlab, "unit": unit, "note": note}
 
 
-def _settling_after(time, err_deg, t0: float, band_deg: float = 1.0):
-    """Time from ``t0`` until |err| stays within ``band_deg`` (None: still outside at the end)."""
-    sel = time >= t0
-    tt = time[sel]
-    outside = np.nonzero(np.abs(err_deg[sel]) > band_deg)[0]
-    if len(outside) == 0:
-        return 0.0
-    if outside[-1] == len(tt) - 1:
-        return None
-    return float(tt[outside[-1] + 1] - t0)
-
-
 def _new_figure(nrows: int, height: float = 6.5, width: float = 9.0, sharex: bool = True):
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
@@ -174,27 +163,6 @@ def _new_figure(nrows: int, height: float = 6.5, width: float = 9.0, sharex: boo
 def _save(fig, path: Path) -> Path:
     fig.savefig(path, dpi=110)
     return path
-
-
-def _held_noise_std_eq39(power: float, sample_time: float) -> float:
-    """Stationary std [rad] of eq (39) driven by zero-order-held white noise.
-
-    Held noise of variance ``P/Ts`` has the two-sided PSD ``P sinc^2(w Ts / 2)``, so
-    ``var = (1/pi) int_0^inf |G(jw)|^2 P sinc^2(w Ts/2) dw``.
-    """
-    from scipy.integrate import quad
-
-    from steerlab.environment.waves import EQ39_DEN, EQ39_NUM
-
-    b = EQ39_NUM[0]
-    a1, a0 = EQ39_DEN[1], EQ39_DEN[2]
-
-    def integrand(w):
-        g2 = (b * w) ** 2 / ((a0 - w * w) ** 2 + (a1 * w) ** 2)
-        return g2 * power * np.sinc(w * sample_time / (2.0 * np.pi)) ** 2
-
-    var = quad(integrand, 0.0, np.inf, limit=500)[0] / np.pi
-    return math.sqrt(var)
 
 
 # --------------------------------------------------------------------------------------------
@@ -362,7 +330,7 @@ def _dist_summary(res) -> dict:
     k = int(np.argmax(np.abs(e) * after))
     return {
         "max_dev": float(np.abs(e[k])), "t_max": float(t[k] - DIST_START),
-        "settle_1deg": _settling_after(t, e, DIST_START, 1.0),
+        "settle_1deg": settling_time(t, e, 1.0, DIST_START),
         "final": float(e[-1]),
         "max_rudder": float(np.max(np.abs(res.delta)) * R2D),
         "metrics": compute_metrics(res),
@@ -494,7 +462,7 @@ def _fig4_fig5(base: Scenario, lengths: _Lengths, out_dir: Path,
     from steerlab.environment.waves import stationary_std_eq39
 
     d_white = stationary_std_eq39(1e-4) * R2D
-    d_held = _held_noise_std_eq39(1e-4, 0.5) * R2D
+    d_held = held_noise_std_eq39(sample_time=0.5, power=1e-4) * R2D
 
     say("fig 4: coloured noise d(t) of eq (39)")
     fig, (ax1, ax2) = _new_figure(2, height=6.0, sharex=False)
