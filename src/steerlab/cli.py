@@ -244,7 +244,7 @@ def build_parser() -> argparse.ArgumentParser:
     e = sub.add_parser("experiment", help="reproduce a paper's results next to the published numbers",
                        description="Reproduce a paper: figures plus comparison.json (paper vs steerlab).",
                        epilog=EXAMPLES["experiment"], formatter_class=fmt)
-    e.add_argument("name", help="experiment name, e.g. zwierzewicz2021")
+    e.add_argument("name", help="experiment name, e.g. zwierzewicz2021 (an unknown name lists the known ones)")
     e.add_argument("--out", required=True, help="output directory")
     e.add_argument("--quick", action="store_true", help="shorter runs (for smoke tests)")
     e.add_argument("--quiet", action="store_true")
@@ -266,6 +266,11 @@ def build_parser() -> argparse.ArgumentParser:
     b.add_argument("--json", action="store_true", help="print JSON")
     b.add_argument("--quiet", action="store_true")
     b.set_defaults(func=cmd_bench)
+
+    from steerlab.commands import command_modules
+
+    for module in command_modules():
+        module.register(sub, fmt)
     return p
 
 

@@ -28,13 +28,17 @@ controller's own (limited) order ``u``; the measured heading enters the error, a
 
 from __future__ import annotations
 
-from typing import NamedTuple
+import math
+from typing import Literal, NamedTuple, Optional, Union
 
 import numba
 import numpy as np
+from pydantic import Field, field_validator
 
 from steerlab.angles import wrap_to_pi
-from steerlab.control.estimators import PAPER_L, eso_step
+from steerlab.config_base import FrozenConfig
+from steerlab.control.estimators import PAPER_L, eso_gains_bandwidth, eso_gains_lqr, eso_step
+from steerlab.control.registry import ControllerSpec
 from steerlab.errors import InputError, require_finite_range
 from steerlab.units import rad
 
@@ -110,3 +114,52 @@ def adrc_update(z, p, t, x, ref, h):
     u = min(max(u, -umax), umax)
     eso_step(z, c0, p[A_L1], p[A_L2], p[A_L3], y, u, h)
     return u
+
+
+class ADRCConfig(FrozenConfig):
+    """``[controller] type = "adrc"`` in a scenario."""
+
+    type: Literal["adrc"]
+    T_settle: float = Field(150.0, gt=0.0, le=1e5, description="settling time of (38) [s]")
+    c0: Union[float, Literal["estimate", "exact"]] = "estimate"
+    observer: Literal["paper", "bandwidth", "lqr"] = "paper"
+    observer_bandwidth: float = Field(0.5, gt=0.0, le=100.0, description="[rad/s] for observer='bandwidth'")
+    lqr_q: tuple[float, float, float] = (1.0, 1.0, 1.0)
+    lqr_r: float = Field(1.0, gt=0.0)
+    L: Optional[tuple[float, float, float]] = None
+    law: Literal["stable", "printed"] = "stable"
+    kd_rule: Literal["herbst", "printed"] = "herbst"
+    u_max_deg: Optional[float] = Field(None, gt=0.0, le=90.0)
+    sample_time: Optional[float] = Field(None, gt=0.0, le=60.0)
+
+    @field_validator("c0", mode="before")
+    @classmethod
+    def _c0_number_or_method(cls, v):
+        if isinstance(v, str) and v in ("estimate", "exact"):
+            return v
+        if isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) and v != 0:
+            return float(v)
+        raise ValueError(f"must be a finite non-zero number [1/s^2], 'estimate' or 'exact'; got {v!r}")
+
+
+def build(cfg: ADRCConfig, ctx):
+    """c0 from the ship (eq 29 or exact linearisation) unless given; L given, paper's, by
+    bandwidth or by LQR on the dual (python-control)."""
+    c0 = cfg.c0 if isinstance(cfg.c0, float) else ctx.ship.b2(ctx.speed, cfg.c0)
+    if cfg.L is not None:
+        L = cfg.L
+    elif cfg.observer == "paper":
+        L = PAPER_L
+    elif cfg.observer == "bandwidth":
+        L = eso_gains_bandwidth(cfg.observer_bandwidth)
+    else:
+        L = eso_gains_lqr(cfg.lqr_q, cfg.lqr_r)
+    c = ADRC.from_settling_time(cfg.T_settle, c0, L=L, law=cfg.law, kd_rule=cfg.kd_rule,
+                                u_max=ctx.u_max(cfg.u_max_deg))
+    return c, c.pack()
+
+
+CONTROLLER = ControllerSpec(
+    name="adrc", description="linear ADRC: ESO + disturbance-cancelling PD (Zwierzewicz et al. 2021)",
+    update=adrc_update, n_state=N_STATE, config=ADRCConfig, build=build,
+    source="Zwierzewicz, Dorobczynski, Artyszuk (2021) Energies 14:7937, Secs 2 and 5, eqs (7), (38)")

@@ -14,12 +14,15 @@ compare their ADRC with Kp = 3.81, Kd = 3.95, Ki = 0.00547.
 
 from __future__ import annotations
 
-from typing import NamedTuple
+from typing import Literal, NamedTuple, Optional
 
 import numba
 import numpy as np
+from pydantic import Field
 
 from steerlab.angles import wrap_to_pi
+from steerlab.config_base import FrozenConfig
+from steerlab.control.registry import ControllerSpec
 from steerlab.errors import require_finite_range
 from steerlab.units import rad
 
@@ -57,3 +60,25 @@ def pid_update(z, p, t, x, ref, h):
     if u == ud or e * ud < 0.0:
         z[0] += e * h
     return u
+
+
+class PIDConfig(FrozenConfig):
+    """``[controller] type = "pid"`` in a scenario (degrees only at this edge)."""
+
+    type: Literal["pid"]
+    Kp: float = Field(3.81, ge=0.0, le=1e4, description="[rad/rad]")
+    Ki: float = Field(0.00547, ge=0.0, le=1e4, description="[1/s]")
+    Kd: float = Field(3.95, ge=0.0, le=1e5, description="[s]")
+    u_max_deg: Optional[float] = Field(None, gt=0.0, le=90.0, description="default: gear limit")
+    sample_time: Optional[float] = Field(None, gt=0.0, le=60.0, description="default: dt")
+
+
+def build(cfg: PIDConfig, ctx):
+    c = PID(Kp=cfg.Kp, Ki=cfg.Ki, Kd=cfg.Kd, u_max=ctx.u_max(cfg.u_max_deg))
+    return c, c.pack()
+
+
+CONTROLLER = ControllerSpec(
+    name="pid", description="PID, derivative on measured yaw rate, clamping anti-windup",
+    update=pid_update, n_state=N_STATE, config=PIDConfig, build=build,
+    source="Zwierzewicz et al. (2021) Sec. 7 (gains); classic heading PID")

@@ -1,13 +1,27 @@
-"""Paper reproductions: each experiment module exposes ``run(out_dir, progress=None, quick=False)``.
+"""Paper reproductions, discovered by module.
 
-``EXPERIMENTS`` maps a name to the module; the module's ``DESCRIPTION`` is its one-line summary.
+Each experiment module exposes ``DESCRIPTION`` (one line), ``run(out_dir, progress=None,
+quick=False) -> rows`` (the comparison rows ``{"quantity", "paper", "steerlab", "unit",
+"note"}``, also written to ``out_dir/comparison.json``) and, if its CLI name is not the module
+name (e.g. ``witkowska-ga``), ``NAME``. ``EXPERIMENTS`` maps the CLI name to the module.
 """
 
-from steerlab.experiments import zwierzewicz2021
+import importlib
+import pkgutil
 
-EXPERIMENTS = {
-    # Zwierzewicz, Dorobczynski, Artyszuk (2021) Energies 14:7937 - ADRC autopilot, Esso tanker, Figs 2-6
-    "zwierzewicz2021": zwierzewicz2021,
-}
 
+def _discover() -> dict:
+    import steerlab.experiments as pkg
+
+    found = {}
+    for mod in sorted(pkgutil.iter_modules(pkg.__path__), key=lambda m: m.name):
+        if mod.name.startswith("_"):
+            continue
+        module = importlib.import_module(f"steerlab.experiments.{mod.name}")
+        if hasattr(module, "run") and hasattr(module, "DESCRIPTION"):
+            found[getattr(module, "NAME", mod.name)] = module
+    return found
+
+
+EXPERIMENTS = _discover()
 DESCRIPTIONS = {name: mod.DESCRIPTION for name, mod in EXPERIMENTS.items()}

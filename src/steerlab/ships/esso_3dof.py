@@ -199,3 +199,28 @@ def zero_dynamics_a0(speed: float, table: EssoTable2 = EssoTable2()) -> float:
     """
     A1, B1 = linearise_paper(speed, table)
     return float(A1[0, 0] - A1[1, 0] * B1[0] / B1[1])
+
+
+def _spec_pack(speed: float, rpm: float | None, options=None) -> np.ndarray:
+    return pack(speed=speed, n_rps=None if rpm is None else rpm / 60.0)
+
+
+def _spec_b2(speed: float) -> float:
+    return float(linearise(speed)[1][1])
+
+
+def _ship_specs():
+    from steerlab.ships.registry import ShipSpec
+    from steerlab.ships.state import PLANAR_NAMES, PLANAR_UNITS
+
+    t = EssoTable2()
+    return [ShipSpec(
+        name="esso",
+        description="Esso Bernicia 190 kdwt tanker, 3-DOF nonlinear (Zwierzewicz et al. 2021, Table 2)",
+        rhs=esso_rhs, n_states=6, state_names=PLANAR_NAMES, state_units=PLANAR_UNITS,
+        pack=_spec_pack, b2_exact=_spec_b2, dims=(t.c_B, t.L, t.B),
+        source="Zwierzewicz, Dorobczynski, Artyszuk, Energies 14 (2021) 7937, Sec. 3.1",
+        linearise=linearise)]
+
+
+SHIP_SPECS = _ship_specs

@@ -1,25 +1,37 @@
-"""The ships steerlab knows, by name: kernel, state names and how to build parameters."""
+"""The ships steerlab knows, by name, discovered from the modules of :mod:`steerlab.ships`.
+
+A module declares ships with a module-level ``SHIP_SPECS`` (a list of :class:`ShipSpec`, or a
+function returning one, e.g. built from data files). Nothing else needs editing to add a
+ship: scenarios, the CLI, the engines and the trials pick it up from here.
+"""
 
 from __future__ import annotations
 
+import importlib
+import pkgutil
 from dataclasses import dataclass
+from functools import lru_cache
 from typing import Callable
 
-import numpy as np
+from pydantic import ValidationError
 
 from steerlab.errors import InputError
-from steerlab.ships import esso_3dof
 from steerlab.ships.b2_estimate import b2_estimate
-from steerlab.ships.state import PLANAR_NAMES, PLANAR_UNITS
 
 
 @dataclass(frozen=True)
 class ShipSpec:
     """A ship model as the engine sees it.
 
-    ``pack(speed [m/s], rpm [rev/min] or None) -> params``; ``b2_exact(speed)`` and
-    ``dims`` (c_B, L [m], B [m]) feed the ADRC design (``c0``), steerlab sign;
-    ``linearise(speed) -> (A1, B1)`` is the sway-yaw linear model on ``[v, r]``, steerlab sign.
+    * ``rhs(t, x, delta, w, p, dx)``: numba kernel writing the derivatives of the ship states
+      (``x`` is the whole plant state, the rudder angle last; the ship writes ``dx[:n_states]``).
+    * ``pack(speed [m/s], rpm [rev/min] or None, options) -> params``; ``options`` is an
+      instance of ``options_model`` (a :class:`~steerlab.config_base.FrozenConfig`) validated
+      from the scenario's ``[ship.options]``, or ``None`` when the ship has no options.
+    * ``b2_exact(speed)`` and ``dims`` (c_B, L [m], B [m]) feed the ADRC design (``c0``),
+      steerlab sign; ``linearise(speed) -> (A1, B1)`` is the sway-yaw linear model on
+      ``[v, r]``, steerlab sign; ``nomoto_KT(speed) -> (K [1/s], T [s])`` a first-order
+      Nomoto model (default: from ``linearise``).
     """
 
     name: str
@@ -33,6 +45,9 @@ class ShipSpec:
     dims: tuple
     source: str
     linearise: Callable | None = None
+    options_model: type | None = None
+    nomoto_KT: Callable | None = None
+    speed_range: tuple = (0.0, float("inf"))   #: validity range of the model [m/s]
 
     def b2(self, speed: float, method: str) -> float:
         """Rudder efficiency [1/s^2], steerlab sign: ``exact`` (linearisation) or ``estimate`` (eq 29)."""
@@ -43,35 +58,95 @@ class ShipSpec:
             return b2_estimate(c_B, L, B, speed)
         raise InputError("controller.c0", f"must be a number, 'estimate' or 'exact', got {method!r}")
 
+    def nomoto(self, speed: float) -> tuple[float, float]:
+        """First-order Nomoto ``(K [1/s], T [s])`` at ``speed`` [m/s]."""
+        if self.nomoto_KT is not None:
+            return self.nomoto_KT(speed)
+        if self.linearise is None:
+            raise InputError("ship.model", f"ship {self.name!r} has neither a Nomoto model nor a linearisation")
+        from steerlab.ships.linear_analysis import nomoto_from_linear
 
-def _esso_pack(speed: float, rpm: float | None) -> np.ndarray:
-    return esso_3dof.pack(speed=speed, n_rps=None if rpm is None else rpm / 60.0)
+        n = nomoto_from_linear(*self.linearise(speed))
+        return n["K"], n["T"]
+
+    def options(self, raw: dict | None):
+        """Validate ``[ship.options]`` against ``options_model`` (errors name ``ship.options.X``)."""
+        raw = dict(raw or {})
+        if self.options_model is None:
+            if raw:
+                raise InputError("ship.options", f"ship {self.name!r} takes no options, got {sorted(raw)}")
+            return None
+        try:
+            return self.options_model.model_validate(raw)
+        except ValidationError as err:
+            first = err.errors()[0]
+            loc = ".".join(str(p) for p in first["loc"])
+            ctx = first.get("ctx") or {}
+            bounds = [f"{k.replace('_', ' ')} {v}" for k, v in ctx.items() if k in ("gt", "ge", "lt", "le")]
+            msg = first["msg"] + (f" (allowed: {', '.join(bounds)})" if bounds else "")
+            raise InputError(f"ship.options.{loc}" if loc else "ship.options", msg) from None
 
 
-def _esso_b2(speed: float) -> float:
-    return float(esso_3dof.linearise(speed)[1][1])
+_SKIP = {"registry", "__init__"}
 
 
-_T = esso_3dof.EssoTable2()
-SHIPS = {
-    "esso": ShipSpec(
-        name="esso",
-        description="Esso Bernicia 190 kdwt tanker, 3-DOF nonlinear (Zwierzewicz et al. 2021, Table 2)",
-        rhs=esso_3dof.esso_rhs,
-        n_states=6,
-        state_names=PLANAR_NAMES,
-        state_units=PLANAR_UNITS,
-        pack=_esso_pack,
-        b2_exact=_esso_b2,
-        dims=(_T.c_B, _T.L, _T.B),
-        source="Zwierzewicz, Dorobczynski, Artyszuk, Energies 14 (2021) 7937, Sec. 3.1",
-        linearise=esso_3dof.linearise,
-    ),
-}
+def _iter_modules(pkg):
+    for mod in sorted(pkgutil.walk_packages(pkg.__path__, prefix=pkg.__name__ + "."),
+                      key=lambda m: m.name):
+        if mod.name.rsplit(".", 1)[-1] in _SKIP or mod.name.rsplit(".", 1)[-1].startswith("_"):
+            continue
+        yield importlib.import_module(mod.name)
+
+
+@lru_cache(maxsize=None)
+def _discover() -> dict:
+    import steerlab.ships as pkg
+
+    found = {}
+    for module in _iter_modules(pkg):
+        specs = getattr(module, "SHIP_SPECS", ())
+        if callable(specs):
+            specs = specs()
+        for spec in specs:
+            if spec.name in found:
+                raise RuntimeError(f"ship {spec.name!r} declared twice")
+            found[spec.name] = spec
+    return found
+
+
+class _Registry(dict):
+    """Lazy, read-only view of the discovered ships (name -> ShipSpec)."""
+
+    def __getitem__(self, k):
+        return _discover()[k]
+
+    def __contains__(self, k):
+        return k in _discover()
+
+    def __iter__(self):
+        return iter(_discover())
+
+    def __len__(self):
+        return len(_discover())
+
+    def keys(self):
+        return _discover().keys()
+
+    def items(self):
+        return _discover().items()
+
+    def values(self):
+        return _discover().values()
+
+    def get(self, k, default=None):
+        return _discover().get(k, default)
+
+
+SHIPS = _Registry()
 
 
 def get_ship(name: str) -> ShipSpec:
     try:
-        return SHIPS[name]
+        return _discover()[name]
     except KeyError:
-        raise InputError("ship.model", f"unknown ship {name!r}; known ships: {sorted(SHIPS)}") from None
+        raise InputError("ship.model", f"unknown ship {name!r}; known ships: {sorted(_discover())}") from None

@@ -35,13 +35,16 @@ import tomllib
 from pathlib import Path
 from typing import Annotated, Literal, Optional, Union
 
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
+from pydantic import BaseModel, Field, ValidationError
+
+from steerlab.config_base import FrozenConfig
+from steerlab.control.adrc import ADRCConfig
+from steerlab.control.registry import CONTROLLERS
 
 from steerlab.errors import InputError
 
 
-class _Frozen(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
+_Frozen = FrozenConfig
 
 
 class ShipConfig(_Frozen):
@@ -49,6 +52,8 @@ class ShipConfig(_Frozen):
     speed_kn: float = Field(16.0, gt=0.0, le=40.0, description="approach speed [kn]")
     rpm: Optional[float] = Field(None, gt=0.0, le=1000.0,
                                  description="propeller rate [rpm]; default: the rate that holds speed_kn")
+    options: dict[str, Union[bool, int, float, str]] = Field(
+        default_factory=dict, description="ship-specific options, validated by the ship's options_model")
 
 
 class GearConfig(_Frozen):
@@ -58,40 +63,12 @@ class GearConfig(_Frozen):
     dead_zone_deg: float = Field(0.0, ge=0.0, le=10.0)
 
 
-class PIDConfig(_Frozen):
-    type: Literal["pid"]
-    Kp: float = Field(3.81, ge=0.0, le=1e4)
-    Ki: float = Field(0.00547, ge=0.0, le=1e4)
-    Kd: float = Field(3.95, ge=0.0, le=1e5)
-    u_max_deg: Optional[float] = Field(None, gt=0.0, le=90.0, description="default: gear limit")
-    sample_time: Optional[float] = Field(None, gt=0.0, le=60.0, description="default: dt")
+def _controller_union():
+    configs = tuple(spec.config for spec in CONTROLLERS.values())
+    return Annotated[Union[configs], Field(discriminator="type")]
 
 
-class ADRCConfig(_Frozen):
-    type: Literal["adrc"]
-    T_settle: float = Field(150.0, gt=0.0, le=1e5, description="settling time of (38) [s]")
-    c0: Union[float, Literal["estimate", "exact"]] = "estimate"
-    observer: Literal["paper", "bandwidth", "lqr"] = "paper"
-    observer_bandwidth: float = Field(0.5, gt=0.0, le=100.0, description="[rad/s] for observer='bandwidth'")
-    lqr_q: tuple[float, float, float] = (1.0, 1.0, 1.0)
-    lqr_r: float = Field(1.0, gt=0.0)
-    L: Optional[tuple[float, float, float]] = None
-    law: Literal["stable", "printed"] = "stable"
-    kd_rule: Literal["herbst", "printed"] = "herbst"
-    u_max_deg: Optional[float] = Field(None, gt=0.0, le=90.0)
-    sample_time: Optional[float] = Field(None, gt=0.0, le=60.0)
-
-    @field_validator("c0", mode="before")
-    @classmethod
-    def _c0_number_or_method(cls, v):
-        if isinstance(v, str) and v in ("estimate", "exact"):
-            return v
-        if isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) and v != 0:
-            return float(v)
-        raise ValueError(f"must be a finite non-zero number [1/s^2], 'estimate' or 'exact'; got {v!r}")
-
-
-ControllerConfig = Annotated[Union[PIDConfig, ADRCConfig], Field(discriminator="type")]
+ControllerConfig = _controller_union()
 
 
 class CourseChange(_Frozen):
@@ -140,7 +117,7 @@ def _dump(d):
 
 def _is_union_member_tag(part) -> bool:
     """pydantic puts the tried union member in ``loc`` ('adrc', 'float', "literal['a','b']")."""
-    return isinstance(part, str) and (part in ("pid", "adrc", "float", "int", "str")
+    return isinstance(part, str) and (part in CONTROLLERS or part in ("float", "int", "str", "dict")
                                       or part.startswith("literal["))
 
 

@@ -6,8 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from steerlab.control import adrc, pid
-from steerlab.control.estimators import PAPER_L, eso_gains_bandwidth, eso_gains_lqr
+from steerlab.control.design_context import DesignContext
 from steerlab.control.registry import ControllerSpec, get_controller
 from steerlab.environment.disturbance import Disturbance, build_disturbance
 from steerlab.errors import InputError
@@ -45,26 +44,9 @@ class SimSetup:
         return tuple(self.ship.state_units) + ("rad",)
 
 
-def controller_params(cfg, ship: ShipSpec, speed: float, gear: SteeringGear):
-    """Packed parameters and the initial-state builder for a controller config."""
-    u_max = rad(cfg.u_max_deg) if cfg.u_max_deg is not None else gear.delta_max
-    if cfg.type == "pid":
-        c = pid.PID(Kp=cfg.Kp, Ki=cfg.Ki, Kd=cfg.Kd, u_max=u_max)
-        return c, c.pack()
-    if cfg.type == "adrc":
-        c0 = cfg.c0 if isinstance(cfg.c0, float) else ship.b2(speed, cfg.c0)
-        if cfg.L is not None:
-            L = cfg.L
-        elif cfg.observer == "paper":
-            L = PAPER_L
-        elif cfg.observer == "bandwidth":
-            L = eso_gains_bandwidth(cfg.observer_bandwidth)
-        else:
-            L = eso_gains_lqr(cfg.lqr_q, cfg.lqr_r)
-        c = adrc.ADRC.from_settling_time(cfg.T_settle, c0, L=L, law=cfg.law, kd_rule=cfg.kd_rule,
-                                         u_max=u_max)
-        return c, c.pack()
-    raise InputError("controller.type", f"unknown controller {cfg.type!r}")  # pragma: no cover
+def controller_params(cfg, ctx: DesignContext):
+    """``(controller, packed params)`` for a validated controller config (its module's ``build``)."""
+    return get_controller(cfg.type).build(cfg, ctx)
 
 
 def build(scenario) -> SimSetup:
@@ -73,12 +55,12 @@ def build(scenario) -> SimSetup:
     ship = get_ship(s.ship.model)
     ctrl_spec = get_controller(s.controller.type)
     speed = knots_to_ms(s.ship.speed_kn)
-    ps = ship.pack(speed, s.ship.rpm)
+    ps = ship.pack(speed, s.ship.rpm, ship.options(s.ship.options))
     gear = SteeringGear(rad(s.gear.delta_max_deg), rad(s.gear.rate_max_deg_s), s.gear.T_sg,
                         rad(s.gear.dead_zone_deg))
     pg = gear.pack()
-    ctrl, pc = controller_params(s.controller, ship, speed, gear)
     ts = s.controller.sample_time if s.controller.sample_time is not None else s.dt
+    ctrl, pc = controller_params(s.controller, DesignContext(ship, speed, gear, s.dt, ts))
     nc = int(round(ts / s.dt))
     if nc < 1 or abs(nc * s.dt - ts) > 1e-9 * max(ts, 1.0):
         raise InputError("controller.sample_time", f"must be a positive multiple of dt={s.dt} s, got {ts} s")
