@@ -8,10 +8,17 @@ esso+pid and esso+adrc, so each compiles once per test process.
 from __future__ import annotations
 
 import copy
+import os
+from pathlib import Path
 
 import pytest
 
 from steerlab.sim.scenario import scenario_from_dict
+
+# Subprocess tests (``python -m steerlab ...``) must import this checkout's ``src`` (pytest's
+# ``pythonpath`` only reaches this process), whichever checkout an editable install points to.
+_SRC = str(Path(__file__).resolve().parent.parent / "src")
+os.environ["PYTHONPATH"] = os.pathsep.join(p for p in (_SRC, os.environ.get("PYTHONPATH")) if p)
 
 BASE = {
     "name": "test",

@@ -3,6 +3,7 @@
 import numpy as np
 import pytest
 
+from steerlab.environment.channels import N_CHANNELS
 from steerlab.errors import InputError
 from steerlab.metrics_online import M_DURATION
 from steerlab.sim.batch import simulate_batch, vary_controller
@@ -59,7 +60,7 @@ def test_result_layout(scenario):
     assert res.states.shape == (51, 7)
     assert res.state_names == ("x_n", "y_e", "psi", "u", "v", "r", "delta")
     assert res.delta_cmd.shape == res.psi_ref.shape == res.r_ref.shape == (51,)
-    assert res.disturbance.shape == (51, 1)
+    assert res.disturbance.shape == (51, N_CHANNELS)
     assert res.dt == pytest.approx(0.2)
     assert res.meta["ship"] == "esso" and res.meta["controller"] == "adrc" and res.meta["n_steps"] == 50
     assert res.states[0, 3] == pytest.approx(U16)

@@ -4,6 +4,7 @@
 import numpy as np
 import pytest
 
+from steerlab.environment.channels import N_CHANNELS
 from steerlab.control.adrc import A_C0, A_KD, A_KP, A_L1, A_L2, A_L3, A_UMAX
 from steerlab.control.estimators import PAPER_L, eso_gains_bandwidth, eso_gains_lqr
 from steerlab.control.pid import C_KD, C_KI, C_KP, C_UMAX
@@ -32,7 +33,7 @@ def test_default_scenario():
     assert sc.n_steps == 30000
     assert sc.environment.waves is True
     s = build(sc)
-    assert s.w.shape == (30001, 1) and s.nc == 1
+    assert s.w.shape == (30001, N_CHANNELS) and s.nc == 1
     assert s.pc[A_C0] == pytest.approx(9.18e-4, rel=5e-3)      # c0 by eq (29), steerlab sign
 
 

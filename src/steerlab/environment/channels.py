@@ -2,15 +2,33 @@
 
 The environment is sampled up front (seeded) into an array ``w`` of shape
 ``(n_steps + 1, N_CHANNELS)``; the engine holds row ``k`` constant over step ``k`` (zero-order
-hold) and hands it to the ship model. Every ship model reads the channels it understands.
+hold) and hands it to the ship model. Every ship model reads the channels it understands and
+ignores the others (a channel a model cannot represent is documented in its docstring).
 
 ``W_RUDDER``
     Equivalent rudder angle [rad] (steerlab sign: > 0 pushes the ship to starboard). It is
     added to the actual rudder angle at the ship's input; Zwierzewicz et al. (2021) express
     both their constant (wind/current) and their coloured-noise (waves) disturbances this way.
+``W_WIND_SPEED``, ``W_WIND_DIR``
+    True wind speed [m/s] and the direction it comes FROM [rad], clockwise from north.
+``W_CURRENT_SPEED``, ``W_CURRENT_DIR``
+    Current speed [m/s] and the direction it flows TOWARDS [rad], clockwise from north
+    (it moves the track, not the heading: thesis 2.4.2).
+``W_YAW_RATE``
+    Additive yaw-rate disturbance [rad/s] (the thesis' wave model adds filtered noise to r).
+``W_YAW_MOMENT``
+    Yaw-moment disturbance expressed as a yaw acceleration [rad/s^2] (wave moments
+    divided by the ship's yaw inertia), for models that take a moment.
 """
 
 W_RUDDER = 0
-N_CHANNELS = 1
-CHANNEL_NAMES = ("d_rudder",)
-CHANNEL_UNITS = ("rad",)
+W_WIND_SPEED = 1
+W_WIND_DIR = 2
+W_CURRENT_SPEED = 3
+W_CURRENT_DIR = 4
+W_YAW_RATE = 5
+W_YAW_MOMENT = 6
+N_CHANNELS = 7
+CHANNEL_NAMES = ("d_rudder", "wind_speed", "wind_dir", "current_speed", "current_dir",
+                 "d_yaw_rate", "d_yaw_accel")
+CHANNEL_UNITS = ("rad", "m/s", "rad", "m/s", "rad", "rad/s", "rad/s^2")
