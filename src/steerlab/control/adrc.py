@@ -145,7 +145,7 @@ class ADRCConfig(FrozenConfig):
 def build(cfg: ADRCConfig, ctx):
     """c0 from the ship (eq 29 or exact linearisation) unless given; L given, paper's, by
     bandwidth or by LQR on the dual (python-control)."""
-    c0 = cfg.c0 if isinstance(cfg.c0, float) else ctx.ship.b2(ctx.speed, cfg.c0)
+    c0 = cfg.c0 if isinstance(cfg.c0, float) else ctx.b2(cfg.c0)
     if cfg.L is not None:
         L = cfg.L
     elif cfg.observer == "paper":

@@ -31,7 +31,9 @@ class ShipSpec:
     * ``b2_exact(speed)`` and ``dims`` (c_B, L [m], B [m]) feed the ADRC design (``c0``),
       steerlab sign; ``linearise(speed) -> (A1, B1)`` is the sway-yaw linear model on
       ``[v, r]``, steerlab sign; ``nomoto_KT(speed) -> (K [1/s], T [s])`` a first-order
-      Nomoto model (default: from ``linearise``).
+      Nomoto model (default: from ``linearise``). Ships with an ``options_model`` take the
+      validated options as a second argument: ``b2_exact(speed, options)``,
+      ``nomoto_KT(speed, options)`` (``options`` may be ``None``: the defaults).
     """
 
     name: str
@@ -49,19 +51,23 @@ class ShipSpec:
     nomoto_KT: Callable | None = None
     speed_range: tuple = (0.0, float("inf"))   #: validity range of the model [m/s]
 
-    def b2(self, speed: float, method: str) -> float:
-        """Rudder efficiency [1/s^2], steerlab sign: ``exact`` (linearisation) or ``estimate`` (eq 29)."""
+    def b2(self, speed: float, method: str, options=None) -> float:
+        """Rudder efficiency [1/s^2], steerlab sign: ``exact`` (linearisation) or ``estimate`` (eq 29).
+
+        ``options``: the validated ``[ship.options]`` (passed on to ``b2_exact`` when the ship
+        has an ``options_model``).
+        """
         if method == "exact":
-            return self.b2_exact(speed)
+            return self.b2_exact(speed, options) if self.options_model is not None else self.b2_exact(speed)
         if method == "estimate":
             c_B, L, B = self.dims
             return b2_estimate(c_B, L, B, speed)
         raise InputError("controller.c0", f"must be a number, 'estimate' or 'exact', got {method!r}")
 
-    def nomoto(self, speed: float) -> tuple[float, float]:
-        """First-order Nomoto ``(K [1/s], T [s])`` at ``speed`` [m/s]."""
+    def nomoto(self, speed: float, options=None) -> tuple[float, float]:
+        """First-order Nomoto ``(K [1/s], T [s])`` at ``speed`` [m/s] (``options`` as in :meth:`b2`)."""
         if self.nomoto_KT is not None:
-            return self.nomoto_KT(speed)
+            return self.nomoto_KT(speed, options) if self.options_model is not None else self.nomoto_KT(speed)
         if self.linearise is None:
             raise InputError("ship.model", f"ship {self.name!r} has neither a Nomoto model nor a linearisation")
         from steerlab.ships.linear_analysis import nomoto_from_linear

@@ -33,7 +33,7 @@ from __future__ import annotations
 import math
 import tomllib
 from pathlib import Path
-from typing import Annotated, Literal, Optional, Union
+from typing import Annotated, Any, Literal, Optional, Union
 
 from pydantic import BaseModel, Field, ValidationError
 
@@ -52,7 +52,7 @@ class ShipConfig(_Frozen):
     speed_kn: float = Field(16.0, gt=0.0, le=40.0, description="approach speed [kn]")
     rpm: Optional[float] = Field(None, gt=0.0, le=1000.0,
                                  description="propeller rate [rpm]; default: the rate that holds speed_kn")
-    options: dict[str, Union[bool, int, float, str]] = Field(
+    options: dict[str, Any] = Field(
         default_factory=dict, description="ship-specific options, validated by the ship's options_model")
 
 

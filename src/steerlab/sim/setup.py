@@ -55,12 +55,13 @@ def build(scenario) -> SimSetup:
     ship = get_ship(s.ship.model)
     ctrl_spec = get_controller(s.controller.type)
     speed = knots_to_ms(s.ship.speed_kn)
-    ps = ship.pack(speed, s.ship.rpm, ship.options(s.ship.options))
+    ship_options = ship.options(s.ship.options)
+    ps = ship.pack(speed, s.ship.rpm, ship_options)
     gear = SteeringGear(rad(s.gear.delta_max_deg), rad(s.gear.rate_max_deg_s), s.gear.T_sg,
                         rad(s.gear.dead_zone_deg))
     pg = gear.pack()
     ts = s.controller.sample_time if s.controller.sample_time is not None else s.dt
-    ctrl, pc = controller_params(s.controller, DesignContext(ship, speed, gear, s.dt, ts))
+    ctrl, pc = controller_params(s.controller, DesignContext(ship, speed, gear, s.dt, ts, ship_options))
     nc = int(round(ts / s.dt))
     if nc < 1 or abs(nc * s.dt - ts) > 1e-9 * max(ts, 1.0):
         raise InputError("controller.sample_time", f"must be a positive multiple of dt={s.dt} s, got {ts} s")
