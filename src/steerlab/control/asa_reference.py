@@ -19,8 +19,10 @@ set-point of the series model (Fig. 4.9) is
 
     psi_r' = psi_m + (2 zeta / omega_n) r_d
 
-and the linear (parallel) reference model driven by ``psi_r'`` has the same states as the
-series model, so (4.4.2 Note 2) the parallel model need not be implemented: its states are
+(and, while the acceleration limit is active, ``psi_r' = psi_m + (r_m' + 2 zeta omega_n
+r_m) / omega_n^2``: the input that makes the linear model produce the limited
+acceleration), and the linear (parallel) reference model driven by ``psi_r'`` has the same
+states as the series model, so (4.4.2 Note 2) the parallel model need not be implemented: its states are
 those of the series model. ``rdot_max`` is the rudder limiter of Fig. 4.10 expressed as a
 yaw acceleration the ship can actually give (``rho K/tau delta_max``, ``rho < 1``).
 
@@ -59,7 +61,7 @@ def reference_model_step(zm, i_psi, i_r, psi_set, omega_n, zeta, r_max, rdot_max
     r_d = min(max(g * e_m, -r_max), r_max)
     acc = 2.0 * zeta * omega_n * (r_d - r_m)
     acc = min(max(acc, -rdot_max), rdot_max)
-    psi_r = psi_m + r_d / g
+    psi_r = psi_m + (acc + 2.0 * zeta * omega_n * r_m) / (omega_n * omega_n)
     zm[i_psi] = wrap_to_pi(psi_m + h * r_m)
     zm[i_r] = r_m + h * acc
     return wrap_to_pi(psi_r)
