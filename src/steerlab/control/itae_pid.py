@@ -57,6 +57,10 @@ the pre-filter. steerlab's guidance already produces exactly that signal: with
 course, which is what a rate limiter does to a step of the desired course, so the limiter is
 not duplicated here. The controller ignores ``r_ref`` (the pre-filter makes its own rate).
 
+The design ignores the steering gear's rate limit: a fast ``t_r`` on a slow ship needs a large
+``H3``, and a large turn can then rate-limit the rudder into a growing oscillation (e.g.
+``nomoto1`` K = 0.1, T = 50 s, t_r = 53 s, 2.33 deg/s gear, 30 deg turn; t_r = 100 s is fine).
+
 Requires ``k > 0``, ``T > 0`` and ``t_r < 8.75 T`` (``H3 > 0``; otherwise the pre-filter
 (11) has a negative leading coefficient and is unstable).
 """
