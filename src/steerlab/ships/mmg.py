@@ -68,6 +68,7 @@ from steerlab.environment.wind_fujiwara import (RHO_AIR, WindGeometry, fujiwara_
 from steerlab.errors import InputError
 from steerlab.ships.clarke import (ClarkeDerivatives, PrimeMass, clarke_derivatives, nomoto_KT_eq11,
                                    prime_mass, state_space_eq10)
+from steerlab.ships.rpm_schedule import check_rpm_schedule, pack_rate, scheduled_rate
 
 # ---------------------------------------------------------------------------------------------
 # ship data (from a TOML file)
@@ -173,10 +174,9 @@ P_XUU, P_CF, P_L, P_RHO = 15, 16, 17, 18             # [kg/m], 0.5 rho T C_D [kg
 P_DP, P_KT0, P_KT1, P_KT2, P_WP, P_TP, P_ETA = 19, 20, 21, 22, 23, 24, 25
 P_RHOA, P_AF, P_AL = 26, 27, 28
 P_WC = 29                                            # 10 Fujiwara coefficients: 29..38
-P_NCONST, P_NSCHED, P_SCHED = 39, 40, 41             # n [rev/s]; k; times (k) then rates (k) [rev/s]
+P_NCONST = 39                                        # rpm block (ships/rpm_schedule.py) from here
 N_FIXED = 41
 N_STRIPS = 8
-MAX_SCHEDULE = 256
 
 
 def _dimensional(data: MMGShipData):
@@ -229,14 +229,14 @@ def pack(data: MMGShipData, n_rps: float, schedule=()) -> np.ndarray:
         The ship.
     n_rps : float
         Constant propeller rate [rev/s] (used when ``schedule`` is empty).
-    schedule : sequence of (t [s], n [rev/s])
+    schedule : sequence of (t [s], rpm)
         Propeller-rate schedule, times non-decreasing (validated by :class:`MMGOptions`).
     """
     h, rd, pr = data.hull, data.rudder, data.propeller
     d, mp, m, xc, M, (q2, q3, q4) = _dimensional(data)
     Minv = np.linalg.inv(M)
-    k = len(schedule)
-    p = np.zeros(N_FIXED + 2 * k)
+    block = pack_rate(n_rps, schedule)
+    p = np.zeros(N_FIXED - 2 + block.size)
     p[P_M11] = m * (1.0 + h.m_x_ratio)
     p[P_MY] = m - d.Y_vdot * q3
     p[P_MXC] = m * xc
@@ -262,11 +262,7 @@ def pack(data: MMGShipData, n_rps: float, schedule=()) -> np.ndarray:
     p[P_AF] = data.wind.A_F
     p[P_AL] = data.wind.A_L
     p[P_WC:P_WC + 10] = fujiwara_coefficients(data.wind_geometry())
-    p[P_NCONST] = n_rps
-    p[P_NSCHED] = k
-    for i, (t, n) in enumerate(schedule):
-        p[P_SCHED + i] = t
-        p[P_SCHED + k + i] = n
+    p[P_NCONST:] = block
     return p
 
 
@@ -276,24 +272,8 @@ def pack(data: MMGShipData, n_rps: float, schedule=()) -> np.ndarray:
 
 @numba.njit(cache=True)
 def propeller_rate(t, p):
-    """Propeller rate [rev/s] at time ``t`` [s]: constant, or the piecewise-linear schedule."""
-    k = int(p[P_NSCHED])
-    if k == 0:
-        return p[P_NCONST]
-    ts = P_SCHED
-    ns = P_SCHED + k
-    if t <= p[ts]:
-        return p[ns]
-    i = k - 1
-    while i > 0 and p[ts + i] > t:
-        i -= 1
-    if i == k - 1:
-        return p[ns + k - 1]
-    t0 = p[ts + i]
-    t1 = p[ts + i + 1]
-    if t1 <= t0:
-        return p[ns + i + 1]
-    return p[ns + i] + (p[ns + i + 1] - p[ns + i]) * (t - t0) / (t1 - t0)
+    """Propeller rate [rev/s] at time ``t`` [s]: constant, or the schedule (:mod:`~steerlab.ships.rpm_schedule`)."""
+    return scheduled_rate(t, p, P_NCONST)
 
 
 @numba.njit(cache=True)
@@ -389,18 +369,7 @@ class MMGOptions(FrozenConfig):
     @field_validator("rpm_schedule")
     @classmethod
     def _check(cls, v):
-        if len(v) > MAX_SCHEDULE:
-            raise ValueError(f"at most {MAX_SCHEDULE} points, got {len(v)}")
-        last = 0.0
-        for i, (t, n) in enumerate(v):
-            if not (math.isfinite(t) and 0.0 <= t <= 1e6):
-                raise ValueError(f"point {i}: time {t} s out of range (allowed: 0 <= t <= 1e6, non-decreasing)")
-            if t < last:
-                raise ValueError(f"point {i}: time {t} s is before the previous point's {last} s (must be non-decreasing)")
-            if not (math.isfinite(n) and 0.0 <= n <= 5000.0):
-                raise ValueError(f"point {i}: rpm {n} out of range (allowed: 0 <= rpm <= 5000)")
-            last = t
-        return v
+        return check_rpm_schedule(v)
 
 
 def linearise_data(data: MMGShipData, speed: float):
@@ -428,8 +397,7 @@ def _spec_for(data: MMGShipData):
         if o.rpm_schedule:
             if rpm is not None:
                 raise InputError("ship.options.rpm_schedule", "give either [ship] rpm or an rpm_schedule, not both")
-            sched = [(t, n / 60.0) for t, n in o.rpm_schedule]
-            return pack(data, sched[0][1], sched)
+            return pack(data, o.rpm_schedule[0][1] / 60.0, o.rpm_schedule)
         n = propeller_rate_for_speed(speed, data) if rpm is None else rpm / 60.0
         return pack(data, n)
 
