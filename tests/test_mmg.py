@@ -199,13 +199,16 @@ def test_wind_in_the_kernel_uses_the_relative_wind():
     w[W_WIND_DIR] = rad(90.0)      # from the east = from starboard on a northbound ship
     x = [0, 0, 0.0, U0, 0, 0]
     d = _rhs(x, w=w) - _rhs(x)
-    assert d[4] < 0 or d[5] != 0       # pushed to port / turned
-    # the surge change equals the wind's X on the relative wind (no current)
+    # the change equals the wind's (X, Y, N) on the relative wind (no current) through the masses
     c = fujiwara_coefficients(KOSOKO.wind_geometry())
     U, a = relative_wind(U0, 0.0, 0.0, 1.5, math.pi / 2)
-    X, _, _ = wind_force(c, KOSOKO.wind.rho_air, KOSOKO.wind.A_F, KOSOKO.wind.A_L, KOSOKO.hull.L, U, a)
-    m11 = build_kosoko_params()[0]
-    assert d[3] == pytest.approx(X / m11)
+    assert U == pytest.approx(math.hypot(U0, 1.5)) and 0 < a < math.pi / 2
+    X, Y, N = wind_force(c, KOSOKO.wind.rho_air, KOSOKO.wind.A_F, KOSOKO.wind.A_L, KOSOKO.hull.L, U, a)
+    assert Y < 0
+    p = build_kosoko_params()
+    assert d[3] == pytest.approx(X / p[0])
+    assert d[4] == pytest.approx(p[4] * Y + p[5] * N) and d[5] == pytest.approx(p[6] * Y + p[7] * N)
+    assert np.all(d[:3] == 0.0)
 
 
 # ------------------------------------------------------------------ closed loop on the Kosoko
