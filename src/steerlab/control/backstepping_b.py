@@ -21,6 +21,7 @@ Derivation (what Table 2 leaves implicit; reference derivatives above the first 
     alpha3' = (L/U)^3 / c * ( -k3 z3' - z2' - f' + alpha2'' )
     u_c    = (T_R / K_R) * ( -k4 z4 + x4 / T_R - c mu^3 z3 + alpha3' )              (26)
 
+(all in the time unit of the gains, see ``gain_time`` in :mod:`steerlab.control.backstepping_a`)
 so that ``z4' = -k4 z4 - c mu^3 z3`` and ``V = (z1^2 + ... + z4^2)/2`` has
 ``V' = -k1 z1^2 - k2 z2^2 - k3 z3^2 - k4 z4^2`` (the cross terms ``c mu^3 z3 z4`` cancel).
 Table 2's ``d3(t)`` is ``alpha3'`` and its ``(L/U)^3 rho psi_r^(4)`` feed-forward is zero for
@@ -40,7 +41,7 @@ from pydantic import Field
 
 from steerlab.config_base import FrozenConfig
 from steerlab.control.backstepping_a import (B_IRDOT, B_K1, B_K2, B_K3, B_K4, B_MU, B_SET, B_TR,
-                                             B_UMAX, N_STATE, backstepping_errors, make)
+                                             B_TU, B_UMAX, N_STATE, backstepping_errors, make)
 from steerlab.control.registry import ControllerSpec
 from steerlab.control.van_leeuwen_design import yaw_accel
 from steerlab.ships.van_leeuwen import vl_drift, vl_drift_partials, vl_gain
@@ -55,10 +56,11 @@ def backstepping_b_update(z, p, t, x, ref, h):
     k2 = p[B_K2]
     k3 = p[B_K3]
     mu = p[B_MU]
+    tu = p[B_TU]
     r = x[5]
     x4 = x[x.shape[0] - 1]
-    g = vl_gain(p, B_SET, mu)
-    f = vl_drift(p, B_SET, mu, r, rd)
+    g = vl_gain(p, B_SET, mu) * tu * tu * tu
+    f = vl_drift(p, B_SET, mu, r, rd) * tu * tu * tu
     alpha3 = (-k3 * z3 - z2 - f + a2d) / g
     z4 = x4 - alpha3
     x3d = g * x4 + f
@@ -67,9 +69,9 @@ def backstepping_b_update(z, p, t, x, ref, h):
     z2dd = z3d - k2 * z2d - z1d
     a2dd = -(k1 + k2) * z2dd + (k1 * k1 - 1.0) * z1dd
     f_r, f_rd = vl_drift_partials(p, B_SET, mu, r)
-    fd = f_r * rd + f_rd * x3d
+    fd = f_r * tu * tu * (rd * tu * tu) + f_rd * tu * x3d
     a3d = (-k3 * z3d - z2d - fd + a2dd) / g
-    T_R = p[B_TR]
+    T_R = p[B_TR] / tu
     u = T_R * (-p[B_K4] * z4 + x4 / T_R - g * z3 + a3d)
     umax = p[B_UMAX]
     return min(max(u, -umax), umax)
@@ -85,6 +87,7 @@ class BacksteppingBConfig(FrozenConfig):
     k4: float = Field(0.001, gt=0.0, le=1e6)
     design_loading: Optional[str] = Field(None, description="Van Leeuwen ships: loading of the design model")
     design_T2: Optional[float] = Field(None, gt=0.0, le=1e3, description="[s] other ships; default gear T_sg")
+    gain_time: Literal["s", "ship"] = Field("s", description="time unit of the gains: 1 s or L/U")
     u_max_deg: Optional[float] = Field(None, gt=0.0, le=90.0, description="default: gear limit")
     sample_time: Optional[float] = Field(None, gt=0.0, le=60.0, description="default: dt")
 
