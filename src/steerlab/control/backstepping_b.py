@@ -1,0 +1,103 @@
+r"""Backstepping heading controller, version B (steering-gear dynamics included).
+
+Source: Witkowska & Śmierzchalski, Table 2, eqs (21)-(24), (26), (29), design model (4)-(7).
+Version B continues version A (:mod:`steerlab.control.backstepping_a`, whose first three
+steps and alpha-dot terms it reuses) by one step through the steering gear::
+
+    x4' = (K_R u_c - x4) / T_R                                                      (7)
+
+(the paper's (7) is ``x4' = u_c - x4``: ``K_R = 1``, ``T_R = 1 s``; steerlab takes
+``T_R = T_sg`` of the configured gear and ``K_R = 1``, the gain of steerlab's gear).
+
+Derivation (what Table 2 leaves implicit; reference derivatives above the first are zero)::
+
+    alpha3 = (L/U)^3 / c * ( -k3 z3 - z2 - f + alpha2' )                            (29)
+    z4     = x4 - alpha3                        (24; its psi_r''' term is zero here)
+    x3'    = c mu^3 x4 + f          =>   z3' = x3' - alpha2' = c mu^3 z4 - k3 z3 - z2
+    z1''   = z2' - k1 z1'
+    z2''   = z3' - k2 z2' - z1'
+    alpha2'' = -(k1 + k2) z2'' + (k1^2 - 1) z1''
+    f'     = (df/dr) x3 + (df/drd) x3'      (f = phi^T theta; df/dr, df/drd in closed form)
+    alpha3' = (L/U)^3 / c * ( -k3 z3' - z2' - f' + alpha2'' )
+    u_c    = (T_R / K_R) * ( -k4 z4 + x4 / T_R - c mu^3 z3 + alpha3' )              (26)
+
+(all in the time unit of the gains, see ``gain_time`` in :mod:`steerlab.control.backstepping_a`)
+so that ``z4' = -k4 z4 - c mu^3 z3`` and ``V = (z1^2 + ... + z4^2)/2`` has
+``V' = -k1 z1^2 - k2 z2^2 - k3 z3^2 - k4 z4^2`` (the cross terms ``c mu^3 z3 z4`` cancel).
+Table 2's ``d3(t)`` is ``alpha3'`` and its ``(L/U)^3 rho psi_r^(4)`` feed-forward is zero for
+steerlab's references. ``x4`` is the measured rudder angle (the last plant state).
+
+The gear's rate limit and saturation are outside the design (as in the paper); the order is
+limited to ``u_max``. Gains [1/s], Table 3 (GA-tuned): ballast ``k1..k4 = 5.93, 184.252,
+0.001, 0.001``; full load ``0.001, 111.8115, 1.3708, 0.001``.
+"""
+
+from __future__ import annotations
+
+from typing import Literal, Optional
+
+import numba
+from pydantic import Field
+
+from steerlab.config_base import FrozenConfig
+from steerlab.control.backstepping_a import (B_IRDOT, B_K1, B_K2, B_K3, B_K4, B_MU, B_SET, B_TR,
+                                             B_TU, B_UMAX, N_STATE, backstepping_errors, make)
+from steerlab.control.registry import ControllerSpec
+from steerlab.control.van_leeuwen_design import yaw_accel
+from steerlab.ships.van_leeuwen import vl_drift, vl_drift_partials, vl_gain
+
+
+@numba.njit(cache=True)
+def backstepping_b_update(z, p, t, x, ref, h):
+    """One sample of law (26): the rudder order [rad]."""
+    rd = yaw_accel(z, 0, p[B_IRDOT], x, h)
+    z1, z2, z3, z1d, z2d, a2d = backstepping_errors(p, x, ref, rd)
+    k1 = p[B_K1]
+    k2 = p[B_K2]
+    k3 = p[B_K3]
+    mu = p[B_MU]
+    tu = p[B_TU]
+    r = x[5]
+    x4 = x[x.shape[0] - 1]
+    g = vl_gain(p, B_SET, mu) * tu * tu * tu
+    f = vl_drift(p, B_SET, mu, r, rd) * tu * tu * tu
+    alpha3 = (-k3 * z3 - z2 - f + a2d) / g
+    z4 = x4 - alpha3
+    x3d = g * x4 + f
+    z3d = x3d - a2d
+    z1dd = z2d - k1 * z1d
+    z2dd = z3d - k2 * z2d - z1d
+    a2dd = -(k1 + k2) * z2dd + (k1 * k1 - 1.0) * z1dd
+    f_r, f_rd = vl_drift_partials(p, B_SET, mu, r)
+    fd = f_r * tu * tu * (rd * tu * tu) + f_rd * tu * x3d
+    a3d = (-k3 * z3d - z2d - fd + a2dd) / g
+    T_R = p[B_TR] / tu
+    u = T_R * (-p[B_K4] * z4 + x4 / T_R - g * z3 + a3d)
+    umax = p[B_UMAX]
+    return min(max(u, -umax), umax)
+
+
+class BacksteppingBConfig(FrozenConfig):
+    """``[controller] type = "backstepping_b"``: gains [1/s] (Table 3, ballast, by default)."""
+
+    type: Literal["backstepping_b"]
+    k1: float = Field(5.93, gt=0.0, le=1e6)
+    k2: float = Field(184.252, gt=0.0, le=1e6)
+    k3: float = Field(0.001, gt=0.0, le=1e6)
+    k4: float = Field(0.001, gt=0.0, le=1e6)
+    design_loading: Optional[str] = Field(None, description="Van Leeuwen ships: loading of the design model")
+    design_T2: Optional[float] = Field(None, gt=0.0, le=1e3, description="[s] other ships; default gear T_sg")
+    gain_time: Literal["s", "ship"] = Field("s", description="time unit of the gains: 1 s or L/U")
+    u_max_deg: Optional[float] = Field(None, gt=0.0, le=90.0, description="default: gear limit")
+    sample_time: Optional[float] = Field(None, gt=0.0, le=60.0, description="default: dt")
+
+
+def build(cfg: BacksteppingBConfig, ctx):
+    return make(cfg, ctx, k4=cfg.k4)
+
+
+CONTROLLER = ControllerSpec(
+    name="backstepping_b",
+    description="backstepping on the Van Leeuwen model with the steering gear (Witkowska, version B)",
+    update=backstepping_b_update, n_state=N_STATE, config=BacksteppingBConfig, build=build,
+    source="Witkowska & Smierzchalski, Table 2 eqs (21)-(24), (26), (29)")

@@ -1,0 +1,208 @@
+r"""Nonlinear ADRC heading controller: TD + ESO with ``fal`` + NLSEF, and Han's time-scale re-tuning.
+
+Source: LOS + ADRC berthing paper (2019), Section 3.2, eqs (20)-(31), after Han (2009).
+The heading is a second-order plant ``psi'' = f + b u`` (20); the controller is (27)::
+
+    TD     v1, v2 track psi_ref                       (21)-(22), tracking_differentiator.py
+    ESO    z1, z2, z3 estimate psi, r, f              (24)-(25), nonlinear_eso.py
+    NLSEF  e1 = wrap(v1 - z1),  e2 = v2 - z2
+           u0 = k1 fal(e1, a1, delta1) + k2 fal(e2, a2, delta2)                     (26)
+    u      = u0 - z3 / b                                                            (27)
+
+(the paper writes ``e1 = x1 - z1``: ``x1, x2`` are the TD outputs). As in (27), ``u0`` is
+already a rudder angle and only ``z3`` is divided by ``b``; this is the reading under which the
+time-scale rule (31) keeps the rudder gains the same from ship to ship. One sample: the
+TD advances, the law acts on the current estimate, then the ESO advances with the applied
+(limited) order, as in steerlab's linear ADRC. The guidance's ``r_ref`` is not used (the TD
+makes its own reference rate).
+
+Parameters (SI). ``b`` [1/s^2] is the rudder gain of ``psi''`` (the ship's ``b2``: ``K/T``
+of its Nomoto model; ``"exact"`` by default, or ``"estimate"`` (Zwierzewicz eq 29) or a
+number). Structural constants default to the paper's (below eq 27): ``a01 = 0.5``,
+``a02 = 0.25``, ``delta01 = delta02 = 0.1``; ``a1 = 0.75``, ``a2 = 2.75`` (as printed; Han's usual
+value is 1.5), ``delta1 = delta2 = 0.1`` (rad and rad/s here). The paper's gains (``beta0i = 10,
+100, 500``, ``k1 = 0.35``, ``k2 = 0.01``, ``b0 = 1``, ``r = 100``, ``h = 0.1``) are for a 1.7 m model
+sampled at 0.125 s; a full-scale ship needs its own. steerlab's defaults therefore derive them
+from two bandwidths: ``omega_o`` (ESO; linear-zone gains of a triple pole, see
+``nleso_gains_bandwidth``) and ``omega_c`` (NLSEF; linear-zone loop ``s^2 + 2 omega_c s +
+omega_c^2``: ``k1 delta1^(a1-1) = omega_c^2 / b``, ``k2 delta2^(a2-1) = 2 omega_c / b``). Explicit
+``k1, k2, beta`` override them.
+
+Time scale (28)-(31). Han's manipulability index of a ship is ``p = 1/sqrt(b)`` (the paper's
+``p = 1/sqrt(K)``, with ``K`` the gain of the integral model ``psi'' = K u``). A setting tuned on
+ship 1 is moved to ship 2 by ``m = p1 / p2 = sqrt(b2 / b1)``::
+
+    beta2i = m^i beta1i (i = 1, 2, 3),  k21 = k11,  k22 = k12 / m,  b2 = m^2 b1        (31)
+
+(:func:`time_scale_retune`). With ``reference_b`` set, the configured ``k1, k2, beta, b`` are
+read as tuned for a ship with ``b = reference_b`` and re-tuned to this ship by (31).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Literal, NamedTuple, Optional, Union
+
+import numba
+import numpy as np
+from pydantic import Field, field_validator
+
+from steerlab.angles import wrap_to_pi
+from steerlab.config_base import FrozenConfig
+from steerlab.control.nonlinear_eso import fal, nleso_gains_bandwidth, nleso_step
+from steerlab.control.registry import ControllerSpec
+from steerlab.control.tracking_differentiator import td_step
+from steerlab.errors import InputError, require_finite_range
+
+(N_B, N_BETA1, N_BETA2, N_BETA3, N_A01, N_D01, N_A02, N_D02, N_K1, N_K2, N_A1, N_D1, N_A2,
+ N_D2, N_R, N_H0, N_UMAX) = range(17)
+N_PARAMS = 17
+N_STATE = 5   # TD [v1 (rad), v2 (rad/s)], ESO [z1 (rad), z2 (rad/s), z3 (rad/s^2)]
+
+
+class TimeScaled(NamedTuple):
+    """A re-tuned setting (eq 31)."""
+
+    beta: tuple
+    k1: float
+    k2: float
+    b: float
+
+
+def time_scale_factor(b1: float, b2: float) -> float:
+    """``m = p1 / p2`` with ``p = 1/sqrt(b)`` (Han's manipulability index), eq (31)."""
+    require_finite_range("controller.reference_b", b1, 0.0, lo_open=True)
+    require_finite_range("controller.b", b2, 0.0, lo_open=True)
+    return math.sqrt(b2 / b1)
+
+
+def time_scale_retune(beta, k1: float, k2: float, b: float, m: float) -> TimeScaled:
+    """Eq (31): the setting ``(beta, k1, k2, b)`` of ship 1 moved to ship 2 with factor ``m``."""
+    require_finite_range("controller.time_scale", m, 0.0, lo_open=True)
+    b1, b2_, b3 = beta
+    return TimeScaled((m * b1, m * m * b2_, m ** 3 * b3), k1, k2 / m, m * m * b)
+
+
+class NonlinearADRC(NamedTuple):
+    b: float
+    beta: tuple
+    a01: float
+    d01: float
+    a02: float
+    d02: float
+    k1: float
+    k2: float
+    a1: float
+    d1: float
+    a2: float
+    d2: float
+    r_td: float
+    h0: float
+    u_max: float
+
+    def pack(self) -> np.ndarray:
+        require_finite_range("controller.b", self.b, 0.0, lo_open=True)
+        for i, v in enumerate(self.beta):
+            require_finite_range(f"controller.beta[{i}]", v, 0.0, lo_open=True)
+        for n in ("k1", "k2"):
+            require_finite_range(f"controller.{n}", getattr(self, n), 0.0)
+        for n in ("a01", "a02", "a1", "a2"):
+            require_finite_range(f"controller.{n}", getattr(self, n), 0.0, 10.0, lo_open=True)
+        for n in ("d01", "d02", "d1", "d2", "r_td", "h0", "u_max"):
+            require_finite_range(f"controller.{n}", getattr(self, n), 0.0, lo_open=True)
+        return np.array([self.b, *self.beta, self.a01, self.d01, self.a02, self.d02, self.k1,
+                         self.k2, self.a1, self.d1, self.a2, self.d2, self.r_td, self.h0,
+                         self.u_max], dtype=np.float64)
+
+    def init_state(self, x0, ref0) -> np.ndarray:
+        """TD at the initial set heading, ESO at the measured heading and rate, no disturbance."""
+        return np.array([ref0[0], 0.0, x0[2], x0[5], 0.0])
+
+
+@numba.njit(cache=True)
+def nlsef(e1, e2, p):
+    """Eq (26): ``u0`` from the tracking errors."""
+    return p[N_K1] * fal(e1, p[N_A1], p[N_D1]) + p[N_K2] * fal(e2, p[N_A2], p[N_D2])
+
+
+@numba.njit(cache=True)
+def nonlinear_adrc_update(z, p, t, x, ref, h):
+    """One sample of (27): TD, NLSEF on the current estimate, then the ESO with the applied order."""
+    td_step(z, 0, ref[0], p[N_R], p[N_H0], h)
+    b = p[N_B]
+    u0 = nlsef(wrap_to_pi(z[0] - z[2]), z[1] - z[3], p)
+    u = u0 - z[4] / b
+    umax = p[N_UMAX]
+    u = min(max(u, -umax), umax)
+    nleso_step(z, 2, b, p[N_BETA1], p[N_BETA2], p[N_BETA3], p[N_A01], p[N_D01], p[N_A02],
+               p[N_D02], x[2], u, h)
+    return u
+
+
+class NonlinearADRCConfig(FrozenConfig):
+    """``[controller] type = "nonlinear_adrc"`` (SI: rad, rad/s, s)."""
+
+    type: Literal["nonlinear_adrc"]
+    b: Union[float, Literal["estimate", "exact"]] = "exact"
+    omega_c: float = Field(0.05, gt=0.0, le=100.0, description="NLSEF bandwidth [rad/s]")
+    omega_o: float = Field(0.5, gt=0.0, le=100.0, description="ESO bandwidth [rad/s]")
+    k1: Optional[float] = Field(None, ge=0.0, le=1e9)
+    k2: Optional[float] = Field(None, ge=0.0, le=1e9)
+    beta: Optional[tuple[float, float, float]] = None
+    reference_b: Optional[float] = Field(None, gt=0.0, description="[1/s^2] re-tune k, beta, b by (31)")
+    a01: float = Field(0.5, gt=0.0, le=10.0)
+    a02: float = Field(0.25, gt=0.0, le=10.0)
+    delta01: float = Field(0.1, gt=0.0, le=10.0)
+    delta02: float = Field(0.1, gt=0.0, le=10.0)
+    a1: float = Field(0.75, gt=0.0, le=10.0)
+    a2: float = Field(2.75, gt=0.0, le=10.0)
+    delta1: float = Field(0.1, gt=0.0, le=10.0)
+    delta2: float = Field(0.1, gt=0.0, le=10.0)
+    r_td: float = Field(0.01, gt=0.0, le=1e6, description="TD tracking speed factor [rad/s^2]")
+    h0: float = Field(1.0, gt=0.0, le=1e3, description="TD filtering factor [s]")
+    u_max_deg: Optional[float] = Field(None, gt=0.0, le=90.0)
+    sample_time: Optional[float] = Field(None, gt=0.0, le=60.0)
+
+    @field_validator("b", mode="before")
+    @classmethod
+    def _b_number_or_method(cls, v):
+        if isinstance(v, str) and v in ("estimate", "exact"):
+            return v
+        if isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) and v > 0:
+            return float(v)
+        raise ValueError(f"must be a finite positive number [1/s^2], 'estimate' or 'exact'; got {v!r}")
+
+    @field_validator("beta")
+    @classmethod
+    def _beta_positive(cls, v):
+        if v is not None and not all(math.isfinite(x) and x > 0 for x in v):
+            raise ValueError("observer gains must be finite and > 0")
+        return v
+
+
+def build(cfg: NonlinearADRCConfig, ctx):
+    b = cfg.b if isinstance(cfg.b, float) else ctx.b2(cfg.b)
+    if not (b > 0.0):
+        raise InputError("controller.b", f"the ship's rudder gain must be > 0, got {b}")
+    if cfg.reference_b is not None:
+        if cfg.k1 is None or cfg.k2 is None or cfg.beta is None:
+            raise InputError("controller.reference_b", "needs k1, k2 and beta (the reference ship's setting)")
+        m = time_scale_factor(cfg.reference_b, b)
+        ts = time_scale_retune(cfg.beta, cfg.k1, cfg.k2, cfg.reference_b, m)
+        beta, k1, k2, b = ts.beta, ts.k1, ts.k2, ts.b
+    else:
+        beta = cfg.beta if cfg.beta is not None else tuple(
+            nleso_gains_bandwidth(cfg.omega_o, cfg.a01, cfg.delta01, cfg.a02, cfg.delta02))
+        k1 = cfg.k1 if cfg.k1 is not None else cfg.omega_c ** 2 / b / cfg.delta1 ** (cfg.a1 - 1.0)
+        k2 = cfg.k2 if cfg.k2 is not None else 2.0 * cfg.omega_c / b / cfg.delta2 ** (cfg.a2 - 1.0)
+    c = NonlinearADRC(b, tuple(float(v) for v in beta), cfg.a01, cfg.delta01, cfg.a02, cfg.delta02,
+                      k1, k2, cfg.a1, cfg.delta1, cfg.a2, cfg.delta2, cfg.r_td, cfg.h0,
+                      ctx.u_max(cfg.u_max_deg))
+    return c, c.pack()
+
+
+CONTROLLER = ControllerSpec(
+    name="nonlinear_adrc",
+    description="nonlinear ADRC: tracking differentiator, ESO with fal, NLSEF (berthing paper eq 20-27)",
+    update=nonlinear_adrc_update, n_state=N_STATE, config=NonlinearADRCConfig, build=build,
+    source="LOS + ADRC automatic berthing (2019) eqs (20)-(31); Han (2009)")

@@ -1,0 +1,150 @@
+r"""Sliding-mode heading controller with a boundary layer, on the fourth-order model (4)-(7).
+
+Source: Witkowska & Śmierzchalski, eqs (12)-(17), "the rule of designing a conventional
+sliding mode controller [10]" (Fossen; Healey & Lienard 1993)::
+
+    x~ = [wrap(psi - psi_z), r - psi_z', r' - psi_z'', delta - psi_z''']             (12)
+    s  = h^T x~                                                                     (12)
+    u_c = u_eq + u_sw                                                               (13)
+    u_eq = -k^T x~                       (14: -N psi_z + k^T x, written on the error)
+    u_sw = -(eta / h^T b) sat(s / phi)                                        (15)-(17)
+
+The paper gives only the tuned ``phi`` and ``eta`` (Table 5), not ``k``, ``N`` or ``h``.
+steerlab designs them by the rule it cites (Fossen; Healey & Lienard): on the linearisation
+``x' = A x + b u_c`` of (4)-(7) at ``r = r' = 0`` (the design model of
+:mod:`steerlab.control.van_leeuwen_design`), ``k`` places the closed-loop poles of
+``A - b k^T`` at ``{0, poles}`` (python-control ``acker``) and ``h`` is the left eigenvector of
+``A - b k^T`` for the pole at 0 (``h^T (A - b k^T) = 0``), scaled to ``h1 = 1`` so that ``s``
+is a heading error [rad]. Then ``s' = h^T b u_sw = -eta sat(s/phi)`` (Fossen's form, the paper's (15) with the factor
+``1/(h^T b)`` taken into ``eta``): ``s`` reaches the boundary layer ``|s| <= phi`` at the rate
+``eta`` [rad/s] and decays in it with rate ``eta / phi`` [1/s]; on ``s = 0`` the motion has the
+poles ``poles``. Writing ``u_eq`` on the error ``x~`` (``psi_z`` enters
+through ``x~1``) is the paper's ``-N psi_z + k^T x`` with ``N = -k1`` and the opposite sign
+convention for ``k``; the pole at 0 makes ``k1 = 0``.
+
+``poles`` (3 negative reals [rad/s]) default to ``(-0.05, -1/T2, -1/T_R)``: the ship's fast
+pole and the gear pole stay where they are and the slow yaw pole moves to -0.05 rad/s. The
+paper's ``eta``, ``phi`` (Table 5: 0.19289, 1.3685 in ballast) are read as deg/s and deg; with
+steerlab's ``k``, ``h`` (not the paper's, which are unknown) they are not the same controller.
+
+The law does not cancel the asymmetry ``a0*`` nor a constant disturbance: the heading keeps a
+steady error (the paper reports ~0.3 deg), with ``|s|`` inside the boundary layer.
+"""
+
+from __future__ import annotations
+
+from typing import Literal, NamedTuple, Optional
+
+import control
+import numba
+import numpy as np
+from pydantic import Field, field_validator
+
+from steerlab.angles import wrap_to_pi
+from steerlab.config_base import FrozenConfig
+from steerlab.control.registry import ControllerSpec
+from steerlab.control.van_leeuwen_design import design_model, linear_design_matrices, yaw_accel
+from steerlab.errors import InputError, require_finite_range
+from steerlab.units import rad
+
+S_K, S_H, S_ETA, S_PHI, S_HB, S_IRDOT, S_UMAX = 0, 4, 8, 9, 10, 11, 12
+N_PARAMS = 13
+N_STATE = 1   # previous yaw rate (r' estimate on ships without an rdot state) [rad/s]
+
+
+def sliding_surface_design(A, b, poles):
+    """``(k, h)``: ``k`` places ``A - b k^T`` at ``{0, *poles}``; ``h`` its left null vector, h1 = 1."""
+    A = np.asarray(A, dtype=float)
+    b = np.asarray(b, dtype=float).reshape(-1, 1)
+    k = np.asarray(control.acker(A, b, [0.0, *poles]), dtype=float).ravel()
+    Ac = A - b @ k.reshape(1, -1)
+    w, V = np.linalg.eig(Ac.T)
+    i = int(np.argmin(np.abs(w)))
+    h = np.real(V[:, i])
+    if abs(h[0]) < 1e-12 * np.max(np.abs(h)):
+        raise InputError("controller.poles", "the sliding surface does not contain the heading error")
+    return k, h / h[0]
+
+
+class SlidingMode(NamedTuple):
+    k: tuple
+    h: tuple
+    eta: float        #: switching gain [rad/s] (reaching rate of s)
+    phi: float        #: boundary-layer width [rad]
+    hb: float         #: h^T b [1/s]
+    i_rdot: float
+    u_max: float
+
+    def pack(self) -> np.ndarray:
+        require_finite_range("controller.eta", self.eta, 0.0)
+        require_finite_range("controller.phi", self.phi, 0.0, lo_open=True)
+        require_finite_range("controller.u_max", self.u_max, 0.0, lo_open=True)
+        for i, v in enumerate((*self.k, *self.h, self.hb)):
+            require_finite_range(f"controller.design[{i}]", v)
+        return np.array([*self.k, *self.h, self.eta, self.phi, self.hb, self.i_rdot,
+                         self.u_max], dtype=np.float64)
+
+    def init_state(self, x0, ref0) -> np.ndarray:
+        return np.array([x0[5]])
+
+
+@numba.njit(cache=True)
+def sliding_mode_update(z, p, t, x, ref, h):
+    """One sample of law (17): the rudder order [rad]."""
+    rd = yaw_accel(z, 0, p[S_IRDOT], x, h)
+    e1 = wrap_to_pi(x[2] - ref[0])
+    e2 = x[5] - ref[1]
+    e4 = x[x.shape[0] - 1]
+    s = p[S_H] * e1 + p[S_H + 1] * e2 + p[S_H + 2] * rd + p[S_H + 3] * e4
+    q = s / p[S_PHI]
+    sat = min(max(q, -1.0), 1.0)
+    u = -(p[S_K] * e1 + p[S_K + 1] * e2 + p[S_K + 2] * rd + p[S_K + 3] * e4) \
+        - p[S_ETA] / p[S_HB] * sat
+    umax = p[S_UMAX]
+    return min(max(u, -umax), umax)
+
+
+class SlidingModeConfig(FrozenConfig):
+    """``[controller] type = "sliding_mode"`` (Table 5, ballast: phi [deg], eta [deg/s])."""
+
+    type: Literal["sliding_mode"]
+    phi_deg: float = Field(1.3685, gt=0.0, le=90.0, description="boundary layer [deg]")
+    eta_deg_s: float = Field(0.19289, ge=0.0, le=90.0, description="switching gain [deg/s]")
+    poles: Optional[tuple[float, float, float]] = Field(
+        None, description="[rad/s] closed-loop poles on s = 0; default (-0.05, -1/T2, -1/T_R)")
+    design_loading: Optional[str] = None
+    design_T2: Optional[float] = Field(None, gt=0.0, le=1e3, description="[s] other ships; default gear T_sg")
+    u_max_deg: Optional[float] = Field(None, gt=0.0, le=90.0, description="default: gear limit")
+    sample_time: Optional[float] = Field(None, gt=0.0, le=60.0, description="default: dt")
+
+    @field_validator("poles")
+    @classmethod
+    def _stable(cls, v):
+        if v is not None and not all(p < 0.0 for p in v):
+            raise ValueError("all three poles must be negative [rad/s]")
+        return v
+
+
+def build(cfg: SlidingModeConfig, ctx):
+    s, L, i_rdot = design_model(ctx, cfg.design_loading, cfg.design_T2)
+    mu = ctx.speed / L
+    T_R = ctx.gear.T_sg
+    A, b = linear_design_matrices(s, mu, T_R)
+    poles = cfg.poles
+    if poles is None:
+        T2 = s[1] / mu   # dimensional second time constant [s]
+        poles = (-0.05, -1.0 / T2, -1.0 / T_R)
+    k, h = sliding_surface_design(A, b, poles)
+    hb = float(h @ b)
+    if abs(hb) < 1e-12:
+        raise InputError("controller.poles", "h^T b = 0: the switching term cannot act on s")
+    c = SlidingMode(tuple(k), tuple(h), rad(cfg.eta_deg_s), rad(cfg.phi_deg), hb, i_rdot,
+                    ctx.u_max(cfg.u_max_deg))
+    return c, c.pack()
+
+
+CONTROLLER = ControllerSpec(
+    name="sliding_mode",
+    description="sliding mode with boundary layer on the 4th-order ship + gear model (Witkowska eq 12-17)",
+    update=sliding_mode_update, n_state=N_STATE, config=SlidingModeConfig, build=build,
+    source="Witkowska & Smierzchalski eqs (12)-(17); surface by Healey & Lienard (1993)")

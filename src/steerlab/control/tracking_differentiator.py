@@ -1,0 +1,52 @@
+r"""Han's tracking differentiator (TD) and its time-optimal synthesis function ``fst``.
+
+Source: LOS + ADRC berthing paper (2019), eqs (21)-(22), after Han (2009)::
+
+    v1' = v2,   v2' = fst(v1 - v, v2, r, h0)                                        (21)
+
+    d = r h0,  d0 = d h0,  y = x1 + h0 x2,  a0 = sqrt(d^2 + 8 r |y|)
+    a = x2 + y / h0                  if |y| <= d0
+        x2 + (a0 - d)/2 sgn(y)       otherwise
+    fst = -r a / d                   if |a| <= d
+          -r sgn(a)                  otherwise                                      (22)
+
+(the paper prints ``y = x1 - u + h x2``, with ``u`` the target ``v``; steerlab passes the
+tracking error ``x1 = v1 - v`` directly, wrapped to [-pi, pi) for a heading). ``r`` [rad/s^2]
+bounds the acceleration of the tracked signal (the "tracking speed factor"), ``h0`` [s] is the
+filtering factor. The TD is advanced by forward Euler at the controller sample time ``h``.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba
+
+from steerlab.angles import wrap_to_pi
+
+
+@numba.njit(cache=True)
+def fst(x1, x2, r, h0):
+    """Eq (22): the TD acceleration for tracking error ``x1`` and rate ``x2``."""
+    d = r * h0
+    d0 = d * h0
+    y = x1 + h0 * x2
+    if abs(y) <= d0:
+        a = x2 + y / h0
+    else:
+        a0 = math.sqrt(d * d + 8.0 * r * abs(y))
+        a = x2 + 0.5 * (a0 - d) * math.copysign(1.0, y)
+    if abs(a) <= d:
+        return -r * a / d
+    return -r * math.copysign(1.0, a)
+
+
+@numba.njit(cache=True)
+def td_step(v, i, v_target, r, h0, h):
+    """Advance the TD state ``[v1, v2] = v[i:i+2]`` (a heading [rad] and its rate [rad/s]) in
+    place by one Euler step of (21)."""
+    v1 = v[i]
+    v2 = v[i + 1]
+    a = fst(wrap_to_pi(v1 - v_target), v2, r, h0)
+    v[i] = wrap_to_pi(v1 + h * v2)
+    v[i + 1] = v2 + h * a
