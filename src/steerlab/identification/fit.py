@@ -109,24 +109,28 @@ def _params_dict(model, theta, names, fixed_values):
 
 
 def _problems(model: str, rec: Record, spiral: SpiralFit | None):
-    """Candidate problems (Norrbin without a spiral: n1 = +1 and n1 = -1)."""
+    """Candidate problems, the best fit wins (Norrbin without a spiral: n1 = +1 and n1 = -1;
+    nomoto2: several splits of the ARX time constant into T1, T2, T3)."""
     K0, T0 = arx_nomoto(rec)
     r0 = float(rec.yaw_rate_estimate()[0])
     d0 = float(rec.delta[0])
     if model == "nomoto1":
         return [(_Problem(nomoto1.nomoto1_rhs, 6, ["K", "T"], [K0, T0], [1e-6, 1e-3], [100.0, 1e5],
-                          lambda th: np.array([th[0], th[1]]), lambda th: None), {})]
+                          lambda th: np.array([th[0], th[1]]), lambda th, r0: None), {})]
     if model == "nomoto2":
         def pack2(th):
             return nomoto2.pack_params(*th)
 
-        def extra2(th):
+        def extra2(th, r0):
             K, T1, T2, T3 = th
             a, b = (T1 + T2) / (T1 * T2), K / (T1 * T2)
             return [a * r0 - b * T3 * d0]      # z with r' = 0 at the start
+        # several starts: T = T1 + T2 - T3 held at the ARX value, T2 and T3 varied
+        starts = [(0.1, 0.1), (0.15, 0.3), (0.3, 0.15), (0.05, 0.25)]
         return [(_Problem(nomoto2.nomoto2_rhs, 7, ["K", "T1", "T2", "T3"],
-                          [K0, T0, 0.1 * T0, 0.1 * T0], [1e-6, 1e-2, 1e-2, 0.0], [100.0, 1e5, 1e5, 1e5],
-                          pack2, extra2), {})]
+                          [K0, T0 * (1 - f2 + f3), f2 * T0, f3 * T0], [1e-6, 1e-2, 1e-2, 0.0],
+                          [100.0, 1e5, 1e5, 1e5], pack2, extra2, scale=[K0, T0, 0.2 * T0, 0.2 * T0]), {})
+                for f2, f3 in starts]
     if model == "norrbin":
         if spiral is not None:
             c = spiral.coef
@@ -135,14 +139,14 @@ def _problems(model: str, rec: Record, spiral: SpiralFit | None):
             fixed = {"K": K, "n0": K * c["c0"], "n1": n1, "n2": K * c["c2"], "n3": K * c["c3"]}
             pk = lambda th: norrbin.pack_params(fixed["K"], th[0], fixed["n0"], fixed["n1"], fixed["n2"], 0.0,
                                                 fixed["n3"])
-            return [(_Problem(norrbin.norrbin_rhs, 6, ["T"], [T0], [1e-2], [1e5], pk, lambda th: None),
+            return [(_Problem(norrbin.norrbin_rhs, 6, ["T"], [T0], [1e-2], [1e5], pk, lambda th, r0: None),
                      {"values": fixed, "by": dict.fromkeys(fixed, "spiral")})]
         out = []
         rmax = max(float(np.max(np.abs(rec.yaw_rate_estimate()))), 1e-4)
         for n1 in (1.0, -1.0):
             pk = (lambda s: lambda th: norrbin.pack_params(th[0], th[1], 0.0, s, 0.0, 0.0, th[2]))(n1)
             out.append((_Problem(norrbin.norrbin_rhs, 6, ["K", "T", "n3"], [K0, T0, 0.1 / rmax ** 2],
-                                 [1e-6, 1e-2, 0.0], [100.0, 1e5, 1e12], pk, lambda th: None,
+                                 [1e-6, 1e-2, 0.0], [100.0, 1e5, 1e12], pk, lambda th, r0: None,
                                  scale=[K0, T0, 1.0 / rmax ** 2]),
                         {"values": {"n0": 0.0, "n1": n1, "n2": 0.0},
                          "by": {"n0": "symmetric", "n1": "normalisation", "n2": "symmetric"}}))
@@ -150,7 +154,7 @@ def _problems(model: str, rec: Record, spiral: SpiralFit | None):
     if model == "bech":
         g = bech.from_nomoto2(K0, T0, 0.1 * T0, 0.1 * T0)
 
-        def extra_b(a, b, T3, c0):
+        def extra_b(a, b, T3, r0):
             return [a * r0 - b * T3 * d0]
         if spiral is not None:
             c = spiral.coef
@@ -159,14 +163,14 @@ def _problems(model: str, rec: Record, spiral: SpiralFit | None):
                                              fixed["c3"])
             return [(_Problem(bech.bech_rhs, 7, ["a", "b", "T3"], [g["a"], g["b"], g["T3"]],
                               [1e-4, 1e-9, 0.0], [100.0, 100.0, 1e5], pk,
-                              lambda th: extra_b(th[0], th[1], th[2], fixed["c0"])),
+                              lambda th, r0: extra_b(th[0], th[1], th[2], r0)),
                      {"values": fixed, "by": dict.fromkeys(fixed, "spiral")})]
         rmax = max(float(np.max(np.abs(rec.yaw_rate_estimate()))), 1e-4)
         pk = lambda th: bech.pack_params(th[0], th[1], th[2], 0.0, th[3], 0.0, 0.0, th[4])
         return [(_Problem(bech.bech_rhs, 7, ["a", "b", "T3", "c1", "c3"],
                           [g["a"], g["b"], g["T3"], g["c1"], 0.1 * g["c1"] / rmax ** 2],
                           [1e-4, 1e-9, 0.0, -1e4, 0.0], [100.0, 100.0, 1e5, 1e4, 1e12], pk,
-                          lambda th: extra_b(th[0], th[1], th[2], 0.0),
+                          lambda th, r0: extra_b(th[0], th[1], th[2], r0),
                           scale=[g["a"], g["b"], g["T3"], g["c1"], g["c1"] / rmax ** 2]),
                  {"values": {"c0": 0.0, "c2": 0.0}, "by": {"c0": "symmetric", "c2": "symmetric"}})]
     raise InputError("--model", f"must be one of {list(MODELS)}, got {model!r}")
@@ -196,22 +200,32 @@ def identify(rec: Record, model: str, use_spiral: bool | None = None, settle: fl
     r0 = float(rec.yaw_rate_estimate()[0])
     speed = rec.mean_speed or 1.0
 
+    # a heading-only record does not give the initial yaw rate: fit it (and the initial
+    # heading) as nuisance parameters appended to the model's
+    n_nuis = 0 if on_rate else 2
     best = None
     for prob, fixed in _problems(model, rec, spiral):
+        def split(th, prob=prob):
+            m = len(prob.x0)
+            return th[:m], (th[m], th[m + 1]) if n_nuis else (psi0, r0)
+
         def residual(th, prob=prob):
-            ps = prob.pack(th)
-            psi, r = simulate_response(prob.rhs, prob.n_states, ps, rec.delta, rec.dt, psi0, r0,
-                                       prob.extra0(th), speed)
-            y = r if on_rate else psi
-            res = y - target
+            th_m, (p0, q0) = split(th)
+            psi, r = simulate_response(prob.rhs, prob.n_states, prob.pack(th_m), rec.delta, rec.dt,
+                                       p0, q0, prob.extra0(th_m, q0), speed)
+            res = (r if on_rate else psi) - target
             return np.where(np.isfinite(res), res, 1e3)
 
         x0 = np.clip(prob.x0, prob.lo, prob.hi)
-        sol = least_squares(residual, x0, bounds=(prob.lo, prob.hi), x_scale=prob.scale,
-                            method="trf", max_nfev=300 * len(x0))
+        lo, hi, sc = prob.lo, prob.hi, prob.scale
+        if n_nuis:
+            x0 = np.r_[x0, psi0, r0]
+            lo, hi, sc = np.r_[lo, psi0 - 0.5, -0.2], np.r_[hi, psi0 + 0.5, 0.2], np.r_[sc, 1e-2, 1e-3]
+        sol = least_squares(residual, x0, bounds=(lo, hi), x_scale=sc, method="trf",
+                            max_nfev=300 * len(x0))
         if best is None or sol.cost < best[0].cost:
-            best = (sol, prob, fixed)
-    sol, prob, fixed = best
+            best = (sol, prob, fixed, split)
+    sol, prob, fixed, split = best
     n, p = len(target), len(sol.x)
     s2 = 2.0 * sol.cost / max(n - p, 1)
     try:
@@ -219,10 +233,11 @@ def identify(rec: Record, model: str, use_spiral: bool | None = None, settle: fl
         half = 1.96 * np.sqrt(np.maximum(np.diag(cov), 0.0))
     except np.linalg.LinAlgError:
         half = np.full(p, np.inf)
-    ps = prob.pack(sol.x)
-    psi_m, r_m = simulate_response(prob.rhs, prob.n_states, ps, rec.delta, rec.dt, psi0, r0,
-                                   prob.extra0(sol.x), speed)
-    params = _params_dict(model, sol.x, prob.names, fixed.get("values", {}))
+    th_m, (p0, q0) = split(sol.x)
+    ps = prob.pack(th_m)
+    psi_m, r_m = simulate_response(prob.rhs, prob.n_states, ps, rec.delta, rec.dt, p0, q0,
+                                   prob.extra0(th_m, q0), speed)
+    params = _params_dict(model, th_m, prob.names, fixed.get("values", {}))
     r_meas = rec.yaw_rate_estimate()
     rms_psi = math.degrees(float(np.sqrt(np.mean((psi_m - rec.psi) ** 2)))) if rec.psi is not None else math.nan
     return FitResult(model=model, params=params,

@@ -64,11 +64,17 @@ class Record:
     def mean_speed(self) -> float | None:
         return None if self.speed is None else float(np.mean(self.speed))
 
-    def yaw_rate_estimate(self) -> np.ndarray:
-        """The recorded yaw rate, or the heading's central difference [rad/s]."""
+    def yaw_rate_estimate(self, smooth: float = 5.0) -> np.ndarray:
+        """The recorded yaw rate, or the central difference of the heading smoothed by a
+        ``smooth``-second moving average [rad/s] (for start guesses and steady turns only)."""
         if self.r is not None:
             return self.r
-        return np.gradient(self.psi, self.t)
+        n = max(int(round(smooth / self.dt)), 1)
+        psi = self.psi
+        if n > 1 and psi.size > 2 * n:
+            pad = np.r_[np.full(n, psi[0]), psi, np.full(n, psi[-1])]
+            psi = np.convolve(pad, np.ones(n) / n, mode="same")[n:-n]
+        return np.gradient(psi, self.t)
 
 
 def make_record(t, delta, psi=None, r=None, speed=None) -> Record:

@@ -2,9 +2,11 @@
 
 Uses the engine's own RK4 plant step (:func:`steerlab.sim.kernels.plant_step`) and the ship
 kernels, so the model identified is exactly the model simulated. The recorded rudder is the
-input: before each step the plant's rudder state is set to the sample and the gear is ordered
-to the same angle, so it holds it over the step (zero-order hold; with the order equal to the
-angle the gear rate is exactly zero).
+input: before the step from sample k to k+1 the plant's rudder state is set to the mean of the
+two samples and the gear is ordered to the same angle, so it holds it over the step (with the
+order equal to the angle the gear rate is exactly zero). Holding the mean rather than sample k
+removes the half-step delay of a plain zero-order hold, which biases the time constants of
+records sampled from a continuous rudder by about dt/2.
 """
 
 from __future__ import annotations
@@ -32,8 +34,9 @@ def _loop(ship_rhs):
         psi_out[0] = x[2]
         r_out[0] = x[5]
         for k in range(n - 1):
-            x[nd] = delta[k]
-            step(k * dt, x, delta[k], w, ps, pg, dt, work)
+            d = 0.5 * (delta[k] + delta[k + 1])
+            x[nd] = d
+            step(k * dt, x, d, w, ps, pg, dt, work)
             psi_out[k + 1] = x[2]
             r_out[k + 1] = x[5]
             if not (abs(x[5]) < 10.0):      # diverged: stop, mark the rest
