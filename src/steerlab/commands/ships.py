@@ -1,0 +1,117 @@
+"""``steerlab ships``: the ship catalogue (every registered ship) and one ship's parameters."""
+
+from __future__ import annotations
+
+EXAMPLES = """examples:
+  steerlab ships                          # id, model, speed range, source of every ship
+  steerlab ships --json
+  steerlab ships show frigate-norrbin     # parameters with units and source
+  steerlab ships show tanker-176k-model-norrbin --json"""
+
+
+def register(sub, formatter_class):
+    p = sub.add_parser("ships", help="list the ship catalogue; 'ships show ID' prints one ship",
+                       description="The ships steerlab knows (modules and the data-file catalogue "
+                                   "ships/data/*.toml), with model, validity range and source.",
+                       epilog=EXAMPLES, formatter_class=formatter_class)
+    p.add_argument("action", nargs="?", choices=("list", "show"), default="list",
+                   help="list (default) or show one ship")
+    p.add_argument("ship", nargs="?", help="ship id for 'show' (as in [ship] model = ...)")
+    p.add_argument("--json", action="store_true", help="print JSON")
+    p.set_defaults(func=run)
+
+
+def _kind(spec) -> str:
+    cat = getattr(spec, "catalogue", None)
+    if cat:
+        return cat["model"]
+    return spec.name
+
+
+def _range(spec) -> str:
+    cat = getattr(spec, "catalogue", None)
+    if cat and "rpm_range" in cat:
+        lo, hi = cat["rpm_range"]
+        return f"{lo:g}-{hi:g} rpm"
+    from steerlab.units import ms_to_knots
+
+    lo, hi = spec.speed_range
+    if hi == float("inf"):
+        return "any" if lo == 0.0 else f">= {ms_to_knots(lo):.3g} kn"
+    if lo == hi:
+        return f"{ms_to_knots(lo):.3g} kn"
+    return f"{ms_to_knots(lo):.3g}-{ms_to_knots(hi):.3g} kn"
+
+
+def list_rows() -> list[dict]:
+    """One row per registered ship: id, model, validity range, source."""
+    from steerlab.ships.registry import SHIPS
+
+    return [{"id": name, "model": _kind(spec), "range": _range(spec), "source": spec.source,
+             "description": spec.description} for name, spec in sorted(SHIPS.items())]
+
+
+def show(ship_id: str) -> dict:
+    """Parameters of one ship with units and source."""
+    from steerlab.ships.registry import get_ship
+
+    spec = get_ship(ship_id)
+    d = {"id": spec.name, "model": _kind(spec), "description": spec.description,
+         "source": spec.source, "range": _range(spec),
+         "states": [{"name": n, "unit": u} for n, u in zip(spec.state_names, spec.state_units)]}
+    cat = getattr(spec, "catalogue", None)
+    if cat:
+        d["catalogue"] = cat
+    if spec.options_model is not None:
+        d["options"] = [{"name": k, "default": f.default, "description": f.description or ""}
+                        for k, f in spec.options_model.model_fields.items()]
+    return d
+
+
+def _print_list(rows):
+    w_id = max(len(r["id"]) for r in rows)
+    w_m = max(len(r["model"]) for r in rows)
+    w_r = max(len(r["range"]) for r in rows)
+    print(f"{'id':<{w_id}}  {'model':<{w_m}}  {'range':<{w_r}}  source")
+    for r in rows:
+        print(f"{r['id']:<{w_id}}  {r['model']:<{w_m}}  {r['range']:<{w_r}}  {r['source']}")
+
+
+def _print_show(d):
+    print(f"{d['id']}: {d['description']}")
+    print(f"  model:  {d['model']}")
+    print(f"  range:  {d['range']}")
+    print(f"  source: {d['source']}")
+    print("  states: " + ", ".join(f"{s['name']} [{s['unit']}]" for s in d["states"]))
+    cat = d.get("catalogue")
+    if cat:
+        print(f"  vessel: {cat['vessel']}, L = {cat['length_m']:g} m ({cat['file']})")
+        cols = [f"{c['name']} [{c['unit']}]" for c in cat["columns"]]
+        widths = [max(len(h), 9) for h in cols]
+        print("  " + "  ".join(f"{h:>{w}}" for h, w in zip(cols, widths)))
+        for row in cat["rows"]:
+            print("  " + "  ".join(f"{v:>{w}.6g}" for v, w in zip(row, widths)))
+        if cat["constants"]:
+            print("  constants: " + ", ".join(f"{k} = {v:g}" for k, v in cat["constants"].items()))
+        print(f"  notes: {cat['notes']}")
+        if cat.get("vessel_notes"):
+            print(f"  vessel notes: {cat['vessel_notes']}")
+    for o in d.get("options", []):
+        print(f"  option {o['name']} = {o['default']!r}: {o['description']}")
+
+
+def run(args) -> int:
+    from steerlab.cli import dump_json
+    from steerlab.errors import InputError
+
+    if args.action == "list":
+        if args.ship:
+            raise InputError("ship", "'steerlab ships' takes no ship id; use 'steerlab ships show ID'")
+        rows = list_rows()
+        print(dump_json(rows)) if args.json else _print_list(rows)
+        return 0
+    if not args.ship:
+        raise InputError("ship", "'steerlab ships show' needs a ship id (see 'steerlab ships')")
+    d = show(args.ship)
+    print(dump_json(d)) if args.json else _print_show(d)
+    return 0
