@@ -179,3 +179,28 @@ def test_cli_bad_input_exit_2_and_nothing_written(tmp_path, capsys, argv, field)
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and f"error: {field}" in err
     assert not out.exists()
+
+
+def test_condition_set_is_the_product_of_variants_speeds_seas_and_seeds(tmp_path):
+    from steerlab.sweeps.conditions import condition_set, load_variants
+
+    f = tmp_path / "loading.toml"
+    f.write_text('[[condition]]\nlabel = "ballast"\nship = { options = { K = 0.12, T = 40.0 } }\n'
+                 '[[condition]]\nlabel = "full"\nship = { options = { K = 0.08, T = 70.0 } }\n')
+    conds = condition_set(scenario_from_dict({**SEA, "duration": 10.0}), n_seeds=2, speeds_kn=(8.0, 12.0),
+                          wave_powers=(0.0, 1e-3), variants=load_variants(f))
+    assert len(conds) == 2 * 2 * 2 * 2
+    c = conds[-1]
+    assert c.label == "full, 12 kn, waves 0.001, seed 6"
+    assert c.scenario.ship.options == {"K": 0.08, "T": 70.0} and c.scenario.ship.speed_kn == 12.0
+    assert c.setup.ps[1] == 70.0 and c.scenario.environment.waves
+    assert not conds[0].scenario.environment.waves
+    bad = tmp_path / "bad.toml"
+    bad.write_text('[[condition]]\nship = { options = { K = -1.0 } }\n')
+    with pytest.raises(InputError) as e:
+        condition_set(scenario_from_dict(SEA), variants=load_variants(bad))
+    assert e.value.field == "ship.options.K"
+    bad.write_text("x = 1\n")
+    with pytest.raises(InputError) as e:
+        load_variants(bad)
+    assert e.value.field == "--conditions"
