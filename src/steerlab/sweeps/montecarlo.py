@@ -1,0 +1,153 @@
+r"""Monte-Carlo over sea realisations: distributions and confidence intervals of every metric.
+
+The scenario is run ``n_runs`` times with seeds ``scenario.seed + i`` (each seed a different
+realisation of the sampled disturbances, e.g. the eq-39 coloured noise), all in one compiled
+batch (:class:`~steerlab.sweeps.packed.PackedBatch`). For every metric of
+:func:`steerlab.metrics.integral_metrics` (exact, from the on-line accumulator) and of
+:func:`steerlab.metrics.step_metrics` plus the final error and the largest rudder angle
+(from the recorded log, every ``record_every`` steps) it reports
+
+* mean, standard deviation, min, max, the 5/25/50/75/95 % percentiles, and
+* the 95 % confidence interval of the mean, ``mean +- t_{0.975, n-1} s / sqrt(n)``
+  (Student t; its half-width shrinks like ``1/sqrt(n)``),
+
+and the percentile bands (5-95 %, 25-75 %, median) over the runs of the heading error
+``wrap_to_pi(psi_ref - psi)`` and of the rudder angle at every recorded instant.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from steerlab.angles import wrap_to_pi_array
+from steerlab.errors import InputError
+from steerlab.metrics import METRIC_UNITS, R2D, integral_metrics, step_metrics
+from steerlab.sweeps.conditions import condition_set
+from steerlab.sweeps.executors import LocalExecutor
+from steerlab.sweeps.packed import PackedBatch
+
+MAX_RUNS = 100_000
+PERCENTILES = (5, 25, 50, 75, 95)
+LOG_BUDGET = 40_000_000
+"""Most floats kept for the recorded logs of a Monte-Carlo batch (sets the default record interval)."""
+
+
+@dataclass
+class MonteCarloResult:
+    seeds: np.ndarray                 # (n,)
+    per_run: dict                     # metric -> (n,) array (NaN where undefined)
+    stats: dict                       # metric -> summary dict
+    time: np.ndarray                  # (n_rec,) [s]
+    error_bands_deg: dict             # percentile -> (n_rec,)
+    rudder_bands_deg: dict            # percentile -> (n_rec,)
+    record_every: int
+    n_steps: int
+    dt: float
+
+
+def confidence_interval(values, level: float = 0.95) -> tuple[float, float, float]:
+    """``(mean, lower, upper)``: Student-t interval of the mean of the finite ``values``."""
+    from scipy import stats
+
+    v = np.asarray(values, dtype=float)
+    v = v[np.isfinite(v)]
+    n = len(v)
+    if n == 0:
+        return math.nan, math.nan, math.nan
+    m = float(np.mean(v))
+    if n == 1:
+        return m, math.nan, math.nan
+    half = float(stats.t.ppf(0.5 + level / 2.0, n - 1) * np.std(v, ddof=1) / math.sqrt(n))
+    return m, m - half, m + half
+
+
+def summarise(values) -> dict:
+    v = np.asarray(values, dtype=float)
+    f = v[np.isfinite(v)]
+    mean, lo, hi = confidence_interval(f)
+    out = {"n": int(len(f)), "n_undefined": int(len(v) - len(f)), "mean": mean, "ci95_low": lo,
+           "ci95_high": hi, "std": float(np.std(f, ddof=1)) if len(f) > 1 else math.nan,
+           "min": float(np.min(f)) if len(f) else math.nan, "max": float(np.max(f)) if len(f) else math.nan}
+    for p in PERCENTILES:
+        out[f"p{p}"] = float(np.percentile(f, p)) if len(f) else math.nan
+    return out
+
+
+def default_record_every(n_runs: int, n_steps: int, nx: int) -> int:
+    """Smallest interval keeping the logs within :data:`LOG_BUDGET` floats (1 = every step)."""
+    per_row = n_runs * (nx + 3)
+    return max(1, int(math.ceil((n_steps + 1) * per_row / LOG_BUDGET)))
+
+
+def run_montecarlo(scenario, n_runs: int, lam: float = 0.1, record_every: int | None = None,
+                   executor=None, progress=None) -> MonteCarloResult:
+    """Run the scenario over ``n_runs`` seeds (see the module docstring)."""
+    say = progress or (lambda msg: None)
+    if not (2 <= int(n_runs) <= MAX_RUNS):
+        raise InputError("--runs", f"must be in [2, {MAX_RUNS}], got {n_runs}")
+    if not (math.isfinite(lam) and lam >= 0):
+        raise InputError("--lambda", f"must be a finite number >= 0, got {lam}")
+    if not scenario.environment.waves:
+        say("note: the scenario has no random disturbance ([environment] waves = false): "
+            "every realisation is the same")
+    conditions = condition_set(scenario, n_seeds=n_runs)
+    batch = PackedBatch.from_setups([c.setup for c in conditions])
+    if record_every is None:
+        record_every = default_record_every(batch.n, batch.n_steps, batch.X.shape[1])
+    if record_every < 1:
+        raise InputError("--record-every", f"must be >= 1, got {record_every}")
+    say(f"{batch.n} runs of {batch.n_steps} steps ({batch.ship_name} + {batch.controller_name}), "
+        f"log every {record_every} step(s); first call compiles the loop")
+    out = (executor or LocalExecutor()).run(batch, record_every)
+    seeds = np.array([c.scenario.seed for c in conditions])
+    per_run: dict = {}
+    nd = batch.X.shape[1] - 1
+    for i in range(batch.n):
+        m = integral_metrics(out.acc[i], lam)
+        m.pop("lambda")
+        m.update(step_metrics(out.time, out.states[i, :, 2], out.ref[i, :, 0]))
+        m["final_error_deg"] = float(wrap_to_pi_array(out.ref[i, -1:, 0] - out.states[i, -1:, 2])[0] * R2D)
+        m["max_abs_rudder_deg"] = float(np.max(np.abs(out.states[i, :, nd])) * R2D)
+        for k, v in m.items():
+            per_run.setdefault(k, np.full(batch.n, np.nan))[i] = math.nan if v is None else float(v)
+    stats = {k: {**summarise(v), "unit": METRIC_UNITS.get(k, "")} for k, v in per_run.items()}
+    err = wrap_to_pi_array(out.ref[:, :, 0] - out.states[:, :, 2]) * R2D
+    rud = out.states[:, :, nd] * R2D
+    eb = {p: np.percentile(err, p, axis=0) for p in PERCENTILES}
+    rb = {p: np.percentile(rud, p, axis=0) for p in PERCENTILES}
+    return MonteCarloResult(seeds, per_run, stats, out.time, eb, rb, record_every, batch.n_steps, batch.dt)
+
+
+def write_montecarlo_outputs(stage, res: MonteCarloResult, scenario_name: str) -> None:
+    """``montecarlo.json``, ``runs.csv/.parquet``, ``bands.csv/.parquet``, ``percentile_bands.png``."""
+    from pathlib import Path
+
+    from steerlab.cli import dump_json
+    from steerlab.sweeps.tables import new_figure, save_figure, write_table
+
+    stage = Path(stage)
+    dump_json({"scenario": scenario_name, "n_runs": int(len(res.seeds)),
+               "seeds": [int(res.seeds[0]), int(res.seeds[-1])], "record_every": res.record_every,
+               "log_resolution_s": res.record_every * res.dt,
+               "note": "integral metrics exact (on-line); step metrics, final error and max rudder "
+                       "from the log at log_resolution_s",
+               "metrics": res.stats}, stage / "montecarlo.json")
+    write_table(stage, "runs", {"seed": res.seeds, **res.per_run})
+    cols = {"t_s": res.time}
+    cols.update({f"error_p{p}_deg": v for p, v in res.error_bands_deg.items()})
+    cols.update({f"rudder_p{p}_deg": v for p, v in res.rudder_bands_deg.items()})
+    write_table(stage, "bands", cols)
+    fig, (a1, a2) = new_figure((8.0, 6.0), nrows=2)
+    for ax, bands, label in ((a1, res.error_bands_deg, "heading error [deg]"),
+                             (a2, res.rudder_bands_deg, "rudder angle [deg]")):
+        ax.fill_between(res.time, bands[5], bands[95], alpha=0.25, color="C0", label="5-95 %")
+        ax.fill_between(res.time, bands[25], bands[75], alpha=0.45, color="C0", label="25-75 %")
+        ax.plot(res.time, bands[50], color="C0", lw=1.0, label="median")
+        ax.set_ylabel(label)
+        ax.legend(loc="upper right")
+    a2.set_xlabel("time [s]")
+    a1.set_title(f"{scenario_name} - {len(res.seeds)} sea realisations: percentile bands", parse_math=False)
+    save_figure(fig, stage / "percentile_bands.png")
