@@ -289,11 +289,17 @@ def _make_spec(entry: CatalogueEntry):
 
 @lru_cache(maxsize=None)
 def load_entries() -> tuple[CatalogueEntry, ...]:
-    """Every entry of every data file, validated (ids unique), in file order."""
+    """Every entry of every catalogue data file, validated (ids unique), in file order.
+
+    A catalogue file has ``[[entry]]`` tables; other files in ``ships/data`` (e.g. ``b481.toml``,
+    ``mmg_kosoko.toml``) hold the parameters of a model module and are read by that module.
+    """
     entries, seen = [], set()
     folder = resources.files("steerlab.ships").joinpath("data")
     for f in sorted((p for p in folder.iterdir() if p.name.endswith(".toml")), key=lambda p: p.name):
         data = tomllib.loads(f.read_text(encoding="utf-8"))
+        if "entry" not in data:
+            continue
         for key in ("vessel", "length_m", "source"):
             if key not in data:
                 raise ValueError(f"{f.name}: missing {key!r}")

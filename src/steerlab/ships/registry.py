@@ -50,6 +50,10 @@ class ShipSpec:
     options_model: type | None = None
     nomoto_KT: Callable | None = None
     speed_range: tuple = (0.0, float("inf"))   #: validity range of the model [m/s]
+    #: ``(speed, options) -> delta0 [rad]`` holding a straight course (None: 0, a symmetric hull)
+    equilibrium_rudder: Callable | None = None
+    #: ``(speed, options) -> bool``: whether delta -> -delta mirrors the response (None: True)
+    symmetric: Callable | None = None
 
     def b2(self, speed: float, method: str, options=None) -> float:
         """Rudder efficiency [1/s^2], steerlab sign: ``exact`` (linearisation) or ``estimate`` (eq 29).

@@ -23,8 +23,6 @@ from steerlab.ships.registry import ShipSpec
 
 @dataclass(frozen=True)
 class TraitShipSpec(ShipSpec):
-    equilibrium_rudder: Callable | None = None
-    symmetric: Callable | None = None
     catalogue: dict | None = None
     estimate_unavailable: str | None = None
 

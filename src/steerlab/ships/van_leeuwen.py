@@ -248,11 +248,17 @@ def _spec_for(ship: VanLeeuwenShip):
         K, T = nomoto_KT(speed, options)
         return K / T
 
+    def equilibrium_rudder(speed, options=None):
+        """``K delta0 = H_N(0) = a0`` (radian form): the rudder that cancels the asymmetry."""
+        T1, T2, K, a0 = ship.loading((options or default).loading).packed()[:4]
+        return a0 / K
+
     return ShipSpec(
         name=ship.name, description=ship.description, rhs=van_leeuwen_rhs, n_states=7,
         state_names=STATE_NAMES, state_units=STATE_UNITS, pack=pack, b2_exact=b2_exact,
         dims=(ship.c_B, ship.L, ship.B), source=ship.source, options_model=Options,
-        nomoto_KT=nomoto_KT, speed_range=(0.5, 15.0))
+        nomoto_KT=nomoto_KT, speed_range=(0.5, 15.0), equilibrium_rudder=equilibrium_rudder,
+        symmetric=lambda speed, options=None: False)
 
 
 def _ship_specs():
