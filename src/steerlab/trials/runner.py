@@ -157,13 +157,27 @@ def run_until(make_program, cond: TrialConditions, duration: float, done, max_do
     res = None
     for _ in range(max_doublings + 1):
         duration = min(duration, MAX_DURATION)
-        res = run_program(cond, make_program(duration), duration)
+        program = make_program(duration)
+        res = run_program(cond, program, duration)
+        check_bounded(res, cond, program.kind)
         if done(res):
             return res, True
         if duration >= MAX_DURATION:
             break
         duration *= 2.0
     return res, False
+
+
+def check_bounded(res, cond: TrialConditions, what: str) -> None:
+    """Raise :class:`InputError` when the ship model diverged (non-finite state, |r| > 1 rad/s).
+
+    A linear course-unstable model (e.g. ``nomoto1`` with ``T < 0``) has no steady turn: its
+    rate of turn grows without bound, and no trial metric means anything.
+    """
+    r_max = max(1.0, 10.0 * cond.speed / get_ship(cond.ship).dims[1])
+    if not np.all(np.isfinite(res.states)) or float(np.max(np.abs(res.r))) > r_max:
+        raise InputError("ship", f"the {cond.ship!r} model diverges during the {what} trial (|r| beyond "
+                                 f"{r_max:.3g} rad/s): it has no steady turn with these options")
 
 
 def rudder_limit_check(cond: TrialConditions, rudder_deg: float, field_name: str = "rudder") -> float:
