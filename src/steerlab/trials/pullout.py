@@ -65,7 +65,8 @@ def run_pullout(cond: TrialConditions, rudder_deg: float = 20.0) -> PulloutTrial
             r_end, d_end = _window_mean(res, end - w, end)
             return abs(d_turn) <= STEADY_REL * abs(r_turn) and abs(d_end) <= STEADY_REL * max(abs(r_end), 0.05 * abs(r_turn))
 
-        res, converged = run_until(program, cond, t0 + 2.0 * span, done, max_doublings=3)
+        res, converged = run_until(program, cond, t0 + 2.0 * span, done, max_doublings=3,
+                                     label="pull-out")
         tr_, end = holder["t_r"], res.time[-1]
         w = 0.2 * (end - tr_)
         r_turn, _ = _window_mean(res, tr_ - w, tr_)

@@ -149,7 +149,8 @@ def time_scale(cond: TrialConditions) -> dict:
     return out
 
 
-def run_until(make_program, cond: TrialConditions, duration: float, done, max_doublings: int = 4):
+def run_until(make_program, cond: TrialConditions, duration: float, done, max_doublings: int = 4,
+              label: str | None = None):
     """Run, and rerun with twice the duration until ``done(result)`` (at most ``max_doublings`` times).
 
     Returns ``(result, converged)``.
@@ -159,7 +160,7 @@ def run_until(make_program, cond: TrialConditions, duration: float, done, max_do
         duration = min(duration, MAX_DURATION)
         program = make_program(duration)
         res = run_program(cond, program, duration)
-        check_bounded(res, cond, program.kind)
+        check_bounded(res, cond, label or program.kind)
         if done(res):
             return res, True
         if duration >= MAX_DURATION:

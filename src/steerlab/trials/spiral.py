@@ -180,7 +180,7 @@ def run_spiral(cond: TrialConditions, max_rudder_deg: float = 10.0, step_deg: fl
         return all(s for _, _, s in step_means(res, holder[key], holder["hold" if key == "times" else "rhold"])[1:])
 
     res_d, _ = run_until(direct_prog, cond, t0 + hold * len(rudders), lambda r: steady(r, "times"),
-                         max_doublings=2)
+                         max_doublings=2, label="spiral")
     sd = step_means(res_d, holder["times"], holder["hold"])
     n_down = int(np.argmin(rudders)) + 1
     points = []
@@ -200,7 +200,7 @@ def run_spiral(cond: TrialConditions, max_rudder_deg: float = 10.0, step_deg: fl
         return TrialProgramConfig(kind="rate_hold", times=tuple(holder["rtimes"]), values=tuple(deg(targets)))
 
     res_r, _ = run_until(reversed_prog, cond, t0 + rhold * len(targets), lambda r: steady(r, "rtimes"),
-                         max_doublings=2)
+                         max_doublings=2, label="reversed-spiral")
     sr = step_means(res_r, holder["rtimes"], holder["rhold"])
     rpoints = [{"set_rate_deg_s": float(deg(tg)), "rate_deg_s": float(deg(rm)), "rudder_deg": float(deg(dm)),
                 "steady": ok} for (dm, rm, ok), tg in zip(sr, targets)]

@@ -134,7 +134,7 @@ def run_turning(cond: TrialConditions, rudder_deg: float = 35.0, port: bool = Fa
         r = res.r[last_turn_window(chi)]
         return (np.max(r) - np.min(r)) <= STEADY_TOL * abs(np.mean(r))
 
-    res, _ = run_until(program, cond, duration, done)
+    res, _ = run_until(program, cond, duration, done, label="turning-circle")
     m = turning_metrics(res, t0, sign, ts["L"], cond.speed, rudder_deg)
     m["imo"] = turning_criteria(m["advance_m"], m["tactical_diameter_m"], ts["L"], rudder_deg, cond)
     m["conditions"] = conditions_dict(cond)

@@ -106,7 +106,7 @@ def run_zigzag(cond: TrialConditions, rudder_deg: float = 10.0, heading_deg: flo
     def done(res):
         return len(reversal_times(res.time, res.delta_cmd, t0)) >= N_REVERSALS
 
-    res, _ = run_until(program, cond, duration, done)
+    res, _ = run_until(program, cond, duration, done, label="zig-zag")
     L_over_V = ts["L_over_U"]
     m = zigzag_metrics(res, t0, sign, rudder_deg, heading_deg, ts["L"], cond.speed)
     m["L_over_V_s"] = L_over_V
