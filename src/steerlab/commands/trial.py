@@ -88,10 +88,11 @@ def _table(kind, metrics) -> str:
 
 def cmd_trial(args) -> int:
     from steerlab.cli import _progress, dump_json, staged_output
-    from steerlab.trials.api import run_trial, write_figures
+    from steerlab.trials.api import check_trial_options, run_trial, write_figures
 
     say = _progress(args.quiet)
     cond = conditions_from_args(args)
+    with_flag_names(check_trial_options, args.trial_kind, cond, **_options(args))
     say(f"{args.trial_kind} trial on {cond.ship} at {cond.speed_kn:g} kn "
         f"(first run compiles the ship's trial loop, a few seconds)")
     trial, metrics = with_flag_names(run_trial, args.trial_kind, cond, **_options(args))

@@ -11,7 +11,7 @@ from pathlib import Path
 from steerlab.errors import InputError
 from steerlab.trials import figures
 from steerlab.trials.pullout import run_pullout
-from steerlab.trials.runner import TrialConditions, get_ship
+from steerlab.trials.runner import TrialConditions
 from steerlab.trials.spiral import run_spiral
 from steerlab.trials.turning import run_turning
 from steerlab.trials.zigzag import run_zigzag
@@ -24,6 +24,25 @@ class TurningPair:
 
     def __init__(self, trials):
         self.trials = trials
+
+
+def check_trial_options(kind: str, cond: TrialConditions, **kw) -> None:
+    """Validate a trial's options before anything runs (raises :class:`InputError`)."""
+    from steerlab.errors import require_finite_range
+    from steerlab.trials.runner import rudder_limit_check
+
+    if kind not in KINDS:
+        raise InputError("trial", f"unknown trial {kind!r}; known: {list(KINDS)}")
+    cond = cond.resolved()
+    if "rudder_deg" in kw:
+        rudder_limit_check(cond, kw["rudder_deg"])
+    if "heading_deg" in kw:
+        require_finite_range("heading", kw["heading_deg"], 0.0, 90.0, lo_open=True)
+    if "max_rudder_deg" in kw:
+        rudder_limit_check(cond, kw["max_rudder_deg"], "max_rudder")
+        require_finite_range("step", kw.get("step_deg", 2.0), 0.0, kw["max_rudder_deg"], lo_open=True)
+    if kw.get("hold_s") is not None:
+        require_finite_range("hold", kw["hold_s"], 0.0, 1e5, lo_open=True)
 
 
 def run_trial(kind: str, cond: TrialConditions, **kw):
@@ -54,8 +73,7 @@ def write_figures(kind: str, trial, out_dir: Path, prefix: str = "") -> list[Pat
     out_dir = Path(out_dir)
     if kind == "turning":
         trials = trial.trials if isinstance(trial, TurningPair) else [trial]
-        cond = trials[0].metrics["conditions"]
-        L = get_ship(cond["ship"]).dims[1]
+        L = trials[0].metrics["conditions"]["L_m"]
         return [figures.plot_turning_track(out_dir / f"{prefix}turning_track.png", trials, L),
                 figures.plot_turning_time(out_dir / f"{prefix}turning_time.png", trials)]
     if kind == "zigzag":

@@ -104,7 +104,7 @@ def plot_zigzag(path: Path, trial, title: str = "") -> Path:
     ax.set_xlabel("time [s]")
     ax.set_ylabel("[deg]")
     ax.set_title(title or f"{m['rudder_deg']:g}/{m['heading_deg']:g} zig-zag", fontsize=10)
-    ax.legend(fontsize=8, loc="lower left")
+    fig.legend(fontsize=8, loc="outside lower center", ncols=3)
     return _save(fig, path)
 
 
@@ -113,9 +113,9 @@ def plot_spiral(path: Path, trial, title: str = "") -> Path:
     fig, (ax,) = _figure((7.0, 5.0))
     m = trial.metrics
     for branch, mk in (("down", "v"), ("up", "^")):
-        pts = [p for p in m["direct"] if p["branch"] == branch]
-        ax.plot([p["mean_rudder_deg"] for p in pts], [p["rate_deg_s"] for p in pts], mk + "-", lw=0.8,
-                ms=6, mfc="none", label=f"direct spiral, rudder {'decreasing' if branch == 'down' else 'increasing'}")
+        pts = [p for p in m["direct"] if p["branch"] in (branch, "start" if branch == "down" else "")]
+        ax.plot([p["mean_rudder_deg"] for p in pts], [p["rate_deg_s"] for p in pts], mk, ms=7, mfc="none",
+                label=f"direct spiral, rudder {'decreasing' if branch == 'down' else 'increasing'}")
     rr = np.array([p["rate_deg_s"] for p in m["reversed"]])
     dd = np.array([p["rudder_deg"] for p in m["reversed"]])
     ax.plot(dd, rr, "o", ms=4, label="reversed spiral (Bech)")

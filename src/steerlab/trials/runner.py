@@ -129,6 +129,15 @@ def run_program(cond: TrialConditions, program: TrialProgramConfig, duration: fl
     return simulate(trial_setup(cond, program, duration), engine=engine)
 
 
+def ship_length(cond: TrialConditions) -> float:
+    """Ship length L [m]: the ``L`` of the validated ``[ship.options]`` when the ship has one
+    (``nomoto1`` takes its length as an option), else ``ShipSpec.dims[1]``."""
+    ship = get_ship(cond.ship)
+    opts = ship.options(cond.options)
+    L = getattr(opts, "L", None) if opts is not None else None
+    return float(L) if isinstance(L, (int, float)) and L > 0 else float(ship.dims[1])
+
+
 def time_scale(cond: TrialConditions) -> dict:
     """Time scales of the ship at the trial speed: ``L/U`` [s] and the Nomoto ``|T|`` [s] (or None).
 
@@ -137,7 +146,7 @@ def time_scale(cond: TrialConditions) -> dict:
     """
     cond = cond.resolved()
     ship = get_ship(cond.ship)
-    L = ship.dims[1]
+    L = ship_length(cond)
     out = {"L": L, "U": cond.speed, "L_over_U": L / cond.speed, "K": None, "T": None}
     try:
         K, T = ship.nomoto(cond.speed, ship.options(cond.options))
@@ -175,7 +184,7 @@ def check_bounded(res, cond: TrialConditions, what: str) -> None:
     A linear course-unstable model (e.g. ``nomoto1`` with ``T < 0``) has no steady turn: its
     rate of turn grows without bound, and no trial metric means anything.
     """
-    r_max = max(1.0, 10.0 * cond.speed / get_ship(cond.ship).dims[1])
+    r_max = max(1.0, 10.0 * cond.speed / ship_length(cond))
     if not np.all(np.isfinite(res.states)) or float(np.max(np.abs(res.r))) > r_max:
         raise InputError("ship", f"the {cond.ship!r} model diverges during the {what} trial (|r| beyond "
                                  f"{r_max:.3g} rad/s): it has no steady turn with these options")
