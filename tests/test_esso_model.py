@@ -90,12 +90,13 @@ def test_propeller_rate_80rpm_at_16kn():
 def test_pack_layout_and_sign_flip():
     p = E.pack()
     assert p.shape == (E.N_PARAMS,) and len(E.PARAM_NAMES) == E.N_PARAMS
-    assert p[E.P_M11] == pytest.approx(1.05)
-    assert p[E.P_M22] == pytest.approx(2.02)
-    assert p[E.P_M33] == pytest.approx((0.05 + 0.0732) * T.L**2)
-    assert p[E.P_YD] == pytest.approx(-T.Y_uud / T.L)
-    assert p[E.P_ND] == pytest.approx(-T.N_uud) and p[E.P_ND] > 0
-    assert p[E.P_MUNK] == pytest.approx(-0.97)
+    m11, m22, m33 = 1.05, 2.02, (0.05 + 0.0732) * T.L**2
+    assert E.mass_terms(T) == pytest.approx((m11, m22, m33))
+    # each equation of (8)-(10) divided through by its mass term
+    assert p[E.P_XVR] == pytest.approx(m22 / m11) and p[E.P_YUR_M] == pytest.approx(-m11 / m22)
+    assert p[E.P_YD] == pytest.approx(-T.Y_uud / T.L / m22)
+    assert p[E.P_ND] == pytest.approx(-T.N_uud / m33) and p[E.P_ND] > 0
+    assert p[E.P_MUNK] == pytest.approx(-0.97 / m33)
 
 
 # ---------------------------------------------------------------- linearisation consistency

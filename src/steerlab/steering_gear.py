@@ -25,7 +25,7 @@ import numpy as np
 from steerlab.errors import require_finite_range
 from steerlab.units import rad
 
-G_DMAX, G_RATE, G_TSG, G_DEAD = 0, 1, 2, 3
+G_DMAX, G_RATE, G_INV_TSG, G_DEAD = 0, 1, 2, 3  # [rad], [rad/s], 1/T_SG [1/s], [rad]
 N_PARAMS = 4
 
 
@@ -46,7 +46,7 @@ class SteeringGear(NamedTuple):
 
     def pack(self) -> np.ndarray:
         g = self.validated()
-        return np.array([g.delta_max, g.rate_max, g.T_sg, g.dead_zone], dtype=np.float64)
+        return np.array([g.delta_max, g.rate_max, 1.0 / g.T_sg, g.dead_zone], dtype=np.float64)
 
 
 @numba.njit(cache=True)
@@ -57,7 +57,7 @@ def gear_rate(delta, delta_cmd, g):
     err = cmd - delta
     if abs(err) <= g[G_DEAD]:
         return 0.0
-    rate = err / g[G_TSG]
+    rate = err * g[G_INV_TSG]
     rmax = g[G_RATE]
     return min(max(rate, -rmax), rmax)
 

@@ -71,14 +71,20 @@ class EssoTable2(NamedTuple):
     N_uud: float = -0.1274    #: N_uu delta [-] (paper sign: delta_p < 0 starboard)
 
 
-# Layout of the packed coefficient record (SI, per unit mass, steerlab rudder sign).
-P_M11, P_M22, P_M33 = 0, 1, 2          # 1 - X_udot [-], 1 - Y_vdot [-], (J_z - N_rdot) L^2 [m^2]
-P_XUU, P_THRUST, P_N = 3, 4, 5         # X_|u|u/L [1/m], (1-t_p) X_nn L [m], n [rev/s]
-P_YUV, P_YVV, P_YUR, P_YD = 6, 7, 8, 9  # [1/m], [1/m], [-], [1/m] (Y_d steerlab sign)
-P_MUNK, P_NUV, P_NUR, P_NVR, P_ND = 10, 11, 12, 13, 14  # [-], [-], [m], [m], [-] (N_d steerlab)
-N_PARAMS = 15
-PARAM_NAMES = ("m11", "m22", "m33", "X_uu", "thrust", "n", "Y_uv", "Y_vv", "Y_ur", "Y_d",
-               "munk", "N_uv", "N_ur", "N_vr", "N_d")
+# Layout of the packed coefficient record (SI, steerlab rudder sign). Each equation of (8)-(10)
+# is divided through by its mass term in :func:`pack`, so the kernel is multiply-adds only:
+# dx3 = XVR v r + XUU |u| u + THRUST n^2, dx4 = YUR_M u r + ..., dx5 = MUNK u v + ...
+P_XVR, P_XUU, P_THRUST, P_N = 0, 1, 2, 3               # m22/m11 [-], X_|u|u/(L m11) [1/m], (1-t_p) X_nn L/m11 [m], n [rev/s]
+P_YUR_M, P_YUV, P_YVV, P_YUR, P_YD = 4, 5, 6, 7, 8     # -m11/m22 [-]; Y_|u|v/(L m22), Y_|v|v/(L m22) [1/m], Y_|u|r/m22 [-], Y_uud/(L m22) [1/m]
+P_MUNK, P_NUV, P_NUR, P_NVR, P_ND = 9, 10, 11, 12, 13  # all / m33 with m33 = (J_z - N_rdot) L^2: [1/m^2], [1/m^2], [1/m], [1/m], [1/m^2]
+N_PARAMS = 14
+PARAM_NAMES = ("m22/m11", "X_uu/m11", "thrust/m11", "n", "-m11/m22", "Y_uv/m22", "Y_vv/m22",
+               "Y_ur/m22", "Y_d/m22", "munk/m33", "N_uv/m33", "N_ur/m33", "N_vr/m33", "N_d/m33")
+
+
+def mass_terms(table: "EssoTable2") -> tuple[float, float, float]:
+    """``(m11, m22, m33)`` of (8)-(10): ``1 - X_udot`` [-], ``1 - Y_vdot`` [-], ``(J_z - N_rdot) L^2`` [m^2]."""
+    return table.m - table.X_udot, table.m - table.Y_vdot, (table.J_z - table.N_rdot) * table.L**2
 
 
 def pack(table: EssoTable2 = EssoTable2(), n_rps: float | None = None, speed: float = 8.2311) -> np.ndarray:
@@ -95,21 +101,21 @@ def pack(table: EssoTable2 = EssoTable2(), n_rps: float | None = None, speed: fl
     """
     t = table
     L = t.L
+    m11, m22, m33 = mass_terms(t)
     p = np.empty(N_PARAMS)
-    p[P_M11] = t.m - t.X_udot
-    p[P_M22] = t.m - t.Y_vdot
-    p[P_M33] = (t.J_z - t.N_rdot) * L**2
-    p[P_XUU] = t.X_uu / L
-    p[P_THRUST] = (1.0 - t.t_p) * t.X_nn * L
-    p[P_YUV] = t.Y_uv / L
-    p[P_YVV] = t.Y_vv / L
-    p[P_YUR] = t.Y_ur
-    p[P_YD] = -t.Y_uud / L            # steerlab sign: delta = -delta_p
-    p[P_MUNK] = t.Y_vdot - t.X_udot
-    p[P_NUV] = t.N_uv
-    p[P_NUR] = t.N_ur * L
-    p[P_NVR] = t.N_vr * L
-    p[P_ND] = -t.N_uud                # steerlab sign
+    p[P_XVR] = m22 / m11
+    p[P_XUU] = t.X_uu / L / m11
+    p[P_THRUST] = (1.0 - t.t_p) * t.X_nn * L / m11
+    p[P_YUR_M] = -m11 / m22
+    p[P_YUV] = t.Y_uv / L / m22
+    p[P_YVV] = t.Y_vv / L / m22
+    p[P_YUR] = t.Y_ur / m22
+    p[P_YD] = -t.Y_uud / L / m22       # steerlab sign: delta = -delta_p
+    p[P_MUNK] = (t.Y_vdot - t.X_udot) / m33
+    p[P_NUV] = t.N_uv / m33
+    p[P_NUR] = t.N_ur * L / m33
+    p[P_NVR] = t.N_vr * L / m33
+    p[P_ND] = -t.N_uud / m33            # steerlab sign
     p[P_N] = propeller_rate_for_speed(speed, table) if n_rps is None else n_rps
     return p
 
@@ -146,11 +152,11 @@ def esso_rhs(t, x, delta, w, p, dx):
     dx[2] = r
     n = p[P_N]
     u2d = u * u * d
-    dx[3] = (p[P_M22] * v * r + p[P_XUU] * au * u + p[P_THRUST] * n * n) / p[P_M11]
-    dx[4] = (-p[P_M11] * u * r + (p[P_YUV] * au + p[P_YVV] * abs(v)) * v
-             + p[P_YUR] * au * r + p[P_YD] * u2d) / p[P_M22]
+    dx[3] = p[P_XVR] * v * r + p[P_XUU] * au * u + p[P_THRUST] * n * n
+    dx[4] = (p[P_YUR_M] * u * r + (p[P_YUV] * au + p[P_YVV] * abs(v)) * v
+             + p[P_YUR] * au * r + p[P_YD] * u2d)
     dx[5] = (p[P_MUNK] * u * v + p[P_NUV] * au * v
-             + (p[P_NUR] * au + p[P_NVR] * abs(v)) * r + p[P_ND] * u2d) / p[P_M33]
+             + (p[P_NUR] * au + p[P_NVR] * abs(v)) * r + p[P_ND] * u2d)
 
 
 def propeller_rate_for_speed(speed: float, table: EssoTable2 = EssoTable2()) -> float:
