@@ -256,3 +256,24 @@ def test_cli_bad_input_subprocess():
                         "36", "--json"], capture_output=True, text=True, timeout=120)
     assert p.returncode == 2 and p.stdout == ""
     assert len(p.stderr.strip().splitlines()) == 1 and "--rudder" in p.stderr
+
+
+# ------------------------------------------------------------------ every registered ship
+
+def _all_ships():
+    from steerlab.ships.registry import SHIPS
+
+    return sorted(SHIPS)
+
+
+@pytest.mark.parametrize("ship", _all_ships())
+def test_every_ship_runs_a_20_20_zigzag_within_the_gear(ship):
+    """Any ship of the registry (default options and speed) runs the trial program unchanged."""
+    tr = run_zigzag(TrialConditions(ship), 20.0, 20.0)
+    m, res = tr.metrics, tr.result
+    assert np.all(np.isfinite(res.states))
+    assert m["complete"] and len(m["overshoot_angles_deg"]) >= 2
+    assert all(math.isfinite(o) for o in m["overshoot_angles_deg"])
+    assert np.max(np.abs(res.delta)) <= rad(35.0) + 1e-12
+    rate = np.abs(np.diff(res.delta)) / res.dt
+    assert np.max(rate) <= rad(2.33) * (1.0 + 1e-9)

@@ -30,7 +30,7 @@ from steerlab.sim.engine import simulate
 from steerlab.sim.scenario import scenario_from_dict
 from steerlab.sim.setup import SimSetup, build
 from steerlab.ships.registry import get_ship
-from steerlab.steering_gear import G_DEAD, G_RATE, G_TSG, SteeringGear
+from steerlab.steering_gear import SteeringGear
 from steerlab.trials.program import TRIAL_PROGRAM, TrialProgramConfig
 from steerlab.trials.program import build as build_program
 from steerlab.units import KNOT, deg, knots_to_ms, rad
@@ -95,13 +95,15 @@ def _scenario(cond: TrialConditions, duration: float):
     })
 
 
-def ideal_gear_params(pg: np.ndarray, dt: float) -> np.ndarray:
-    """Gear record of the ideal rudder (see the module docstring); keeps the angle limit."""
-    p = pg.copy()
-    p[G_RATE] = 1e6
-    p[G_TSG] = dt / IDEAL_GEAR_LAG_STEPS
-    p[G_DEAD] = 0.0
-    return p
+def scenario_gear(scenario) -> SteeringGear:
+    """The scenario's steering gear (SI), built the same way as :func:`steerlab.sim.setup.build`."""
+    g = scenario.gear
+    return SteeringGear(rad(g.delta_max_deg), rad(g.rate_max_deg_s), g.T_sg, rad(g.dead_zone_deg))
+
+
+def ideal_gear(gear: SteeringGear, dt: float) -> SteeringGear:
+    """The ideal rudder of ``--no-gear`` (see the module docstring); keeps the angle limit."""
+    return SteeringGear(gear.delta_max, 1e6, dt / IDEAL_GEAR_LAG_STEPS, 0.0)
 
 
 def gear_limit_deg(cond: TrialConditions) -> float:
@@ -114,11 +116,14 @@ def trial_setup(cond: TrialConditions, program: TrialProgramConfig, duration: fl
     cond = cond.resolved()
     if not (0.0 < duration <= MAX_DURATION):
         raise InputError("duration", f"trial duration {duration:.0f} s is outside (0, {MAX_DURATION:.0f}] s")
-    base = build(_scenario(cond, duration))
-    gear = SteeringGear(*base.pg)
+    scenario = _scenario(cond, duration)
+    base = build(scenario)
+    gear = scenario_gear(scenario)
+    if not cond.gear:
+        gear = ideal_gear(gear, cond.dt)
     ctx = DesignContext(base.ship, cond.speed, gear, cond.dt, cond.dt, base.ship.options(cond.options))
     prog, pc = build_program(program, ctx)
-    pg = base.pg if cond.gear else ideal_gear_params(base.pg, cond.dt)
+    pg = base.pg if cond.gear else gear.pack()
     z0 = prog.init_state(base.x0, (base.x0[2], 0.0))
     return replace(base, controller=TRIAL_PROGRAM, pc=np.asarray(pc, dtype=float), z0=z0, nc=1, pg=pg,
                    name=f"{program.kind}-{cond.ship}")
