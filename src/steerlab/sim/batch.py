@@ -14,7 +14,7 @@ import numpy as np
 
 from steerlab.errors import InputError
 from steerlab.metrics_online import N_ACC
-from steerlab.sim.kernels import batch_loop
+from steerlab.sim.kernels import LANES, batch_loop
 from steerlab.sim.setup import SimSetup
 
 
@@ -43,8 +43,12 @@ def _stack(arrays, field):
     return np.ascontiguousarray(np.stack(arrays))
 
 
-def simulate_batch(setups: list[SimSetup], record_every: int | None = None) -> BatchResult:
-    """Run every setup with the compiled engine, in parallel over the available cores."""
+def simulate_batch(setups: list[SimSetup], record_every: int | None = None, lanes: int = LANES) -> BatchResult:
+    """Run every setup with the compiled engine, in parallel over the available cores.
+
+    ``lanes`` runs are advanced together by each thread (see :func:`steerlab.sim.kernels.lane_loop`);
+    the numbers do not depend on it.
+    """
     if not setups:
         raise InputError("setups", "a batch needs at least one run")
     s0 = setups[0]
@@ -81,7 +85,9 @@ def simulate_batch(setups: list[SimSetup], record_every: int | None = None) -> B
     out_cmd = np.empty((n, n_rec))
     out_ref = np.empty((n, n_rec, 2))
     acc = np.zeros((n, N_ACC))
-    run_batch = batch_loop(s0.ship.rhs, s0.controller.update, nx)
+    if not 1 <= int(lanes) <= 64:
+        raise InputError("lanes", f"must be in [1, 64], got {lanes}")
+    run_batch = batch_loop(s0.ship.rhs, s0.controller.update, nx, int(lanes))
     run_batch(X, Z, PS, PG, PC, GD, W, w_index, s0.dt, s0.nc, N, rec, out_x, out_cmd, out_ref, acc)
     time = np.arange(n_rec) * rec * s0.dt
     return BatchResult(acc, X, time, out_x, out_cmd, out_ref, s0.state_names)

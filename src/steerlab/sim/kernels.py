@@ -126,7 +126,7 @@ def _plant_kernels(ship_rhs, nx: int = 0):
         """Advance ``x`` in place by one RK4 step; ``work`` is a (5, nx) scratch array."""
         rk4(t, x, delta_cmd, w, ps, pg, dt, work[0], work[1], work[2], work[3], work[4])
 
-    return rk4, rk4_step
+    return rk4, rk4_step, plant_rhs, clamp
 
 
 def plant_step(ship_rhs):
@@ -230,20 +230,150 @@ def closed_loop(ship_rhs, ctrl_update, nx: int | None = None):
     return run
 
 
+LANES = 4
+"""Runs advanced together, stage by stage, by one thread of the batch engine."""
+
+
 @lru_cache(maxsize=None)
-def batch_loop(ship_rhs, ctrl_update, nx: int | None = None):
-    """Parallel batch over scenarios (numba ``prange``) around :func:`closed_loop`.
+def lane_loop(ship_rhs, ctrl_update, nx: int, lanes: int = LANES):
+    """Compiled loop advancing a group of up to ``lanes`` independent runs in lock step.
+
+    Same kernels and the same operations, in the same order, per run as :func:`closed_loop`
+    (so each run's numbers are bit-identical to its single run); only the schedule differs:
+    each RK4 stage is evaluated for every run of the group before the next stage. The runs
+    are independent, so the processor overlaps one run's dependency chain (the stages of
+    RK4 are sequential; a single run is latency-bound) with the others'.
+
+    ``group(X, Z, PS, PG, PC, GD, W, w_index, i0, n_act, ...)`` advances runs
+    ``i0 .. i0 + n_act - 1`` of the batch arrays in place.
+    """
+    NX = int(nx)
+    G = int(lanes)
+    _, _, plant_rhs, clamp = _plant_kernels(ship_rhs, NX)
+    update = _fused(ctrl_update)
+    reference = _fused(course_reference)
+    acc_step = _fused(accumulate)
+    wrap = _fused(wrap_to_pi)
+    RB = REF_BLOCK
+
+    @_jit_fused
+    def group(X, Z, PS, PG, PC, GD, W, w_index, i0, n_act, dt, nc, n_steps, rec_every,
+              out_x, out_cmd, out_ref, ACC, K1, K2, K3, K4, XT, REF, RBUF, CMD, E, DPREV):
+        h = nc * dt
+        h2 = 0.5 * dt
+        s6 = dt / 6.0
+        j = 0
+        kc = 0
+        kr = 0
+        nb = 0
+        ib = 0
+        for g in range(n_act):
+            CMD[g] = 0.0
+        for k in range(n_steps + 1):
+            t = k * dt
+            sample = kc == 0
+            if sample and ib == nb:
+                for g in range(n_act):
+                    kk = k
+                    m = 0
+                    while m < RB and kk <= n_steps:
+                        reference(kk * dt, GD[i0 + g], RBUF[g, m])
+                        m += 1
+                        kk += nc
+                    nb = m
+                ib = 0
+            for g in range(n_act):
+                i = i0 + g
+                if sample:
+                    REF[g, 0] = RBUF[g, ib, 0]
+                    REF[g, 1] = RBUF[g, ib, 1]
+                E[g] = wrap(REF[g, 0] - X[i, 2])
+                if sample:
+                    CMD[g] = update(Z[i], PC[i], t, X[i], REF[g], h)
+            if sample:
+                ib += 1
+            kc += 1
+            if kc == nc:
+                kc = 0
+            if kr == 0:
+                for g in range(n_act):
+                    i = i0 + g
+                    for q in range(NX):
+                        out_x[i, j, q] = X[i, q]
+                    out_cmd[i, j] = CMD[g]
+                    out_ref[i, j, 0] = REF[g, 0]
+                    out_ref[i, j, 1] = REF[g, 1]
+                j += 1
+            kr += 1
+            if kr == rec_every:
+                kr = 0
+            if k == n_steps:
+                break
+            # RK4, stage by stage over the group (see rk4 in _plant_kernels: same operations)
+            t2 = t + h2
+            for g in range(n_act):
+                i = i0 + g
+                DPREV[g] = X[i, NX - 1]
+                plant_rhs(t, X[i], CMD[g], W[w_index[i], k], PS[i], PG[i], K1[g])
+            for g in range(n_act):
+                i = i0 + g
+                for q in range(NX):
+                    XT[g, q] = X[i, q] + h2 * K1[g, q]
+                plant_rhs(t2, XT[g], CMD[g], W[w_index[i], k], PS[i], PG[i], K2[g])
+            for g in range(n_act):
+                i = i0 + g
+                for q in range(NX):
+                    XT[g, q] = X[i, q] + h2 * K2[g, q]
+                plant_rhs(t2, XT[g], CMD[g], W[w_index[i], k], PS[i], PG[i], K3[g])
+            for g in range(n_act):
+                i = i0 + g
+                for q in range(NX):
+                    XT[g, q] = X[i, q] + dt * K3[g, q]
+                plant_rhs(t + dt, XT[g], CMD[g], W[w_index[i], k], PS[i], PG[i], K4[g])
+            for g in range(n_act):
+                i = i0 + g
+                for q in range(NX):
+                    X[i, q] += s6 * (K1[g, q] + 2.0 * K2[g, q] + 2.0 * K3[g, q] + K4[g, q])
+                X[i, NX - 1] = clamp(X[i, NX - 1], PG[i])
+                acc_step(ACC[i], t, E[g], DPREV[g], X[i, NX - 1], dt)
+
+    return group
+
+
+@lru_cache(maxsize=None)
+def batch_loop(ship_rhs, ctrl_update, nx: int, lanes: int = LANES):
+    """Parallel batch over scenarios: groups of ``lanes`` runs (:func:`lane_loop`) spread over
+    the cores with numba ``prange``.
 
     Per-run 2-D inputs have a leading run axis; ``w`` is a stack of disturbance sequences
     shared by index ``w_index[i]`` (so 1000 runs in the same sea store it once).
     """
-    run = closed_loop(ship_rhs, ctrl_update, nx)
+    group = lane_loop(ship_rhs, ctrl_update, int(nx), int(lanes))
+    G = int(lanes)
+    NX = int(nx)
+    RB = REF_BLOCK
 
     @numba.njit(parallel=True)
     def run_batch(X, Z, PS, PG, PC, GD, W, w_index, dt, nc, n_steps, rec_every,
                   out_x, out_cmd, out_ref, ACC):
-        for i in numba.prange(X.shape[0]):
-            run(X[i], Z[i], PS[i], PG[i], PC[i], GD[i], W[w_index[i]], dt, nc, n_steps,
-                rec_every, out_x[i], out_cmd[i], out_ref[i], ACC[i])
+        n = X.shape[0]
+        if X.shape[1] != NX:
+            raise ValueError("plant state size differs from the one this loop was built for")
+        n_groups = (n + G - 1) // G
+        for gi in numba.prange(n_groups):
+            i0 = gi * G
+            n_act = min(G, n - i0)
+            K1 = np.empty((G, NX))
+            K2 = np.empty((G, NX))
+            K3 = np.empty((G, NX))
+            K4 = np.empty((G, NX))
+            XT = np.empty((G, NX))
+            REF = np.zeros((G, 2))
+            RBUF = np.empty((G, RB, 2))
+            CMD = np.empty(G)
+            E = np.empty(G)
+            DPREV = np.empty(G)
+            group(X, Z, PS, PG, PC, GD, W, w_index, i0, n_act, dt, nc, n_steps, rec_every,
+                  out_x, out_cmd, out_ref, ACC, K1, K2, K3, K4, XT, REF, RBUF, CMD, E, DPREV)
 
     return run_batch

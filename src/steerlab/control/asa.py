@@ -1,0 +1,331 @@
+r"""ASA: the adaptive autopilot of van Amerongen (1982), chapter 4 (Sec. 4.6).
+
+One kernel, :func:`asa_update`, runs every part of ASA each sample, in the order of the
+thesis' flow diagram (Fig. 5.7: FILTER, CTLSET, DELLIM, PAREST):
+
+1. **Noise-adaptive state estimator** (Fig. 4.13-4.14, eqs 4.66-4.76;
+   :mod:`steerlab.control.wave_filter`): heading and yaw-rate estimates ``psi^``, ``r^`` from
+   the measured heading and the actual rudder through the identified Nomoto model, and the
+   noise level ``xi`` (1 = no noise). The control laws use ``psi^``, ``r^``
+   (``use_estimator = false`` uses the raw measurements, for comparison).
+2. **Mode logic** (:mod:`steerlab.control.asa_modes`): course changing for orders of more
+   than 5 deg, back to course keeping about ten time constants after the new heading is
+   reached.
+3. **Course changing** (Sec. 4.6.1): series reference model with the user's rate of turn and
+   a rudder limiter (:mod:`steerlab.control.asa_reference`); control law (4.81)
+   ``delta = Kp (psi_r' - psi^) - Kd r^ + Ki`` with Kp, Kd, Ki adapted by the MRAS laws
+   (4.78)-(4.80) = (4.43)-(4.45) (:func:`steerlab.control.asa_mras.mras_gain_step`) from
+   ``Kp0 = 2.5 U0/U``, ``Kd0`` (zeta = 1), ``Ki0`` = mean Ki of the preceding course keeping.
+   Adaptive gains of the decreasing type, scaled with the noise level (4.86)-(4.87)
+   *[reconstructed]*: ``alpha = alpha0 xi / (1 + Td/T_decay)``, ``Td`` the time since the
+   start of the change. Rudder limit (4.85) ``min(u_max, f_delta r_max L/U)``. Adaptation
+   stops while the order is limited (4.4.2 Note 2: Landau 1979).
+4. **Course keeping** (Sec. 4.6.2, :mod:`steerlab.control.asa_schedule`): one user setting
+   ``mu`` (1 economy ... 5 accuracy), ``Kp = mu/2`` at cruising speed (4.88), scheduled
+   with speed and noise level (4.90)-(4.91); Kd LQ-optimal (3.6) or constant damping (4.2)
+   from the identified K*, tau*; integral action (4.104) *[reconstructed]*
+   ``dKi/dt = Kp e / (n_Ti tau)`` (clamping anti-windup), ``e = wrap_to_pi(psi_set - psi^)``.
+5. **Parameter estimation** (Fig. 4.12, eqs 4.93-4.99; :func:`~steerlab.control.asa_mras.
+   mras_identify_step`): MRAS identification of K*, tau* (non-dimensional, bounded) with a
+   parallel adjustable model driven by the actual rudder and compared with the measured yaw
+   rate; decreasing, noise-scaled gains.
+
+Speed enters as ``U = x[3]`` (surge speed, m/s) for the gain scheduling and the
+non-dimensional model; below ``freeze_speed`` every adaptation (direct and identification)
+is frozen and the scheduling uses ``U = freeze_speed`` (no division by a vanishing speed).
+
+Sign: the thesis takes the rudder angle positive anti-clockwise "to obtain a positive gain";
+steerlab's rudder > 0 turns to starboard with K > 0, so all laws are written with K > 0 and
+need no sign change. Where the thesis' equations are lost in the text extraction, the
+modules say *[reconstructed]* and give the derivation.
+
+State ``z``: :mod:`steerlab.control.asa_layout` (``N_STATE`` floats); params ``p``: the
+same module (``N_PARAMS`` floats). The kernel allocates nothing.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Literal, NamedTuple, Optional
+
+import numba
+import numpy as np
+from pydantic import Field
+
+from steerlab.angles import wrap_to_pi
+from steerlab.config_base import FrozenConfig
+from steerlab.control.asa_layout import (N_PARAMS, N_STATE, P_ALPHA, P_ALPHA_ID, P_BETA, P_BETA_ID,
+                                         P_F_DELTA, P_GAMMA, P_KD_RULE, P_KP_LOW, P_KS_MAX, P_KS_MIN,
+                                         P_L, P_MU, P_N_TI, P_R_MAX, P_RHO_ACC, P_SIGMA2, P_T_DECAY,
+                                         P_T_DECAY_ID, P_T_POW_ID, P_TS_MAX, P_TS_MIN, P_U0, P_U_FREEZE,
+                                         P_U_MAX, P_USE_EST, P_ZETA_CC, P_ZETA_CK, Z_A, Z_B, Z_DELTA_LIM,
+                                         Z_KD, Z_KI, Z_KI_MEAN, Z_KP, Z_MODE, Z_OMEGA, Z_PD, Z_PR,
+                                         Z_PSI_M, Z_PSI_SET, Z_R_M, Z_RM_ID, Z_SAT, Z_T_REACHED,
+                                         Z_T_START)
+from steerlab.control.asa_modes import MODE_CHANGING, asa_mode_step
+from steerlab.control.asa_mras import mras_gain_step, mras_identify_step
+from steerlab.control.asa_reference import lyapunov_p12_p22, reference_model_step
+from steerlab.control.asa_schedule import kd_damping, kd_lq, keeping_kp
+from steerlab.control.registry import ControllerSpec
+from steerlab.control.wave_filter import (F_DELTA, F_PSI, F_R, F_XI, WaveFilterConfig, WaveFilterParams,
+                                          wave_filter_init, wave_filter_step)
+from steerlab.errors import InputError, require_finite_range
+from steerlab.units import knots_to_ms, rad
+
+
+class ASA(NamedTuple):
+    """ASA settings in SI (see :class:`ASAConfig` for meanings and ranges)."""
+
+    L: float                   #: ship length [m]
+    U0: float                  #: cruising speed [m/s]
+    K_star0: float             #: initial K* [-]
+    tau_star0: float           #: initial tau* [-]
+    r_max: float = rad(0.5)    #: user rate-of-turn setting [rad/s]
+    mu: float = 3.0            #: accuracy setting [-], 1 economy ... 5 accuracy
+    u_max: float = rad(35.0)   #: output limit [rad]
+    U_freeze: float = 0.0      #: adaptation frozen below this speed [m/s] (0: 0.2 U0)
+    kp_change: float = 2.5
+    kp_low: float = 0.5
+    zeta_change: float = 1.0
+    kd_rule: str = "lq"
+    zeta_keep: float = 0.8
+    alpha: float = 2.0
+    beta: float = 2.0
+    gamma: float = 0.2
+    alpha_id: float = 0.5
+    beta_id: float = 0.5
+    T_decay: float = 300.0
+    T_decay_id: float = 3600.0
+    threshold: float = rad(5.0)
+    n_hold: float = 10.0
+    K_star_bounds: tuple = (0.2, 5.0)
+    tau_star_bounds: tuple = (0.2, 10.0)
+    n_ti: float = 4.0
+    rho_acc: float = 0.5
+    f_delta: float = 4.0
+    use_estimator: bool = True
+    sigma2: float = 1e-6
+    T_pow_id: float = 300.0
+    wave_filter: WaveFilterParams = WaveFilterParams()
+
+    def pack(self) -> np.ndarray:
+        f = "controller"
+        require_finite_range(f"{f}.L", self.L, 0.0, 2000.0, lo_open=True)
+        require_finite_range(f"{f}.cruise_speed", self.U0, 0.0, 50.0, lo_open=True)
+        require_finite_range(f"{f}.rate_of_turn", self.r_max, 0.0, rad(10.0), lo_open=True)
+        require_finite_range(f"{f}.mu", self.mu, 1.0, 5.0)
+        require_finite_range(f"{f}.u_max", self.u_max, 0.0, math.pi / 2, lo_open=True)
+        uf = self.U_freeze if self.U_freeze > 0.0 else 0.2 * self.U0
+        require_finite_range(f"{f}.freeze_speed", uf, 0.0, self.U0, lo_open=True)
+        ks_lo, ks_hi = self.K_star_bounds
+        ts_lo, ts_hi = self.tau_star_bounds
+        require_finite_range(f"{f}.K_star_min", ks_lo, 0.0, 100.0, lo_open=True)
+        require_finite_range(f"{f}.K_star_max", ks_hi, ks_lo, 100.0)
+        require_finite_range(f"{f}.tau_star_min", ts_lo, 0.0, 100.0, lo_open=True)
+        require_finite_range(f"{f}.tau_star_max", ts_hi, ts_lo, 100.0)
+        require_finite_range(f"{f}.K_star0", self.K_star0, ks_lo, ks_hi)
+        if not (self.tau_star0 > 0.0):
+            raise InputError(f"{f}.tau_star0",
+                             f"must be > 0 (got {self.tau_star0!r}): ASA's MRAS identification needs a "
+                             "course-stable ship (thesis 4.3.2); give tau_star0 explicitly for this ship")
+        require_finite_range(f"{f}.tau_star0", self.tau_star0, ts_lo, ts_hi)
+        for name in ("kp_change", "kp_low", "alpha", "beta", "gamma", "alpha_id", "beta_id"):
+            require_finite_range(f"{f}.{name}", getattr(self, name), 0.0, 1e3)
+        require_finite_range(f"{f}.zeta_change", self.zeta_change, 0.0, 10.0, lo_open=True)
+        require_finite_range(f"{f}.zeta_keep", self.zeta_keep, 0.0, 10.0, lo_open=True)
+        if self.kd_rule not in ("lq", "damping"):
+            raise InputError(f"{f}.kd_rule", f"must be 'lq' or 'damping', got {self.kd_rule!r}")
+        for name in ("T_decay", "T_decay_id", "T_pow_id"):
+            require_finite_range(f"{f}.{name}", getattr(self, name), 0.0, 1e7, lo_open=True)
+        require_finite_range(f"{f}.change_threshold", self.threshold, 0.0, math.pi, lo_open=True)
+        require_finite_range(f"{f}.hold_time_constants", self.n_hold, 0.0, 1e3)
+        require_finite_range(f"{f}.integral_time_constants", self.n_ti, 0.0, 1e4, lo_open=True)
+        require_finite_range(f"{f}.accel_margin", self.rho_acc, 0.0, 1.0, lo_open=True)
+        require_finite_range(f"{f}.rudder_limit_factor", self.f_delta, 0.0, 100.0, lo_open=True)
+        require_finite_range(f"{f}.sigma2", self.sigma2, 0.0, 1.0, lo_open=True)
+        wf = self.wave_filter.pack(f"{f}.wave_filter")
+        rest = [self.L, self.U0, uf, self.mu, self.r_max, self.u_max, self.zeta_change, self.kp_change,
+                self.kp_low, 0.0 if self.kd_rule == "lq" else 1.0, self.zeta_keep, self.alpha, self.beta,
+                self.gamma, self.alpha_id, self.beta_id, self.T_decay, self.T_decay_id, self.threshold,
+                self.n_hold, ks_lo, ks_hi, ts_lo, ts_hi, self.n_ti, self.rho_acc, self.f_delta,
+                1.0 if self.use_estimator else 0.0, self.sigma2, self.T_pow_id]
+        p = np.concatenate([wf, np.array(rest, dtype=np.float64)])
+        assert p.shape[0] == N_PARAMS
+        return p
+
+    def init_state(self, x0, ref0) -> np.ndarray:
+        """Course keeping at the initial order; filter at the measured state; K*, tau* initial."""
+        z = np.zeros(N_STATE)
+        delta0 = float(x0[len(x0) - 1])
+        wave_filter_init(z, float(x0[2]), float(x0[5]), delta0)
+        z[Z_MODE] = 0.0
+        z[Z_PSI_SET] = float(ref0[0])
+        z[Z_PSI_M] = float(x0[2])
+        z[Z_R_M] = float(x0[5])
+        z[Z_T_START] = 0.0
+        z[Z_T_REACHED] = -1.0
+        z[Z_A] = 1.0 / self.tau_star0
+        z[Z_B] = self.K_star0 / self.tau_star0
+        U = float(x0[3]) if float(x0[3]) > 0.0 else self.U0
+        z[Z_RM_ID] = float(x0[5]) * self.L / U
+        z[Z_DELTA_LIM] = self.u_max
+        return z
+
+
+@numba.njit(cache=True)
+def asa_update(z, p, t, x, ref, h):
+    """One ASA sample: returns the rudder order [rad]; updates ``z`` in place (see module doc)."""
+    nx = x.shape[0]
+    delta_act = x[nx - 1]
+    psi = x[2]
+    r = x[5]
+    u_freeze = p[P_U_FREEZE]
+    U = x[3]
+    frozen = U < u_freeze
+    Us = max(U, u_freeze)
+    LU = p[P_L] / Us
+    U0U = p[P_U0] / Us
+    taus = 1.0 / z[Z_A]
+    Ks = z[Z_B] * taus
+    tau = taus * LU
+    K = Ks / LU
+    delta_prev = z[F_DELTA]
+    # 1. FILTER: noise-adaptive state estimator (model II)
+    wave_filter_step(z, p, K, tau, psi, delta_act, h)
+    xi = z[F_XI]
+    if p[P_USE_EST] > 0.5:
+        psi_h = z[F_PSI]
+        r_h = z[F_R]
+    else:
+        psi_h = psi
+        r_h = r
+    # 2. mode logic
+    asa_mode_step(z, p, t, ref[0], psi_h, r_h, Ks, taus, LU, U0U)
+    adapt = (not frozen) and z[Z_SAT] < 0.5
+    u_max = p[P_U_MAX]
+    if z[Z_MODE] == MODE_CHANGING:
+        # 3. CTLSET (course changing): series model, MRAS on Kp, Kd, Ki, law (4.81)
+        r_max = p[P_R_MAX]
+        lim = min(u_max, p[P_F_DELTA] * r_max * LU)
+        omega = z[Z_OMEGA]
+        zeta = p[P_ZETA_CC]
+        rdot_max = p[P_RHO_ACC] * (K / tau) * lim
+        psi_m0 = z[Z_PSI_M]
+        r_m0 = z[Z_R_M]
+        psi_rp = reference_model_step(z, Z_PSI_M, Z_R_M, z[Z_PSI_SET], omega, zeta, r_max, rdot_max, h)
+        if adapt:
+            p12, p22 = lyapunov_p12_p22(omega * LU, zeta)
+            f = xi / (1.0 + (t - z[Z_T_START]) / p[P_T_DECAY])
+            mras_gain_step(z, Z_KP, Z_KD, Z_KI, psi_m0, r_m0, psi_rp, psi_h, r_h, p12, p22,
+                           p[P_ALPHA] * f, p[P_BETA] * f, p[P_GAMMA] * f, LU, h)
+        z[Z_KI] = min(max(z[Z_KI], -lim), lim)
+        ud = z[Z_KP] * wrap_to_pi(psi_rp - psi_h) - z[Z_KD] * r_h + z[Z_KI]
+    else:
+        # 4. CTLSET (course keeping): scheduled gains, integral action (4.104)
+        lim = u_max
+        kp = keeping_kp(p[P_MU], p[P_KP_LOW], U0U, xi)
+        if p[P_KD_RULE] < 0.5:
+            kd = kd_lq(Ks, taus, kp, LU)
+        else:
+            kd = kd_damping(Ks, taus, kp, p[P_ZETA_CK], LU)
+        z[Z_KP] = kp
+        z[Z_KD] = kd
+        z[Z_PSI_M] = psi_h
+        z[Z_R_M] = r_h
+        e = wrap_to_pi(z[Z_PSI_SET] - psi_h)
+        ud = kp * e - kd * r_h + z[Z_KI]
+        if not frozen and (abs(ud) <= lim or e * ud < 0.0):
+            z[Z_KI] = z[Z_KI] + h * kp * e / (p[P_N_TI] * tau)
+        z[Z_KI] = min(max(z[Z_KI], -lim), lim)
+        z[Z_KI_MEAN] = z[Z_KI_MEAN] + min(h / tau, 1.0) * (z[Z_KI] - z[Z_KI_MEAN])
+    # 5. DELLIM: rudder limit
+    u = min(max(ud, -lim), lim)
+    z[Z_SAT] = 1.0 if u != ud else 0.0
+    z[Z_DELTA_LIM] = lim
+    # 6. PAREST: identification of K*, tau* (model I), decreasing noise-scaled gains
+    if frozen:
+        aid = 0.0
+        bid = 0.0
+    else:
+        g = xi / (1.0 + (t - z[Z_T_START]) / p[P_T_DECAY_ID])
+        aid = p[P_ALPHA_ID] * g
+        bid = p[P_BETA_ID] * g
+    mras_identify_step(z, Z_A, Z_B, Z_RM_ID, Z_PD, Z_PR, r, delta_prev, delta_act, aid, bid, LU, h,
+                       p[P_T_POW_ID], p[P_SIGMA2], p[P_KS_MIN], p[P_KS_MAX], p[P_TS_MIN], p[P_TS_MAX])
+    return u
+
+
+class ASAConfig(FrozenConfig):
+    """``[controller] type = "asa"`` (degrees, knots at this edge)."""
+
+    type: Literal["asa"]
+    rate_of_turn_deg_s: float = Field(0.5, gt=0.0, le=10.0,
+                                      description="user setting: rate of turn in course changes [deg/s]")
+    mu: float = Field(3.0, ge=1.0, le=5.0, description="user setting: 1 = economy ... 5 = accuracy")
+    cruise_speed_kn: Optional[float] = Field(None, gt=0.0, le=40.0, description="U0; default: the ship's speed")
+    freeze_speed_kn: Optional[float] = Field(None, gt=0.0, le=40.0,
+                                             description="adaptation frozen below; default 0.2 U0")
+    L: Optional[float] = Field(None, gt=0.0, le=2000.0, description="ship length [m]; default: the ship's")
+    K_star0: Optional[float] = Field(None, gt=0.0, le=100.0, description="initial K* = K L/U; default: ship's Nomoto")
+    tau_star0: Optional[float] = Field(None, gt=0.0, le=100.0, description="initial tau* = tau U/L")
+    K_star_min: float = Field(0.2, gt=0.0, le=100.0)
+    K_star_max: float = Field(5.0, gt=0.0, le=100.0)
+    tau_star_min: float = Field(0.2, gt=0.0, le=100.0)
+    tau_star_max: float = Field(10.0, gt=0.0, le=100.0)
+    kp_change: float = Field(2.5, gt=0.0, le=100.0, description="Kp at cruising speed in course changes (4.82)")
+    kp_low: float = Field(0.5, ge=0.0, le=100.0, description="lowest course-keeping Kp at cruising speed (3.12)")
+    zeta_change: float = Field(1.0, gt=0.0, le=10.0, description="reference-model damping")
+    kd_rule: Literal["lq", "damping"] = "lq"
+    zeta_keep: float = Field(0.8, gt=0.0, le=10.0, description="damping for kd_rule='damping'")
+    alpha: float = Field(2.0, ge=0.0, le=1e3, description="adaptive gain of Kp [-]")
+    beta: float = Field(2.0, ge=0.0, le=1e3, description="adaptive gain of Kd [-]")
+    gamma: float = Field(0.2, ge=0.0, le=1e3, description="adaptive gain of Ki [-]")
+    alpha_id: float = Field(0.5, ge=0.0, le=1e3, description="identification gain of 1/tau* [-]")
+    beta_id: float = Field(0.5, ge=0.0, le=1e3, description="identification gain of K*/tau* [-]")
+    adapt_decay_s: float = Field(300.0, gt=0.0, le=1e7, description="T_decay of the direct gains [s]")
+    identify_decay_s: float = Field(3600.0, gt=0.0, le=1e7, description="T_decay of identification [s]")
+    change_threshold_deg: float = Field(5.0, gt=0.0, le=180.0)
+    hold_time_constants: float = Field(10.0, ge=0.0, le=1000.0)
+    integral_time_constants: float = Field(4.0, gt=0.0, le=1e4)
+    rudder_limit_factor: float = Field(4.0, gt=0.0, le=100.0, description="f_delta of (4.85)")
+    accel_margin: float = Field(0.5, gt=0.0, le=1.0, description="rho of the model's rudder limiter")
+    use_estimator: bool = True
+    wave_filter: WaveFilterConfig = WaveFilterConfig()
+    u_max_deg: Optional[float] = Field(None, gt=0.0, le=90.0, description="default: gear limit")
+    sample_time: Optional[float] = Field(None, gt=0.0, le=60.0, description="default: dt")
+
+
+def ship_length(ctx) -> float:
+    """The ship's length [m]: its ``[ship.options]`` ``L`` if it has one, else ``dims[1]``."""
+    L = getattr(ctx.ship_options, "L", None)
+    return float(L) if L is not None else float(ctx.ship.dims[1])
+
+
+def build(cfg: ASAConfig, ctx):
+    """ASA from its settings; K*, tau* initialised from the ship's Nomoto model at the speed."""
+    L = cfg.L if cfg.L is not None else ship_length(ctx)
+    U0 = knots_to_ms(cfg.cruise_speed_kn) if cfg.cruise_speed_kn is not None else ctx.speed
+    if cfg.K_star0 is None or cfg.tau_star0 is None:
+        K, T = ctx.nomoto()
+        ks0 = K * L / ctx.speed
+        ts0 = T * ctx.speed / L
+    ks0 = cfg.K_star0 if cfg.K_star0 is not None else ks0
+    ts0 = cfg.tau_star0 if cfg.tau_star0 is not None else ts0
+    uf = knots_to_ms(cfg.freeze_speed_kn) if cfg.freeze_speed_kn is not None else 0.2 * U0
+    c = ASA(L=L, U0=U0, K_star0=ks0, tau_star0=ts0, r_max=rad(cfg.rate_of_turn_deg_s), mu=cfg.mu,
+            u_max=ctx.u_max(cfg.u_max_deg), U_freeze=uf, kp_change=cfg.kp_change, kp_low=cfg.kp_low,
+            zeta_change=cfg.zeta_change, kd_rule=cfg.kd_rule, zeta_keep=cfg.zeta_keep,
+            alpha=cfg.alpha, beta=cfg.beta, gamma=cfg.gamma, alpha_id=cfg.alpha_id, beta_id=cfg.beta_id,
+            T_decay=cfg.adapt_decay_s, T_decay_id=cfg.identify_decay_s,
+            threshold=rad(cfg.change_threshold_deg), n_hold=cfg.hold_time_constants,
+            K_star_bounds=(cfg.K_star_min, cfg.K_star_max), tau_star_bounds=(cfg.tau_star_min, cfg.tau_star_max),
+            n_ti=cfg.integral_time_constants, rho_acc=cfg.accel_margin, f_delta=cfg.rudder_limit_factor,
+            use_estimator=cfg.use_estimator, wave_filter=cfg.wave_filter.params())
+    return c, c.pack()
+
+
+CONTROLLER = ControllerSpec(
+    name="asa",
+    description="adaptive autopilot ASA: MRAS course changing + identification, noise-adaptive filter",
+    update=asa_update, n_state=N_STATE, config=ASAConfig, build=build,
+    source="van Amerongen (1982) Adaptive steering of ships, ch. 4 (Sec. 4.6), eqs 4.43-4.45, 4.66-4.105")

@@ -1,0 +1,79 @@
+r"""Gain-shaping PID from a second-order model (Los/ADRC berthing paper, Sec. 3.1).
+
+Source: "automatic berthing" paper (LOS guidance + ADRC, 2019), Sec. 3.1, eqs (17)-(19).
+For a second-order plant (17) ``G(s) = (b1 s + b0)/(a2 s^2 + a1 s + a0)`` the first-order
+closed-loop gain shaping rule (18) chooses ``K_C = (a2 s^2 + a1 s + a0)/(b0 T01 s)`` so that
+the open loop is ``1/(T01 s)`` and the closed loop ``1/(T01 s + 1)``. That is a PID (19)::
+
+    kp = a1/(b0 T01),   ki = a0/(b0 T01),   kd = a2/(b0 T01)
+
+``T01`` [s] is the designed closed-loop time constant (bandwidth ``1/T01``); ``b1`` is
+neglected by the rule.
+
+steerlab's second-order model is the ship's first-order Nomoto model as a heading model,
+``psi/delta = K/(s (T s + 1)) = K/(T s^2 + s)``: ``a2 = T``, ``a1 = 1``, ``a0 = 0``,
+``b0 = K``, so::
+
+    kp = 1/(K T01) [rad/rad],   ki = 0,   kd = T/(K T01) [s]
+
+The rule gives **no integral action** for a heading model (``a0 = 0``): a constant
+disturbance ``d`` (equivalent rudder) leaves the steady error ``-d/kp = -d K T01``. The
+controller zero cancels the ship pole ``-1/T``, which stays a pole of the disturbance
+response: the closed-loop characteristic polynomial is ``(T s + 1)(T01 s + 1)/T01``, so
+``T > 0`` (a course-stable design model) is required.
+
+The law runs on the PID kernel :func:`steerlab.control.pid.pid_update`: the derivative acts
+on ``r_ref - r`` (the error's derivative without the impulse of a set-point step; with a
+rate-limited reference it is the error's derivative exactly), output limited to ``u_max``.
+``K``, ``T`` come from the ship's Nomoto model at the design speed unless given.
+"""
+
+from __future__ import annotations
+
+from typing import Literal, Optional
+
+from pydantic import Field
+
+from steerlab.config_base import FrozenConfig
+from steerlab.control.design_model import nomoto_design_model
+from steerlab.control.pid import N_STATE, PID, pid_update
+from steerlab.control.registry import ControllerSpec
+from steerlab.errors import require_finite_range
+
+
+def gain_shaping_gains(T01: float, a2: float, a1: float, a0: float, b0: float) -> tuple[float, float, float]:
+    """``(kp, ki, kd)`` of eq (19) for the second-order model (17) and time constant ``T01`` [s]."""
+    require_finite_range("controller.T01", T01, 0.0, lo_open=True)
+    require_finite_range("controller.K", b0, 0.0, lo_open=True)
+    d = b0 * T01
+    return a1 / d, a0 / d, a2 / d
+
+
+def nomoto_gain_shaping_gains(T01: float, K: float, T: float) -> tuple[float, float, float]:
+    """Eq (19) for the Nomoto heading model ``K/(T s^2 + s)``: ``(1/(K T01), 0, T/(K T01))``."""
+    require_finite_range("controller.T", T, 0.0, lo_open=True)
+    return gain_shaping_gains(T01, T, 1.0, 0.0, K)
+
+
+class GainShapingPIDConfig(FrozenConfig):
+    """``[controller] type = "gain_shaping_pid"``."""
+
+    type: Literal["gain_shaping_pid"]
+    T01: float = Field(20.0, gt=0.0, le=1e5, description="closed-loop time constant of (18) [s]")
+    K: Optional[float] = Field(None, gt=0.0, le=100.0, description="design K [1/s]; default: ship's Nomoto K")
+    T: Optional[float] = Field(None, gt=0.0, le=1e5, description="design T [s]; default: ship's Nomoto T")
+    u_max_deg: Optional[float] = Field(None, gt=0.0, le=90.0, description="default: gear limit")
+    sample_time: Optional[float] = Field(None, gt=0.0, le=60.0, description="default: dt")
+
+
+def build(cfg: GainShapingPIDConfig, ctx):
+    K, T = nomoto_design_model(cfg.K, cfg.T, ctx)
+    kp, ki, kd = nomoto_gain_shaping_gains(cfg.T01, K, T)
+    c = PID(Kp=kp, Ki=ki, Kd=kd, u_max=ctx.u_max(cfg.u_max_deg))
+    return c, c.pack()
+
+
+CONTROLLER = ControllerSpec(
+    name="gain_shaping_pid", description="PID by first-order closed-loop gain shaping (berthing paper eq 17-19)",
+    update=pid_update, n_state=N_STATE, config=GainShapingPIDConfig, build=build,
+    source="LOS/ADRC automatic berthing paper (2019), Sec. 3.1, eqs (17)-(19)")

@@ -1,0 +1,221 @@
+r"""ITAE-robust PID with set-point pre-filter and speed scheduling (Morawski & Pomirski).
+
+Source: L. Morawski, J. Pomirski, "Design of the robust PID course-keeping control system for
+ships", Gdynia Maritime University, eqs (1)-(11) and Fig. 9.
+
+Design model: first-order Nomoto ``T r' + r = k delta`` (1), i.e. ``psi/delta = k/(s(Ts+1))``
+(same rudder sign as steerlab: ``delta > 0`` turns to starboard). Controller (3) on the
+pre-filtered error ``eps = psi_p - psi``::
+
+    G_C(s) = H1 + H2/s + H3 s
+
+With (1) the closed loop (9) has the denominator
+``s^3 + s^2 (1 + k H3)/T + s k H1/T + k H2/T``. Matching it to the ITAE-optimal third-order
+polynomial with ``omega_0 = 5 / t_r`` (8) (``t_r`` = 2 % settling time [s])::
+
+    M(s) = s^3 + 1.75 w0 s^2 + c2 w0^2 s + w0^3                                  (6)
+
+    H1 = c2 w0^2 T / k,   H2 = w0^3 T / k,   H3 = (1.75 w0 T - 1) / k             (10)
+
+    G_p(s) = H2 / (H3 s^2 + H1 s + H2)                                           (11)
+
+so that the whole loop is ``psi/psi_d = w0^3 / M(s)`` without zeros (5).
+
+**The printed paper is inconsistent about c2**, and steerlab keeps both readings:
+
+* eq (6) prints ``c2 = 1`` (``polynomial = "eq6"``);
+* eqs (10) and (11) print ``H1 = 53.75 T/(t_r^2 k)`` and the pre-filter's ``53.75 T t_r s``,
+  i.e. ``c2 = 53.75/25 = 2.15`` -- the ITAE-optimal coefficient of Dorf & Bishop's table,
+  the paper's reference [1] (``polynomial = "dorf"``, the default: it is the design the
+  paper's formulas, and so presumably its simulations, use). ``H2`` and ``H3`` are the same
+  in both. With ``c2 = 2.15``, eq (10)'s ``H2 = 125 T/(t_r^3 k)`` and
+  ``H3 = (8.75 T/t_r - 1)/k`` follow exactly.
+
+Speed scheduling (2), online: ``k = k_m V/V_m``, ``T = T_m V_m/V`` with ``V`` the present
+surge speed ``x[3]`` (clamped below at ``v_min_fraction * V_m``), ``V_m`` the design speed
+(the scenario's approach speed unless ``design_speed_kn`` is given) and ``k_m``, ``T_m``
+the ship's Nomoto model at ``V_m`` (``ctx.nomoto()``) unless given. So ``H1``, ``H2`` scale
+with ``(V_m/V)^2``, and ``H3`` and the pre-filter change too. ``schedule = false`` keeps the
+design-speed gains.
+
+Implementation (per sample ``h``, radians):
+
+* pre-filter (11) as the controller state ``[psi_p, psi_p']``, a unit-gain second-order lag
+  ``1/(a2 s^2 + a1 s + 1)``, ``a2 = H3/H2``, ``a1 = H1/H2``, advanced by the trapezoidal
+  (Tustin) rule with the set-point held over the sample; it is written relative to its own
+  output so that the set-point enters only through ``wrap_to_pi(psi_d - psi_p)`` (a
+  359 deg -> 1 deg change is a 2 deg turn); its steady state is exactly ``psi_d``;
+* ``delta_c = sat(H1 eps + H2 I + H3 (psi_p' - r))`` with ``eps = wrap_to_pi(psi_p - psi)``
+  -- the derivative of the error uses the pre-filter's own rate, so no set-point kick;
+* ``I <- I + eps h``; the paper has no anti-windup (its Fig. 7 shows the resulting
+  overshoot), so by default neither has steerlab; ``anti_windup = true`` adds the clamping
+  rule of :mod:`steerlab.control.pid`.
+
+The course-rate limiter of Fig. 9 (1.2 deg/s in Fig. 8) sits on the desired course before
+the pre-filter. steerlab's guidance already produces exactly that signal: with
+``[guidance] rate_max_deg_s = 1.2`` the set-point ``psi_d`` ramps at 1.2 deg/s to each new
+course, which is what a rate limiter does to a step of the desired course, so the limiter is
+not duplicated here. The controller ignores ``r_ref`` (the pre-filter makes its own rate).
+
+The design ignores the steering gear's rate limit: a fast ``t_r`` on a slow ship needs a large
+``H3``, and a large turn can then rate-limit the rudder into a growing oscillation (e.g.
+``nomoto1`` K = 0.1, T = 50 s, t_r = 53 s, 2.33 deg/s gear, 30 deg turn; t_r = 100 s is fine).
+
+Requires ``k > 0``, ``T > 0`` and ``t_r < 8.75 T`` (``H3 > 0``; otherwise the pre-filter
+(11) has a negative leading coefficient and is unstable).
+"""
+
+from __future__ import annotations
+
+from typing import Literal, NamedTuple, Optional
+
+import numba
+import numpy as np
+from pydantic import Field
+
+from steerlab.angles import wrap_to_pi
+from steerlab.config_base import FrozenConfig
+from steerlab.control.design_model import nomoto_design_model
+from steerlab.control.registry import ControllerSpec
+from steerlab.errors import InputError, require_finite_range
+from steerlab.units import knots_to_ms, rad
+
+ITAE_C1 = 1.75
+POLYNOMIALS = {"dorf": 2.15, "eq6": 1.0}
+"""``c2`` of M(s) = s^3 + 1.75 w0 s^2 + c2 w0^2 s + w0^3 for each reading of the paper."""
+
+I_WN, I_KM, I_TM, I_VM, I_SCHED, I_VMIN, I_C2, I_UMAX, I_AW = range(9)
+N_PARAMS = 9
+N_STATE = 3  # [pre-filtered set-point psi_p (rad), its rate (rad/s), integral of eps (rad s)]
+
+
+def itae_gains(t_r: float, k: float, T: float, polynomial: str = "dorf") -> tuple[float, float, float]:
+    """PID coefficients ``(H1 [rad/rad], H2 [1/s], H3 [s])`` of eq (10) for ``omega_0 = 5/t_r``.
+
+    ``polynomial``: ``"dorf"`` (``c2 = 2.15``, eq 10-11 as printed) or ``"eq6"`` (``c2 = 1``,
+    eq 6 as printed). Raises :class:`InputError` where the design is not possible.
+    """
+    require_finite_range("controller.t_r", t_r, 0.0, lo_open=True)
+    require_finite_range("controller.K", k, 0.0, lo_open=True)
+    require_finite_range("controller.T", T, 0.0, lo_open=True)
+    if polynomial not in POLYNOMIALS:
+        raise InputError("controller.polynomial", f"must be one of {sorted(POLYNOMIALS)}, got {polynomial!r}")
+    w0 = 5.0 / t_r
+    c2 = POLYNOMIALS[polynomial]
+    h3 = (ITAE_C1 * w0 * T - 1.0) / k
+    if h3 <= 0.0:
+        raise InputError("controller.t_r", f"{t_r!r} s is too slow for T = {T:.4g} s: need t_r < "
+                         f"{ITAE_C1 * 5.0:.2f} T = {ITAE_C1 * 5.0 * T:.4g} s (H3 > 0, stable pre-filter)")
+    return c2 * w0**2 * T / k, w0**3 * T / k, h3
+
+
+def prefilter_coefficients(t_r: float, k: float, T: float, polynomial: str = "dorf") -> tuple[float, float]:
+    """``(a2 [s^2], a1 [s])`` of the pre-filter (11) written as ``1/(a2 s^2 + a1 s + 1)``."""
+    h1, h2, h3 = itae_gains(t_r, k, T, polynomial)
+    return h3 / h2, h1 / h2
+
+
+class ItaePID(NamedTuple):
+    """ITAE PID design data (SI)."""
+
+    t_r: float                      #: 2 % settling time [s]
+    k_m: float                      #: Nomoto gain at the design speed [1/s]
+    T_m: float                      #: Nomoto time constant at the design speed [s]
+    V_m: float                      #: design speed [m/s]
+    schedule: bool = True           #: schedule on the surge speed x[3] (eq 2)
+    v_min_fraction: float = 0.3     #: scheduling speed floor, fraction of V_m
+    polynomial: str = "dorf"        #: "dorf" (c2 = 2.15) or "eq6" (c2 = 1)
+    u_max: float = rad(35.0)        #: output limit [rad]
+    anti_windup: bool = False       #: clamping anti-windup (not in the paper)
+
+    def gains(self, V: float | None = None) -> tuple[float, float, float]:
+        """``(H1, H2, H3)`` at speed ``V`` [m/s] (default: the design speed)."""
+        k, T = self.k_m, self.T_m
+        if V is not None:
+            k, T = k * V / self.V_m, T * self.V_m / V
+        return itae_gains(self.t_r, k, T, self.polynomial)
+
+    def pack(self) -> np.ndarray:
+        self.gains()   # validates t_r, k_m, T_m, polynomial
+        require_finite_range("controller.design_speed", self.V_m, 0.0, lo_open=True)
+        require_finite_range("controller.v_min_fraction", self.v_min_fraction, 0.0, 1.0, lo_open=True)
+        require_finite_range("controller.u_max", self.u_max, 0.0, lo_open=True)
+        if self.schedule:
+            # the slowest scheduled speed has the largest T: the pre-filter must stay stable there
+            self.gains(self.v_min_fraction * self.V_m)
+        return np.array([5.0 / self.t_r, self.k_m, self.T_m, self.V_m, float(self.schedule),
+                         self.v_min_fraction, POLYNOMIALS[self.polynomial], self.u_max,
+                         float(self.anti_windup)], dtype=np.float64)
+
+    def init_state(self, x0, ref0) -> np.ndarray:
+        """Pre-filter at rest on the initial set-point; no integral."""
+        return np.array([ref0[0], 0.0, 0.0])
+
+
+@numba.njit(cache=True)
+def itae_pid_update(z, p, t, x, ref, h):
+    """One ITAE-PID sample (see the module docstring); returns the rudder order [rad]."""
+    w0 = p[I_WN]
+    k = p[I_KM]
+    T = p[I_TM]
+    if p[I_SCHED] != 0.0:                      # eq (2) on the present surge speed
+        vm = p[I_VM]
+        v = max(x[3], p[I_VMIN] * vm)
+        k = k * v / vm
+        T = T * vm / v
+    h1 = p[I_C2] * w0 * w0 * T / k
+    h2 = w0 * w0 * w0 * T / k
+    h3 = (ITAE_C1 * w0 * T - 1.0) / k
+    # PID (3) on the pre-filtered error, derivative from the pre-filter's rate
+    eps = wrap_to_pi(z[0] - x[2])
+    ud = h1 * eps + h2 * z[2] + h3 * (z[1] - x[5])
+    umax = p[I_UMAX]
+    u = min(max(ud, -umax), umax)
+    if p[I_AW] == 0.0 or u == ud or eps * ud < 0.0:
+        z[2] += eps * h
+    # pre-filter (11): a2 y'' + a1 y' + y = psi_d, Tustin step relative to y
+    a2 = h3 / h2
+    a1 = h1 / h2
+    d = wrap_to_pi(ref[0] - z[0])              # input relative to the present output
+    q = 0.5 * h / a2
+    m11 = 1.0 + q * a1
+    det = m11 + 0.5 * h * q
+    rhs0 = 0.5 * h * z[1]
+    rhs1 = (1.0 - q * a1) * z[1] + 2.0 * q * d
+    z[0] = wrap_to_pi(z[0] + (m11 * rhs0 + 0.5 * h * rhs1) / det)
+    z[1] = (rhs1 - q * rhs0) / det
+    return u
+
+
+class ItaePIDConfig(FrozenConfig):
+    """``[controller] type = "itae_pid"`` (degrees and knots only at this edge)."""
+
+    type: Literal["itae_pid"]
+    t_r: float = Field(53.0, gt=0.0, le=1e5, description="2 % settling time [s] (paper: 38, 48, 53 s)")
+    K: Optional[float] = Field(None, gt=0.0, le=100.0, description="design k_m [1/s]; default: ship's Nomoto K")
+    T: Optional[float] = Field(None, gt=0.0, le=1e5, description="design T_m [s]; default: ship's Nomoto T")
+    design_speed_kn: Optional[float] = Field(None, gt=0.0, le=40.0,
+                                             description="V_m of eq (2) [kn]; default: ship.speed_kn")
+    schedule: bool = True
+    v_min_fraction: float = Field(0.3, gt=0.0, le=1.0, description="scheduling speed floor / V_m")
+    polynomial: Literal["dorf", "eq6"] = "dorf"
+    anti_windup: bool = False
+    u_max_deg: Optional[float] = Field(None, gt=0.0, le=90.0, description="default: gear limit")
+    sample_time: Optional[float] = Field(None, gt=0.0, le=60.0, description="default: dt")
+
+
+def build(cfg: ItaePIDConfig, ctx):
+    """k_m, T_m from the ship's Nomoto model at the design speed unless given."""
+    K, T = nomoto_design_model(cfg.K, cfg.T, ctx)
+    Vm = knots_to_ms(cfg.design_speed_kn) if cfg.design_speed_kn is not None else ctx.speed
+    c = ItaePID(t_r=cfg.t_r, k_m=K, T_m=T, V_m=Vm, schedule=cfg.schedule,
+                v_min_fraction=cfg.v_min_fraction, polynomial=cfg.polynomial,
+                u_max=ctx.u_max(cfg.u_max_deg), anti_windup=cfg.anti_windup)
+    return c, c.pack()
+
+
+CONTROLLER = ControllerSpec(
+    name="itae_pid",
+    description="ITAE-robust PID with set-point pre-filter and speed scheduling (Morawski & Pomirski)",
+    update=itae_pid_update, n_state=N_STATE, config=ItaePIDConfig, build=build,
+    source="Morawski & Pomirski, robust PID course-keeping, eqs (2), (6)-(11), Fig. 9")

@@ -1,0 +1,152 @@
+r"""Noise-adaptive, Kalman-type wave filter on heading and yaw rate (van Amerongen 1982, 4.5.2).
+
+Source: van Amerongen (1982) *Adaptive steering of ships*, Sec. 4.5.2 "Note 2" and "Note 3",
+Fig. 4.13 (model II of the parameter and state estimator) and Fig. 4.14 (discrete
+noise-adaptive state estimator), eqs (4.66)-(4.76). The equations did not survive the text
+extraction of the thesis; what follows is reconstructed from the surrounding text and
+standard alpha-beta / steady-state Kalman filtering, and every reconstructed piece is marked
+*[reconstructed]*.
+
+The problem (thesis): the wave-induced yaw is *system* noise (it is really in the heading),
+the measurement noise is negligible, so a textbook Kalman filter does not apply; instead
+the filter weighs a model prediction against the measured heading so that "high-frequency
+disturbances are suppressed and low-frequency estimation errors are kept small", with
+filter gains adjusted from the ratio of the low- and the high-frequency components of the
+prediction error.
+
+Prediction with the first-order Nomoto model ``tau r' + r = K delta`` (eq 2.44, steerlab
+sign: delta > 0 turns to starboard), over one sample ``h`` with the rudder taken as the mean
+of its value at the two ends of the interval (eq 4.74 [reconstructed: exact ZOH
+discretisation])::
+
+    a      = exp(-h / tau)
+    r-     = a r^ + (1 - a) K delta
+    psi-   = psi^ + h r^ + (h - tau (1 - a)) (K delta - r^)
+
+Update with the measured heading ``psi`` (eqs 4.75-4.76 [reconstructed: alpha-beta form])::
+
+    eps    = wrap_to_pi(psi - psi-)                  prediction error (innovation)
+    psi^   = psi- + k_psi eps
+    r^     = r-   + k_r eps / h
+
+Noise-adaptive gains (eqs 4.66-4.73 [reconstructed]). The innovation is split by a
+first-order low-pass of time constant ``T_lf`` into a low-frequency part ``eps_L`` (model
+error: wind, wrong K or tau) and a high-frequency part ``eps_H = eps - eps_L`` (waves); their
+powers ``P_L``, ``P_H`` are averaged with time constant ``T_pow``::
+
+    xi     = (P_L + P0) / (P_L + P_H + P0),   xi_min <= xi <= 1        (0 < xi <= 1: 4.69)
+    k_psi  = xi,        k_r = k_psi^2 / (2 - k_psi)                      (Benedict-Bordner)
+
+``P0`` [rad^2] is the noise floor: when the absolute noise level is low, ``xi -> 1`` and the
+filter passes the measurement through (``psi^ = psi``, ``r^`` = the heading difference); in
+heavy seas ``xi`` falls and the estimate follows the rudder-driven model, which has almost no
+phase lag. ``k_r = k_psi^2/(2 - k_psi)`` is the steady-state relation of the alpha-beta
+(Kalman) tracker of Benedict and Bordner (1962). ``xi`` is also the noise level used for gain
+scheduling of ASA (eqs 4.5, 4.86, 4.87, 4.91).
+
+State record ``zf`` (``N_WF`` floats, see the ``F_*`` indices) and parameter record
+``pf`` (``N_WF_PARAMS`` floats, ``WF_*`` indices; :class:`WaveFilterParams`).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import NamedTuple
+
+import numba
+import numpy as np
+from pydantic import Field
+
+from steerlab.angles import wrap_to_pi
+from steerlab.config_base import FrozenConfig
+from steerlab.errors import require_finite_range
+
+F_PSI, F_R, F_DELTA, F_ELF, F_PL, F_PH, F_XI = 0, 1, 2, 3, 4, 5, 6
+N_WF = 7
+"""Filter state: [psi^ (rad), r^ (rad/s), previous rudder (rad), low-passed innovation (rad),
+P_L (rad^2), P_H (rad^2), xi (-)]."""
+
+WF_TLF, WF_TPOW, WF_P0, WF_XIMIN = 0, 1, 2, 3
+N_WF_PARAMS = 4
+
+
+class WaveFilterParams(NamedTuple):
+    """Tuning of the noise-adaptive filter (SI)."""
+
+    T_lf: float = 20.0       #: low-pass splitting the innovation into LF / HF [s]
+    T_pow: float = 60.0      #: averaging time of the LF / HF powers [s]
+    P0: float = 1e-8         #: noise floor [rad^2] (xi -> 1 below it)
+    xi_min: float = 0.02     #: lower bound of xi and of the filter gain k_psi [-]
+
+    def pack(self, field: str = "controller.wave_filter") -> np.ndarray:
+        require_finite_range(f"{field}.T_lf", self.T_lf, 0.0, 1e5, lo_open=True)
+        require_finite_range(f"{field}.T_pow", self.T_pow, 0.0, 1e6, lo_open=True)
+        require_finite_range(f"{field}.P0", self.P0, 0.0, 1.0, lo_open=True)
+        require_finite_range(f"{field}.xi_min", self.xi_min, 0.0, 1.0, lo_open=True)
+        return np.array([self.T_lf, self.T_pow, self.P0, self.xi_min], dtype=np.float64)
+
+
+class WaveFilterConfig(FrozenConfig):
+    """``wave_filter = { ... }`` in a controller block (seconds, rad^2)."""
+
+    T_lf: float = Field(20.0, gt=0.0, le=1e5, description="LF/HF split of the innovation [s]")
+    T_pow: float = Field(60.0, gt=0.0, le=1e6, description="averaging time of the powers [s]")
+    P0: float = Field(1e-8, gt=0.0, le=1.0, description="noise floor [rad^2]")
+    xi_min: float = Field(0.02, gt=0.0, le=1.0, description="lower bound of xi and k_psi [-]")
+
+    def params(self) -> WaveFilterParams:
+        return WaveFilterParams(self.T_lf, self.T_pow, self.P0, self.xi_min)
+
+
+def wave_filter_init(zf, psi, r, delta):
+    """Start the filter at the measured heading and yaw rate, no noise seen yet (xi = 1)."""
+    zf[F_PSI] = psi
+    zf[F_R] = r
+    zf[F_DELTA] = delta
+    zf[F_ELF] = 0.0
+    zf[F_PL] = 0.0
+    zf[F_PH] = 0.0
+    zf[F_XI] = 1.0
+
+
+@numba.njit(cache=True)
+def wave_filter_step(zf, pf, K, tau, psi_meas, delta, h):
+    """Advance the filter over one sample: predict from the previous estimate with the mean
+    rudder of the interval, then correct with the measured heading (see module docstring).
+
+    Parameters
+    ----------
+    zf : (N_WF,) float64 array, filter state, updated in place
+    pf : (N_WF_PARAMS,) float64 array, packed :class:`WaveFilterParams`
+    K : float, Nomoto gain of the model [1/s]
+    tau : float, Nomoto time constant of the model [s] (non-zero)
+    psi_meas : float, measured heading [rad]
+    delta : float, actual rudder angle now [rad]
+    h : float, sample time [s]
+    """
+    d = 0.5 * (zf[F_DELTA] + delta)
+    a = math.exp(-h / tau)
+    r0 = zf[F_R]
+    drive = K * d - r0
+    r_pred = r0 + (1.0 - a) * drive
+    psi_pred = zf[F_PSI] + h * r0 + (h - tau * (1.0 - a)) * drive
+    eps = wrap_to_pi(psi_meas - psi_pred)
+    # LF / HF split of the innovation and their powers (first-order filters, Euler form)
+    cl = min(h / pf[WF_TLF], 1.0)
+    elf = zf[F_ELF] + cl * (eps - zf[F_ELF])
+    ehf = eps - elf
+    cp = min(h / pf[WF_TPOW], 1.0)
+    pl = zf[F_PL] + cp * (elf * elf - zf[F_PL])
+    ph = zf[F_PH] + cp * (ehf * ehf - zf[F_PH])
+    p0 = pf[WF_P0]
+    xi = (pl + p0) / (pl + ph + p0)
+    xi = min(max(xi, pf[WF_XIMIN]), 1.0)
+    k_psi = xi
+    k_r = k_psi * k_psi / (2.0 - k_psi)
+    zf[F_PSI] = wrap_to_pi(psi_pred + k_psi * eps)
+    zf[F_R] = r_pred + k_r * eps / h
+    zf[F_DELTA] = delta
+    zf[F_ELF] = elf
+    zf[F_PL] = pl
+    zf[F_PH] = ph
+    zf[F_XI] = xi

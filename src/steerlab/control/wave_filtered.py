@@ -1,0 +1,167 @@
+r"""Any controller behind the noise-adaptive wave filter: ``type = "<name>+wf"``.
+
+Design (no engine change needed)
+--------------------------------
+:func:`wave_filtered` takes a registered :class:`~steerlab.control.registry.ControllerSpec`
+and makes a new one whose kernel
+
+1. advances the wave filter of :mod:`steerlab.control.wave_filter` (van Amerongen 1982,
+   Fig. 4.13-4.14; a Nomoto model with fixed K, T predicts, the measured heading corrects,
+   noise-adaptive gains) from the measured heading ``x[2]`` and the actual rudder (last
+   plant state);
+2. copies the plant state ``x`` into a scratch block of its own state ``z`` and replaces
+   heading and yaw rate there (``x[2]``, ``x[5]``) by the filtered estimates;
+3. calls the inner controller's kernel on that copy, with views of its own state and
+   parameter blocks, and returns its order.
+
+Layouts: ``z = [filter (N_WF) | x copy (NX_MAX) | inner z]``,
+``p = [filter params (N_WF_PARAMS) | K [1/s] | T [s] | inner p]``. Nothing is allocated
+(the copy lives in ``z``; slices are views), so the kernel obeys the engine's rules. The
+kernel is a copy of one template function whose module globals bind ``_inner`` to the inner
+kernel, so the engine's fusing (``sim/kernels.py: _fused``, which follows kernels called
+through module globals) inlines the filter and the inner controller like any other kernel.
+It is not disk-cached (all wrappers share one code object), so it compiles once per process.
+
+The filter's K, T come from ``ctx.nomoto()`` (the ship's first-order Nomoto model at the
+design speed) unless ``filter_K``, ``filter_T`` are given; ASA itself uses the same filter
+kernel with its on-line identified K*, tau* instead.
+
+Registration: this module wraps every controller it finds in the sibling modules of
+:mod:`steerlab.control` (except ``asa``, which has its own filter) as ``"<name>+wf"``; the
+scenario syntax is the inner controller's block plus ``wave_filter = {...}``::
+
+    [controller]
+    type = "pid+wf"
+    Kp = 0.5
+    Kd = 20.0
+    wave_filter = { T_lf = 20.0, T_pow = 60.0 }
+"""
+
+from __future__ import annotations
+
+import importlib
+import pkgutil
+import types
+from functools import lru_cache
+from typing import Literal, NamedTuple, Optional
+
+import numba
+import numpy as np
+from pydantic import Field, create_model
+
+from steerlab.control.registry import ControllerSpec
+from steerlab.control.wave_filter import (F_PSI, F_R, N_WF, N_WF_PARAMS, WaveFilterConfig, WaveFilterParams,
+                                          wave_filter_init, wave_filter_step)
+from steerlab.errors import InputError, require_finite_range
+
+NX_MAX = 32
+"""Largest plant state (ship states + rudder) the wrapper can copy."""
+
+OFF_X = N_WF
+OFF_Z = N_WF + NX_MAX
+P_K = N_WF_PARAMS
+P_T = N_WF_PARAMS + 1
+OFF_P = N_WF_PARAMS + 2
+
+SUFFIX = "+wf"
+NOT_WRAPPED = ("asa",)
+
+
+def _inner(z, p, t, x, ref, h):  # pragma: no cover - replaced per wrapper
+    raise NotImplementedError
+
+
+def _wf_update_template(z, p, t, x, ref, h):
+    """Wave filter, then the inner controller on the filtered copy of ``x`` (module doc)."""
+    nx = x.shape[0]
+    wave_filter_step(z, p, p[P_K], p[P_T], x[2], x[nx - 1], h)
+    xf = z[OFF_X:OFF_X + nx]
+    for i in range(nx):
+        xf[i] = x[i]
+    xf[2] = z[F_PSI]
+    xf[5] = z[F_R]
+    return _inner(z[OFF_Z:], p[OFF_P:], t, xf, ref, h)
+
+
+class WaveFiltered(NamedTuple):
+    """A designed inner controller plus the filter settings."""
+
+    inner: object
+    K: float
+    T: float
+    filt: WaveFilterParams = WaveFilterParams()
+
+    def pack(self, inner_p) -> np.ndarray:
+        require_finite_range("controller.filter_K", self.K, 0.0, 100.0, lo_open=True)
+        require_finite_range("controller.filter_T", self.T, -1e4, 1e4)
+        if abs(self.T) < 1e-6:
+            raise InputError("controller.filter_T", "must be non-zero (|T| >= 1e-6 s)")
+        wf = self.filt.pack("controller.wave_filter")
+        return np.concatenate([wf, [self.K, self.T], np.asarray(inner_p, dtype=np.float64)])
+
+    def init_state(self, x0, ref0) -> np.ndarray:
+        x0 = np.asarray(x0, dtype=float)
+        if x0.shape[0] > NX_MAX:
+            raise InputError("ship.model", f"plant state of {x0.shape[0]} > {NX_MAX} values: too large for '+wf'")
+        zi = np.asarray(self.inner.init_state(x0, ref0), dtype=float)
+        z = np.zeros(OFF_Z + zi.shape[0])
+        wave_filter_init(z, float(x0[2]), float(x0[5]), float(x0[-1]))
+        z[OFF_X:OFF_X + x0.shape[0]] = x0
+        z[OFF_Z:] = zi
+        return z
+
+
+@lru_cache(maxsize=None)
+def wave_filtered(spec: ControllerSpec) -> ControllerSpec:
+    """``spec`` behind the wave filter, registered as ``spec.name + "+wf"`` (memoised)."""
+    name = spec.name + SUFFIX
+    g = dict(_wf_update_template.__globals__)
+    g["_inner"] = spec.update
+    fn = types.FunctionType(_wf_update_template.__code__, g, name.replace("+", "_") + "_update")
+    fn.__doc__ = f"{spec.name} behind the noise-adaptive wave filter (steerlab.control.wave_filtered)."
+    kernel = numba.njit(fn)
+    cfg_cls = create_model(
+        spec.config.__name__ + "WaveFiltered", __base__=spec.config,
+        type=(Literal[name], ...),
+        wave_filter=(WaveFilterConfig, WaveFilterConfig()),
+        filter_K=(Optional[float], Field(None, gt=0.0, le=100.0, description="filter model K [1/s]")),
+        filter_T=(Optional[float], Field(None, ge=-1e4, le=1e4, description="filter model T [s]")))
+
+    def build(cfg, ctx):
+        data = cfg.model_dump(exclude={"wave_filter", "filter_K", "filter_T"})
+        data["type"] = spec.name
+        inner_cfg = spec.config.model_validate(data)
+        inner, inner_p = spec.build(inner_cfg, ctx)
+        if ctx.ship.n_states + 1 > NX_MAX:
+            raise InputError("ship.model", f"plant state of {ctx.ship.n_states + 1} > {NX_MAX} values: "
+                             "too large for '+wf'")
+        if cfg.filter_K is None or cfg.filter_T is None:
+            K, T = ctx.nomoto()
+        K = cfg.filter_K if cfg.filter_K is not None else K
+        T = cfg.filter_T if cfg.filter_T is not None else T
+        c = WaveFiltered(inner, float(K), float(T), cfg.wave_filter.params())
+        return c, c.pack(inner_p)
+
+    return ControllerSpec(
+        name=name, description=f"{spec.description}, behind the noise-adaptive wave filter",
+        update=kernel, n_state=OFF_Z + spec.n_state, config=cfg_cls, build=build,
+        source=f"{spec.source}; wave filter: van Amerongen (1982) Fig. 4.13-4.14")
+
+
+def _sibling_specs():
+    import steerlab.control as pkg
+
+    skip = {"registry", "design_context", "__init__", __name__.rsplit(".", 1)[1]}
+    for mod in sorted(pkgutil.iter_modules(pkg.__path__), key=lambda m: m.name):
+        if mod.name in skip or mod.name.startswith("_"):
+            continue
+        module = importlib.import_module(f"steerlab.control.{mod.name}")
+        specs = list(getattr(module, "CONTROLLERS", ()))
+        if hasattr(module, "CONTROLLER"):
+            specs.append(module.CONTROLLER)
+        for spec in specs:
+            if spec.name not in NOT_WRAPPED and not spec.name.endswith(SUFFIX):
+                yield spec
+
+
+CONTROLLERS = [wave_filtered(s) for s in _sibling_specs()]
