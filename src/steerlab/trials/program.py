@@ -35,6 +35,7 @@ from pydantic import Field
 
 from steerlab.config_base import FrozenConfig
 from steerlab.control.registry import ControllerSpec
+from steerlab.errors import InputError
 from steerlab.trials.rate_hold import pack_rate_hold, rate_hold_gains, rate_hold_update
 from steerlab.trials.rudder_schedule import pack_schedule, schedule_update
 from steerlab.trials.zigzag_logic import pack_zigzag, zigzag_update
@@ -91,8 +92,11 @@ def default_rate_omega(ctx) -> float:
     Fast against the ship's yaw time constant ``T`` and its time scale ``L/U``, slow against
     the steering gear (2.33 deg/s moves the rudder 10 deg in ~4 s).
     """
-    _, T = ctx.nomoto()
     L = ctx.ship.dims[1]
+    try:
+        _, T = ctx.nomoto()
+    except (InputError, ValueError, ZeroDivisionError):
+        return ctx.speed / L
     return max(2.0 / abs(T), ctx.speed / L)
 
 
@@ -102,15 +106,19 @@ def build(cfg: TrialProgramConfig, ctx):
     The rate hold designs its PI gains (:func:`~steerlab.trials.rate_hold.rate_hold_gains`)
     from the ship's first-order Nomoto model at the trial speed (``ctx.nomoto()``):
     ``a = -1/T``, ``b = K/T``. A course-unstable ship whose Nomoto fit has ``T < 0`` and
-    ``K < 0`` still has ``b > 0``.
+    ``K < 0`` still has ``b > 0``. A ship without a Nomoto model or linearisation falls back to
+    ``a = 0`` and the rudder effectiveness of eq (29) (``ctx.b2("estimate")``).
     """
     if cfg.kind == "schedule":
         return TrialProgram(), pack_schedule(MODE_SCHEDULE, cfg.times, rad(np.asarray(cfg.values)))
     if cfg.kind == "zigzag":
         d1 = rad(cfg.rudder_deg)
         return TrialProgram(d1), pack_zigzag(MODE_ZIGZAG, cfg.t0, d1, rad(cfg.heading_deg), rad(cfg.psi0_deg))
-    K, T = ctx.nomoto()
-    a, b = -1.0 / T, K / T
+    try:
+        K, T = ctx.nomoto()
+        a, b = -1.0 / T, K / T
+    except (InputError, ValueError, ZeroDivisionError):   # no Nomoto model: rudder effectiveness only
+        a, b = 0.0, ctx.b2("estimate")
     if not (b > 0.0 and math.isfinite(b)):
         b = abs(b) if b != 0.0 and math.isfinite(b) else ctx.b2("estimate")
     omega = cfg.omega if cfg.omega is not None else default_rate_omega(ctx)
