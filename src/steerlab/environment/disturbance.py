@@ -6,14 +6,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from steerlab.environment.channels import N_CHANNELS, W_RUDDER
+from steerlab.environment.channels import (N_CHANNELS, W_CURRENT_DIR, W_CURRENT_SPEED, W_RUDDER,
+                                           W_WIND_DIR, W_WIND_SPEED)
 from steerlab.environment.waves import coloured_noise
 from steerlab.errors import require_finite_range
 
 
 @dataclass(frozen=True)
 class Disturbance:
-    """Disturbances, all as equivalent rudder angle (Zwierzewicz et al. 2021, Section 6).
+    """Disturbances: equivalent rudder angle (Zwierzewicz et al. 2021, Section 6), constant wind and current.
 
     Attributes
     ----------
@@ -28,6 +29,14 @@ class Disturbance:
         White-noise sample time [s] (paper: 0.5 s).
     wave_power : float
         White-noise power (paper: 1e-4).
+    wind_speed : float
+        Constant true wind speed [m/s] (channel ``W_WIND_SPEED``; read by ships with a wind model).
+    wind_dir : float
+        Direction the wind comes FROM [rad], clockwise from north (``W_WIND_DIR``).
+    current_speed : float
+        Constant current speed [m/s] (``W_CURRENT_SPEED``).
+    current_dir : float
+        Direction the current flows TOWARDS [rad], clockwise from north (``W_CURRENT_DIR``).
     """
 
     constant_rudder: float = 0.0
@@ -35,17 +44,25 @@ class Disturbance:
     waves: bool = False
     wave_sample_time: float = 0.5
     wave_power: float = 1e-4
+    wind_speed: float = 0.0
+    wind_dir: float = 0.0
+    current_speed: float = 0.0
+    current_dir: float = 0.0
 
     def validated(self) -> "Disturbance":
         require_finite_range("environment.constant_rudder [rad]", self.constant_rudder, -np.pi / 2, np.pi / 2)
         require_finite_range("environment.constant_start", self.constant_start, 0.0)
         require_finite_range("environment.wave_sample_time", self.wave_sample_time, 0.0, lo_open=True)
         require_finite_range("environment.wave_power", self.wave_power, 0.0)
+        require_finite_range("environment.wind_speed [m/s]", self.wind_speed, 0.0, 100.0)
+        require_finite_range("environment.wind_dir [rad]", self.wind_dir, -2 * np.pi, 2 * np.pi)
+        require_finite_range("environment.current_speed [m/s]", self.current_speed, 0.0, 10.0)
+        require_finite_range("environment.current_dir [rad]", self.current_dir, -2 * np.pi, 2 * np.pi)
         return self
 
 
 def build_disturbance(dist: Disturbance, n_steps: int, dt: float, seed: int) -> np.ndarray:
-    """Sample every disturbance up front: array ``(n_steps + 1, N_CHANNELS)`` [rad].
+    """Sample every disturbance up front: array ``(n_steps + 1, N_CHANNELS)`` (channel units).
 
     Uses ``numpy.random.default_rng(seed)`` only, so the same seed gives the same sea for
     every controller compared, bit for bit.
@@ -54,6 +71,10 @@ def build_disturbance(dist: Disturbance, n_steps: int, dt: float, seed: int) -> 
     w = np.zeros((n_steps + 1, N_CHANNELS))
     t = np.arange(n_steps + 1) * dt
     w[:, W_RUDDER] = np.where(t >= dist.constant_start, dist.constant_rudder, 0.0)
+    w[:, W_WIND_SPEED] = dist.wind_speed
+    w[:, W_WIND_DIR] = dist.wind_dir
+    w[:, W_CURRENT_SPEED] = dist.current_speed
+    w[:, W_CURRENT_DIR] = dist.current_dir
     if dist.waves:
         rng = np.random.default_rng(seed)
         w[:, W_RUDDER] += coloured_noise(n_steps, dt, rng, dist.wave_sample_time, dist.wave_power)

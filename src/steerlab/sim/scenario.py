@@ -88,6 +88,12 @@ class EnvironmentConfig(_Frozen):
     waves: bool = False
     wave_sample_time: float = Field(0.5, gt=0.0, le=60.0)
     wave_power: float = Field(1e-4, ge=0.0, le=1.0)
+    wind_speed: float = Field(0.0, ge=0.0, le=100.0, description="constant true wind speed [m/s]")
+    wind_dir_deg: float = Field(0.0, ge=-360.0, le=360.0,
+                                description="direction the wind comes FROM [deg], clockwise from north")
+    current_speed: float = Field(0.0, ge=0.0, le=10.0, description="constant current speed [m/s]")
+    current_dir_deg: float = Field(0.0, ge=-360.0, le=360.0,
+                                   description="direction the current flows TOWARDS [deg], clockwise from north")
 
 
 class Scenario(_Frozen):

@@ -79,8 +79,11 @@ def build(scenario) -> SimSetup:
     if s.environment.waves and abs(ws / s.dt - round(ws / s.dt)) > 1e-9 * max(1.0, ws / s.dt):
         raise InputError("environment.wave_sample_time",
                          f"must be a positive integer multiple of dt={s.dt} s, got {ws} s")
-    dist = Disturbance(rad(s.environment.constant_rudder_deg), s.environment.constant_start,
-                       s.environment.waves, s.environment.wave_sample_time, s.environment.wave_power)
+    env = s.environment
+    dist = Disturbance(rad(env.constant_rudder_deg), env.constant_start, env.waves,
+                       env.wave_sample_time, env.wave_power, wind_speed=env.wind_speed,
+                       wind_dir=rad(env.wind_dir_deg), current_speed=env.current_speed,
+                       current_dir=rad(env.current_dir_deg))
     w = build_disturbance(dist, n_steps, s.dt, s.seed)
     return SimSetup(ship, ctrl_spec, ps, pg, pc, gd, x0, np.asarray(z0, dtype=float), w, s.dt, nc,
                     n_steps, s.name, s.seed)
