@@ -22,6 +22,9 @@ def add_ship_arguments(p) -> None:
                    help="open loop: ideal rudder that follows the order (no rate limit, lag dt/1.6)")
     p.add_argument("--rudder-limit", type=float, default=None, metavar="DEG",
                    help="steering-gear rudder limit [deg] (default 35)")
+    p.add_argument("--rudder-rate", type=float, default=None, metavar="DEG_S",
+                   help="steering-gear rate limit [deg/s] (default 2.33; model-scale ships need a "
+                        "Froude-scaled, faster gear)")
     p.add_argument("--dt", type=float, default=0.1, help="integration step [s] (default 0.1)")
     p.add_argument("--quiet", action="store_true", help="no progress messages")
 
@@ -52,6 +55,10 @@ def conditions_from_args(args):
         if not (math.isfinite(args.rudder_limit) and 0.0 < args.rudder_limit <= 90.0):
             raise InputError("--rudder-limit", f"must be in (0, 90] deg, got {args.rudder_limit}")
         gear["delta_max_deg"] = args.rudder_limit
+    if args.rudder_rate is not None:
+        if not (math.isfinite(args.rudder_rate) and 0.0 < args.rudder_rate <= 100.0):
+            raise InputError("--rudder-rate", f"must be in (0, 100] deg/s, got {args.rudder_rate}")
+        gear["rate_max_deg_s"] = args.rudder_rate
     if args.speed_kn is not None and not (math.isfinite(args.speed_kn) and 0.0 < args.speed_kn <= 40.0):
         raise InputError("--speed-kn", f"must be in (0, 40] kn, got {args.speed_kn}")
     if not (math.isfinite(args.dt) and 0.0 < args.dt <= 5.0):
