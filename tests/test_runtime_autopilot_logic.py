@@ -135,7 +135,7 @@ def test_route_bearing_and_waypoint_switching(tmp_path):
     r = Route([(1000.0, 0.0), (1000.0, 1000.0)], accept_radius=100.0)
     assert r.set_course(0.0, 0.0) == pytest.approx(0.0)              # due north
     assert r.set_course(950.0, 0.0) == pytest.approx(math.atan2(1000.0, 50.0))  # wp 1 reached: to wp 2
-    assert r.set_course(1000.0, 950.0) == pytest.approx(math.pi / 2)  # last reached: keep course
+    assert r.set_course(1000.0, 950.0) == pytest.approx(math.atan2(1000.0, 50.0))  # last reached: keep
     assert r.finished
     f = tmp_path / "route.csv"
     f.write_text("x_n,y_e\n0,0\n-500,10\n")
