@@ -152,7 +152,7 @@ class Autopilot:
         return (time.monotonic() - self._t0) * self.config.speedup
 
     def on_state_datagram(self, data: bytes, addr=None, t: float | None = None) -> None:
-        msg, _ = self.filter.accept(data, time.time(), addr[0] if addr else None)
+        msg, _ = self.filter.accept(data, time.time(), addr)
         if msg is not None:
             self.latest = msg.body
             self.latest_t = self.clock() if t is None else t

@@ -6,7 +6,8 @@ in each direction, independently (seeded ``numpy.random.default_rng``): is dropp
 probability ``loss``; else sent, and sent once more with probability ``duplicate``; each copy is
 delayed by ``delay`` plus, with probability ``reorder``, an extra uniform delay of up to
 ``reorder_delay`` wall seconds (so it arrives after later ones). ``cut = True`` drops
-everything (a cable pulled out).
+everything (a cable pulled out). ``record=True`` keeps the client's datagrams in ``recorded``
+(what an eavesdropper could capture and replay).
 """
 
 from __future__ import annotations
@@ -20,13 +21,14 @@ from steerlab.runtime.udp import LOOPBACK, open_udp, send
 
 class LossyProxy:
     def __init__(self, upstream, listen=(LOOPBACK, 0), loss=0.0, duplicate=0.0, reorder=0.0,
-                 reorder_delay=0.02, delay=0.0, seed=0):
+                 reorder_delay=0.02, delay=0.0, seed=0, record=False):
         self.upstream = upstream
         self.listen = listen
         self.loss, self.duplicate, self.reorder = float(loss), float(duplicate), float(reorder)
         self.reorder_delay, self.delay = float(reorder_delay), float(delay)
         self.rng = np.random.default_rng(seed)
         self.cut = False
+        self.recorded = [] if record else None     #: client -> upstream datagrams, as sent
         self.client = None
         self.counts = {"in": 0, "dropped": 0, "duplicated": 0, "reordered": 0}
         self.front = None
@@ -48,6 +50,8 @@ class LossyProxy:
 
     def _from_client(self, data, addr):
         self.client = addr
+        if self.recorded is not None:
+            self.recorded.append(bytes(data))
         self._forward(self.back, data, self.upstream)
 
     def _from_upstream(self, data, addr):

@@ -8,6 +8,9 @@ from collections import OrderedDict
 class RateLimiter:
     """At most ``rate`` datagrams per second on average, bursts of ``burst``, per source.
 
+    The runtime keys the buckets on the source address ``(host, port)``, so that on a shared
+    host (loopback) one flooding process does not starve the legitimate peer.
+
     ``allow(source, now)`` takes one token from ``source``'s bucket (refilled at ``rate``
     tokens/s up to ``burst``) and says whether there was one. At most ``max_sources``
     buckets are kept (least recently used dropped), so a flood of spoofed addresses cannot

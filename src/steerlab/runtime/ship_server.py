@@ -169,7 +169,7 @@ class ShipServer:
 
     # ------------------------------------------------------------ I/O
     def on_datagram(self, data: bytes, addr) -> None:
-        msg, _ = self.filter.accept(data, time.time(), addr[0] if addr else None)
+        msg, _ = self.filter.accept(data, time.time(), addr)
         if msg is None:
             return
         if addr is not None and (addr in self.subscribers or len(self.subscribers) < self.config.max_subscribers):
