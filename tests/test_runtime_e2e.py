@@ -208,3 +208,40 @@ def P_now():
     import time
 
     return time.time()
+
+
+def test_nmea_heading_and_plotter_course_and_signalk(controller, tmp_path):
+    """Server emits NMEA to the autopilot (heading from HDT/THS); a 'plotter' sends APB; Signal K out."""
+    from steerlab.runtime import nmea, signalk
+    from steerlab.runtime.udp import open_udp
+
+    got_sk = []
+
+    async def start(ctx):
+        sk = await open_udp(lambda d, a: got_sk.append(signalk.parse_delta(d)), ("127.0.0.1", 0))
+        nm = await open_udp(ctx["ap"].on_nmea_datagram, ("127.0.0.1", 0))
+        ctx["server"].nmea_to = nm.get_extra_info("sockname")[:2]
+        ctx["server"].signalk_to = sk.get_extra_info("sockname")[:2]
+        ctx["server"].out_transport = await open_udp(lambda d, a: None, ("127.0.0.1", 0))
+        ctx["sockets"] = (sk, nm)
+
+    def plotter(ctx):
+        apb = nmea.render("APB", ["A", "A", "0.00", "R", "N", "V", "V", "15.0", "T", "WP1", "15.0", "T", "15.0", "T"])
+        ctx["ap"].on_nmea_datagram(apb.encode())
+
+    def close(ctx):
+        for s in ctx["sockets"]:
+            s.close()
+
+    log = tmp_path / "ap.csv"
+    ctx = asyncio.run(_session(controller, log, 16.0, [(0.5, start), (3.0, plotter), (15.9, close)],
+                               ap_cfg=AutopilotConfig(speedup=SPEEDUP, nmea_timeout=20.0)))
+    rows = _read_log(log)
+    ap = ctx["ap"]
+    assert ap.nmea_counts["accepted"] > 100 and ap.nmea_counts["rejected"] == 0
+    nm_rows = [r for r in rows if r["heading_source"] == "nmea"]
+    assert len(nm_rows) > 50
+    assert all(r["psi_set_deg"] == pytest.approx(15.0) for r in rows if r["t"] > 3.5)
+    assert max(abs(r["psi_deg"] - 15.0) for r in rows if r["t"] > 14.0) < 1.5
+    paths = set().union(*(d for d in got_sk if d))
+    assert {"navigation.headingTrue", "navigation.rateOfTurn", "steering.rudderAngle"} <= paths
