@@ -78,6 +78,8 @@ async def _session(controller, log, duration, actions=(), key=None, ap_key="same
     task = asyncio.create_task(director())
     try:
         await ap.run(duration)
+        if task.done():
+            task.result()                    # an action that failed fails the test
     finally:
         task.cancel()
         server.stop()
