@@ -111,7 +111,9 @@ class Autopilot:
         self.route = route
         self.key = key
         self.sender = P.Sender(key)
-        self.filter = LinkFilter(P.TYPE_STATE, key=key, max_age=cfg.max_age)
+        # states come at 20/s of ship time; allow 5x that per source before rate limiting
+        self.filter = LinkFilter(P.TYPE_STATE, key=key, max_age=cfg.max_age,
+                                 rate=100.0 * cfg.speedup, burst=50.0)
         self.log_path = log_path
         self.alarms = AlarmBoard()
         self.psi_set = None if heading is None else wrap_to_pi(float(heading))
