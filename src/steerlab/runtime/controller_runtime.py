@@ -18,8 +18,8 @@ def runtime_scenario(scenario, controller: str | None, sample_time: float):
     """``scenario`` with ``dt = sample_time`` and the controller ``controller`` (by name).
 
     The scenario's ``[controller]`` settings are kept if it is of that type, else the named
-    controller's defaults are used; a ``sample_time`` field is cleared (the sample time is
-    ``dt``). The duration is cut to a few samples (the runtime has no horizon).
+    controller's defaults are used; a ``sample_time`` field is set to the runtime's (which is
+    also ``dt``). The duration is cut to a few samples (the runtime has no horizon).
     """
     from steerlab.sim.scenario import scenario_from_dict
 
@@ -28,7 +28,7 @@ def runtime_scenario(scenario, controller: str | None, sample_time: float):
     if controller and controller != ctrl.get("type"):
         ctrl = {"type": controller}
     if "sample_time" in ctrl:
-        ctrl["sample_time"] = None
+        ctrl["sample_time"] = sample_time
     d.update(controller=ctrl, dt=sample_time, duration=4 * sample_time)
     d["environment"] = {**d["environment"], "waves": False}
     return scenario_from_dict(d)
