@@ -1,0 +1,129 @@
+"""``steerlab autopilot``: steer a ship server with any steerlab controller, in real time."""
+
+from __future__ import annotations
+
+import math
+import sys
+
+EXAMPLES = """examples:
+  steerlab autopilot --connect 127.0.0.1:47110 --controller pid --heading 20
+  steerlab autopilot --connect 127.0.0.1:47110 --controller adrc --scenario my.toml --route route.csv
+  steerlab autopilot --connect 127.0.0.1:47110 --controller pid --heading 0 --web 127.0.0.1:8080
+  steerlab autopilot --connect 127.0.0.1:47110 --controller pid --nmea-listen 127.0.0.1:10111   # follow OpenCPN APB/RMB
+
+The controller is designed for the scenario's ship (--scenario, default: the bundled one); use
+the same scenario as serve-ship. Every sample is logged to --log (CSV). docs/runtime.md"""
+
+
+def register(sub, formatter_class) -> None:
+    from steerlab.commands.serve_ship import add_link_security
+
+    p = sub.add_parser("autopilot", help="run a steerlab controller against a ship server over UDP",
+                       description="Sample the ship server's state every 0.125 s, run guidance + a steerlab "
+                                   "controller and send rudder orders; watchdog (alarm + safe action), "
+                                   "off-course alarm, CSV log, optional NMEA 0183 / Signal K / bridge page.",
+                       epilog=EXAMPLES, formatter_class=formatter_class)
+    p.add_argument("--connect", required=True, metavar="HOST:PORT", help="the ship server")
+    p.add_argument("--controller", help="controller name (default: the scenario's)")
+    g = p.add_mutually_exclusive_group()
+    g.add_argument("--heading", type=float, help="set course [deg] (default: heading at engagement)")
+    g.add_argument("--route", help="CSV of waypoints x_n,y_e [m]: steer the bearing to the next one")
+    p.add_argument("--accept-radius", type=float, default=200.0, help="waypoint acceptance radius [m] (default 200)")
+    p.add_argument("--scenario", help="scenario TOML the controller is designed for (ship, speed, gear)")
+    p.add_argument("--log", default="autopilot-log.csv", help="CSV log, one row per sample (default autopilot-log.csv)")
+    p.add_argument("--speedup", type=float, default=1.0, help="must match serve-ship's (default 1)")
+    p.add_argument("--duration", type=float, default=0.0, help="stop after this ship time [s]; 0: until Ctrl-C")
+    p.add_argument("--sample-time", type=float, default=0.125, help="controller sample time [s] (default 0.125)")
+    p.add_argument("--watchdog", type=float, default=1.0, help="no valid state for longer: alarm + safe action [s]")
+    p.add_argument("--safe-action", choices=("midships", "hold"), default="midships")
+    p.add_argument("--off-course-deg", type=float, default=10.0, help="off-course alarm limit [deg] (default 10)")
+    p.add_argument("--turn-rate", type=float, default=None,
+                   help="course-change rate limit [deg/s] (default: the scenario's guidance.rate_max_deg_s)")
+    p.add_argument("--rpm", type=float, default=None, help="propeller order [rpm] (default: leave the ship's)")
+    p.add_argument("--standby", action="store_true", help="start in standby (engage from the bridge page)")
+    p.add_argument("--nmea-listen", metavar="HOST:PORT", help="UDP port for HDT/THS heading and APB/RMB/HTC course")
+    p.add_argument("--nmea-to", metavar="HOST:PORT", help="send the autopilot's HTD here each sample")
+    p.add_argument("--xte-lookahead", type=float, default=500.0, help="cross-track correction lookahead [m]")
+    p.add_argument("--signalk-listen", metavar="HOST:PORT", help="UDP port for Signal K deltas (target heading, state)")
+    p.add_argument("--signalk-to", metavar="HOST:PORT", help="send Signal K autopilot deltas here")
+    p.add_argument("--web", metavar="HOST:PORT", help="serve the bridge page here (e.g. 127.0.0.1:8080)")
+    add_link_security(p)
+    p.add_argument("--quiet", action="store_true")
+    p.set_defaults(func=run)
+
+
+def build_autopilot(args):
+    """The :class:`~steerlab.runtime.autopilot.Autopilot` (and web bind) for parsed ``args``."""
+    from steerlab.errors import InputError, require_finite_range
+    from steerlab.runtime.autopilot import Autopilot, AutopilotConfig
+    from steerlab.runtime.controller_runtime import ControllerRuntime
+    from steerlab.runtime.keys import load_key
+    from steerlab.runtime.route import Route, load_route
+    from steerlab.runtime.udp import is_loopback, parse_hostport
+    from steerlab.sim.scenario import default_scenario, load_scenario
+    from steerlab.units import rad
+
+    connect = parse_hostport(args.connect, "--connect")
+    if connect[1] == 0:
+        raise InputError("--connect", "port must be in [1, 65535]")
+    key = load_key(args.key_file, args.key_env)
+    scenario = load_scenario(args.scenario) if args.scenario else default_scenario()
+    ctrl = ControllerRuntime(scenario, args.controller, args.sample_time)
+    if args.heading is not None:
+        require_finite_range("--heading", args.heading, -360.0, 360.0)
+    turn = scenario.guidance.rate_max_deg_s if args.turn_rate is None else args.turn_rate
+    require_finite_range("--turn-rate", turn, 0.0, 30.0)
+    require_finite_range("--off-course-deg", args.off_course_deg, 0.0, 180.0, lo_open=True)
+    cfg = AutopilotConfig(sample_time=args.sample_time, speedup=args.speedup, watchdog_timeout=args.watchdog,
+                          safe_action=args.safe_action, off_course_limit=rad(args.off_course_deg),
+                          turn_rate=rad(turn), max_age=args.max_age,
+                          rpm_cmd=math.nan if args.rpm is None else args.rpm, xte_lookahead=args.xte_lookahead)
+    route = Route(load_route(args.route), args.accept_radius) if args.route else None
+    web = parse_hostport(args.web, "--web") if args.web else None
+    if web is not None and not is_loopback(web[0]):
+        print(f"autopilot: warning: the bridge page on {web[0]} is reachable from the network and has no login",
+              file=sys.stderr)
+    hp = lambda v, f: parse_hostport(v, f) if v else None  # noqa: E731
+    ap = Autopilot(ctrl, connect, cfg, heading=None if args.heading is None else rad(args.heading),
+                   route=route, key=key, log_path=args.log, engaged=not args.standby,
+                   nmea_listen=hp(args.nmea_listen, "--nmea-listen"), nmea_to=hp(args.nmea_to, "--nmea-to"),
+                   signalk_listen=hp(args.signalk_listen, "--signalk-listen"),
+                   signalk_to=hp(args.signalk_to, "--signalk-to"))
+    return ap, web
+
+
+async def run_with_web(ap, web, duration, started=None):
+    """Run the autopilot (and its bridge page, if ``web``) until ``duration`` or stop."""
+    bridge = None
+    if web is not None:
+        from steerlab.runtime.web import BridgeServer
+
+        bridge = await BridgeServer(ap, web[0], web[1]).start()
+    try:
+        await ap.run(duration, started=lambda a: started(a, bridge) if started else None)
+    finally:
+        if bridge is not None:
+            await bridge.close()
+    return ap
+
+
+def run(args) -> int:
+    import asyncio
+
+    ap, web = build_autopilot(args)
+
+    def started(a, bridge):
+        if not args.quiet:
+            page = f", bridge page http://{bridge.address[0]}:{bridge.address[1]}/" if bridge else ""
+            print(f"autopilot: {a.ctrl.name} -> {a.connect[0]}:{a.connect[1]}, sample {a.config.sample_time:g} s, "
+                  f"watchdog {a.config.watchdog_timeout:g} s ({a.config.safe_action}), log {args.log}{page}; "
+                  "Ctrl-C stops", file=sys.stderr, flush=True)
+
+    try:
+        asyncio.run(run_with_web(ap, web, args.duration, started))
+    finally:
+        if not args.quiet:
+            print(f"autopilot: {ap.samples} samples, mode {ap.mode}, link {dict(ap.filter.counts)}, "
+                  f"alarms raised {[n for _, n, w in ap.alarms.history if w == 'raised']}",
+                  file=sys.stderr, flush=True)
+    return 0

@@ -1,0 +1,24 @@
+"""Real-time runtime: a ship server and an autopilot client over UDP, safe on a bad link.
+
+=====================  ==========================================================
+module                 concept
+=====================  ==========================================================
+``protocol``           wire format v1 (datagrams with session, sequence, stamp, HMAC)
+``link_filter``        what may be used: duplicates, reordering, stale, replay, auth
+``rate_limit``         token bucket per source
+``keys``               shared HMAC key from a file or an environment variable
+``udp``                asyncio UDP endpoints, ``HOST:PORT`` parsing
+``ship_server``        a scenario's ship in real time (hold, then centre the rudder)
+``controller_runtime`` any registered controller kernel, sample by sample
+``autopilot``          the client: guidance, controller, watchdog, alarms, CSV log
+``alarms``             raise / clear / acknowledge
+``route``              waypoint following (bearing to the next waypoint)
+``nmea``               NMEA 0183 out (HDT, THS, ROT, RSA, RMC, VTG, HTD) and in (APB, RMB, HTC)
+``signalk``            Signal K delta messages
+``web``                the bridge page (HTTP + WebSocket)
+``lossy_proxy``        loss, duplication, reordering and cuts, for tests
+=====================  ==========================================================
+
+The protocol and its guarantees are documented in ``docs/runtime.md``. The runtime imports
+the library; the library never imports the runtime.
+"""

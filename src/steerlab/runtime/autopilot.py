@@ -1,0 +1,400 @@
+"""Autopilot client: a steerlab controller steering a ship server over UDP, with a watchdog.
+
+Every ``sample_time`` (0.125 s of ship time by default, as in the berthing paper's client) the
+autopilot takes the newest accepted state (:class:`~steerlab.runtime.link_filter.LinkFilter`:
+duplicates, reordered, stale, forged and replayed datagrams never reach it), evaluates the
+guidance and the controller kernel, and sends a rudder order. On packet loss the last state is
+**held**; once no valid state has arrived for ``watchdog_timeout`` (default 1 s) the state is no
+longer used: the ``link`` alarm is raised and the **safe action** is ordered (``midships`` or
+``hold`` the last order). The **off-course** alarm is raised when ``|wrap(psi - psi_set)|``
+exceeds its limit; it is armed only once the heading has come within the limit after a course
+change, so a commanded turn does not trip it.
+
+Guidance: a set course (``--heading``; ``course_reference`` slews the reference at the turn-rate
+limit), a route (bearing to the next waypoint, :mod:`steerlab.runtime.route`) or a chart
+plotter's APB/RMB/XTE sentences (:mod:`steerlab.runtime.nmea`). The heading may come from
+NMEA HDT/THS instead of the state datagram.
+
+Clock: ship time ``t = speedup * (wall time since start)``; all periods and timeouts are in
+ship seconds (freshness limits on datagram stamps are in wall seconds).
+"""
+
+from __future__ import annotations
+
+import asyncio
+import csv
+import math
+import time
+from collections import deque
+from dataclasses import dataclass
+
+import numpy as np
+
+from steerlab.angles import wrap_to_2pi, wrap_to_pi
+from steerlab.errors import InputError, require_finite_range
+from steerlab.guidance.reference_models import course_reference, course_schedule
+from steerlab.runtime import protocol as P
+from steerlab.runtime.alarms import LINK, OFF_COURSE, AlarmBoard
+from steerlab.runtime.link_filter import LinkFilter
+from steerlab.runtime.udp import LOOPBACK, open_udp, send
+from steerlab.units import deg, rad
+
+SAFE_ACTIONS = ("midships", "hold")
+
+LOG_COLUMNS = ("t", "wall", "t_sim", "state_age", "link_ok", "mode", "psi_deg", "r_deg_s",
+               "delta_deg", "u", "x_n", "y_e", "psi_set_deg", "psi_ref_deg", "r_ref_deg_s",
+               "delta_cmd_deg", "heading_source", "alarms", "accepted", "rejected")
+"""CSV log columns (one row per sample; ship time ``t`` [s], degrees at this edge)."""
+
+
+@dataclass(frozen=True)
+class AutopilotConfig:
+    sample_time: float = 0.125          #: controller sample time [s]
+    speedup: float = 1.0                #: ship seconds per wall second (match the server's)
+    watchdog_timeout: float = 1.0       #: no valid state for longer: alarm + safe action [s]
+    safe_action: str = "midships"       #: "midships" or "hold"
+    off_course_limit: float = rad(10.0)  #: off-course alarm limit [rad]
+    turn_rate: float = 0.0              #: reference turn-rate limit [rad/s]; 0: step
+    max_age: float = 0.5                #: freshness limit on state stamps [wall s]; 0: off
+    hello_period: float = 0.5           #: subscription refresh [s]
+    rpm_cmd: float = math.nan           #: propeller order [rpm]; NaN: leave the ship's
+    nmea_timeout: float = 2.0           #: NMEA heading/course older than this is not used [s]
+    xte_lookahead: float = 500.0        #: cross-track correction lookahead for RMB/XTE [m]
+
+    def validate(self) -> "AutopilotConfig":
+        require_finite_range("--sample-time", self.sample_time, 0.001, 60.0)
+        require_finite_range("--speedup", self.speedup, 0.01, 1000.0)
+        require_finite_range("--watchdog", self.watchdog_timeout, 0.0, 3600.0, lo_open=True)
+        if self.safe_action not in SAFE_ACTIONS:
+            raise InputError("--safe-action", f"must be one of {SAFE_ACTIONS}, got {self.safe_action!r}")
+        require_finite_range("--off-course-deg", self.off_course_limit, 0.0, math.pi, lo_open=True)
+        require_finite_range("--turn-rate", self.turn_rate, 0.0, 1.0)
+        require_finite_range("--max-age", self.max_age, 0.0, 3600.0)
+        if not math.isnan(self.rpm_cmd):
+            require_finite_range("--rpm", self.rpm_cmd, 0.0, 1000.0, lo_open=True)
+        require_finite_range("--xte-lookahead", self.xte_lookahead, 1.0, 1e5)
+        return self
+
+
+class Autopilot:
+    """The client. ``sample(t)`` is the whole per-sample logic (no sockets); ``run`` adds I/O.
+
+    Parameters
+    ----------
+    controller : steerlab.runtime.controller_runtime.ControllerRuntime
+    connect : (host, port)
+        The ship server.
+    heading : float or None
+        Initial set course [rad]; None: the heading at engagement (or the route's course).
+    route : steerlab.runtime.route.Route or None
+    key : bytes or None
+        HMAC key (states must be signed; commands are signed).
+    log_path : path or None
+        CSV log, one row per sample (:data:`LOG_COLUMNS`).
+    engaged : bool
+        Start engaged (else standby: no rudder orders are sent).
+    nmea_listen, signalk_listen : (host, port) or None
+        UDP ports for NMEA 0183 sentences (HDT/THS heading; APB/RMB/XTE route) and Signal K
+        deltas (``steering.autopilot.target.headingTrue``, ``steering.autopilot.state``).
+    signalk_to, nmea_to : (host, port) or None
+        Where to send the autopilot's Signal K delta / NMEA HTD sentence each sample.
+    """
+
+    def __init__(self, controller, connect, config: AutopilotConfig = AutopilotConfig(),
+                 heading=None, route=None, key=None, log_path=None, engaged=True,
+                 nmea_listen=None, signalk_listen=None, signalk_to=None, nmea_to=None, bind=None):
+        self.ctrl = controller
+        self.connect = connect
+        self.config = cfg = config.validate()
+        if abs(cfg.sample_time - controller.h) > 1e-12:
+            raise InputError("--sample-time", "differs from the controller's sample time")
+        self.route = route
+        self.key = key
+        self.sender = P.Sender(key)
+        # states come at 20/s of ship time; allow 5x that per source before rate limiting
+        self.filter = LinkFilter(P.TYPE_STATE, key=key, max_age=cfg.max_age,
+                                 rate=100.0 * cfg.speedup, burst=50.0)
+        self.log_path = log_path
+        self.alarms = AlarmBoard()
+        self.psi_set = None if heading is None else wrap_to_pi(float(heading))
+        self.gd = None
+        self.ref = np.zeros(2)
+        self.want_engaged = bool(engaged)
+        self.engaged = False           # controlling (engaged and reset on a valid state)
+        self.off_course_armed = False
+        self.latest: P.State | None = None
+        self.latest_t = -math.inf
+        self.last_cmd = 0.0
+        self.cmd_sent = None
+        self.mode = "standby"
+        self.samples = 0
+        self.nmea_heading = None       # (psi [rad], t)
+        self.nmea_course = None        # (psi_set [rad], t)
+        self.nmea_counts = {"accepted": 0, "rejected": 0}
+        self.signalk_counts = {"accepted": 0, "rejected": 0}
+        self.track: deque = deque(maxlen=4000)
+        self.last_row: dict = {}
+        self.nmea_listen = nmea_listen
+        self.signalk_listen = signalk_listen
+        self.signalk_to = signalk_to
+        self.nmea_to = nmea_to
+        self.bind = bind or (LOOPBACK if connect[0] in (LOOPBACK, "localhost") else "0.0.0.0", 0)
+        self.transport = None
+        self._t0 = None
+        self._stop = None
+        self._listeners = []
+        self._log_file = None
+        self._log = None
+
+    # ------------------------------------------------------------ clock and inputs
+    def clock(self) -> float:
+        """Ship time [s] since :meth:`run` started."""
+        if self._t0 is None:
+            return 0.0
+        return (time.monotonic() - self._t0) * self.config.speedup
+
+    def on_state_datagram(self, data: bytes, addr=None, t: float | None = None) -> None:
+        msg, _ = self.filter.accept(data, time.time(), addr)
+        if msg is not None:
+            self.latest = msg.body
+            self.latest_t = self.clock() if t is None else t
+
+    def on_nmea_datagram(self, data: bytes, addr=None, t: float | None = None) -> None:
+        from steerlab.runtime.nmea import steering_inputs
+
+        t = self.clock() if t is None else t
+        got = steering_inputs(data, self.config.xte_lookahead)
+        self.nmea_counts["accepted"] += got["accepted"]
+        self.nmea_counts["rejected"] += got["rejected"]
+        if got["heading"] is not None:
+            self.nmea_heading = (got["heading"], t)
+        if got["course"] is not None:
+            self.nmea_course = (got["course"], t)
+
+    def on_signalk_datagram(self, data: bytes, addr=None, t: float | None = None) -> None:
+        from steerlab.runtime.signalk import parse_delta
+
+        t = self.clock() if t is None else t
+        values = parse_delta(data)
+        if values is None:
+            self.signalk_counts["rejected"] += 1
+            return
+        self.signalk_counts["accepted"] += 1
+        target = values.get("steering.autopilot.target.headingTrue")
+        if isinstance(target, (int, float)) and math.isfinite(target):
+            self.set_course(float(target), t)
+        state = values.get("steering.autopilot.state")
+        if state == "auto":
+            self.engage(t)
+        elif state == "standby":
+            self.standby(t)
+
+    # ------------------------------------------------------------ operator actions
+    def set_course(self, psi: float, t: float) -> None:
+        """New set course [rad]; the reference slews to it at the turn-rate limit."""
+        psi = wrap_to_pi(float(psi))
+        if self.psi_set is not None and abs(wrap_to_pi(psi - self.psi_set)) < 1e-9 and self.gd is not None:
+            return
+        self.psi_set = psi
+        start = self.ref[0] if self.gd is not None else psi
+        if self.gd is None and self.latest is not None:
+            start = self.latest.psi
+        self.gd = course_schedule(float(start), [(max(t, 0.0), psi)], self.config.turn_rate)
+        self.off_course_armed = False
+
+    def adjust(self, ddeg: float, t: float) -> None:
+        """Change the set course by ``ddeg`` degrees (the bridge page's ±1/±10 buttons)."""
+        base = self.psi_set if self.psi_set is not None else (self.latest.psi if self.latest else 0.0)
+        self.set_course(base + rad(float(ddeg)), t)
+
+    def engage(self, t: float) -> None:
+        self.want_engaged = True
+
+    def standby(self, t: float) -> None:
+        self.want_engaged = False
+        self.engaged = False
+
+    def acknowledge(self, t: float, name: str | None = None) -> None:
+        self.alarms.acknowledge(t, name)
+
+    # ------------------------------------------------------------ one sample
+    def _heading(self, t: float):
+        if self.nmea_heading is not None and t - self.nmea_heading[1] <= self.config.nmea_timeout:
+            return self.nmea_heading[0], "nmea"
+        return self.latest.psi, "state"
+
+    def sample(self, t: float, now: float | None = None) -> dict:
+        """Run one sample at ship time ``t`` (the clock reads ``now``, default ``t``).
+
+        Returns the log row; the order is in ``cmd_sent`` (None: nothing to send).
+        """
+        cfg = self.config
+        st = self.latest
+        age = (t if now is None else now) - self.latest_t
+        link_ok = st is not None and age <= cfg.watchdog_timeout
+        self.alarms.set(LINK, not link_ok and (st is not None or t > cfg.watchdog_timeout), t,
+                        f"no valid ship state for more than {cfg.watchdog_timeout:g} s")
+        cmd = None
+        psi = src = None
+        if link_ok:
+            psi, src = self._heading(t)
+            x = self.ctrl.measured_state(st.x_n, st.y_e, psi, st.u, st.v, st.r, st.delta)
+            self.track.append((st.x_n, st.y_e))
+            if self.route is not None:
+                c = self.route.set_course(st.x_n, st.y_e)
+                if c is not None:
+                    self.set_course(c, t)
+            if self.nmea_course is not None and t - self.nmea_course[1] <= cfg.nmea_timeout:
+                self.set_course(self.nmea_course[0], t)
+            if self.psi_set is None:
+                self.set_course(psi, t)
+            if self.gd is None:
+                self.set_course(self.psi_set, t)
+            course_reference(t, self.gd, self.ref)
+            if self.want_engaged and not self.engaged:
+                self.ctrl.reset(x, self.ref)
+                self.engaged = True
+            if self.engaged:
+                cmd = self.ctrl.update(t, x, self.ref)
+                self.mode = "auto"
+            else:
+                self.mode = "standby"
+            dev = abs(wrap_to_pi(psi - self.psi_set))
+            if dev <= cfg.off_course_limit and abs(wrap_to_pi(self.ref[0] - self.psi_set)) < 1e-6:
+                self.off_course_armed = True
+            self.alarms.set(OFF_COURSE, self.off_course_armed and dev > cfg.off_course_limit, t,
+                            f"heading off the set course by more than {deg(cfg.off_course_limit):g} deg")
+        elif self.want_engaged:
+            cmd = 0.0 if cfg.safe_action == "midships" else self.last_cmd
+            self.mode = "safe"
+            self.engaged = False          # reset the controller on the next valid state
+        else:
+            self.mode = "standby"
+        if cmd is not None:
+            self.last_cmd = cmd
+        self.cmd_sent = cmd
+        self.samples += 1
+        row = {
+            "t": t, "wall": time.time(), "t_sim": st.t_sim if st else math.nan,
+            "state_age": age if st else math.nan, "link_ok": int(link_ok), "mode": self.mode,
+            "psi_deg": deg(psi) if psi is not None else math.nan,
+            "r_deg_s": deg(st.r) if link_ok else math.nan,
+            "delta_deg": deg(st.delta) if link_ok else math.nan,
+            "u": st.u if link_ok else math.nan,
+            "x_n": st.x_n if link_ok else math.nan, "y_e": st.y_e if link_ok else math.nan,
+            "psi_set_deg": deg(self.psi_set) if self.psi_set is not None else math.nan,
+            "psi_ref_deg": deg(self.ref[0]) if self.gd is not None else math.nan,
+            "r_ref_deg_s": deg(self.ref[1]) if self.gd is not None else math.nan,
+            "delta_cmd_deg": deg(cmd) if cmd is not None else math.nan,
+            "heading_source": src or "",
+            "alarms": ";".join(a["name"] for a in self.alarms.snapshot() if a["active"]),
+            "accepted": self.filter.counts["accepted"], "rejected": self.filter.rejected(),
+        }
+        self.last_row = row
+        return row
+
+    def order(self):
+        """The datagram body for the last sample's order, or None (standby: nothing sent)."""
+        if self.cmd_sent is None:
+            return None
+        mode = (P.MODE_ENGAGED if self.mode == "auto" else 0) | (P.MODE_SAFE if self.mode == "safe" else 0)
+        return P.Command(self.cmd_sent, self.config.rpm_cmd, mode)
+
+    def status(self) -> dict:
+        """Everything the bridge page shows (SI; the page converts to degrees)."""
+        st = self.latest
+        r = self.last_row
+        return {
+            "t": r.get("t", 0.0), "mode": self.mode, "link_ok": bool(r.get("link_ok", 0)),
+            "state_age": r.get("state_age"),
+            "heading": None if st is None else wrap_to_2pi(st.psi),
+            "set_course": None if self.psi_set is None else wrap_to_2pi(self.psi_set),
+            "reference": None if self.gd is None else wrap_to_2pi(float(self.ref[0])),
+            "yaw_rate": None if st is None else st.r, "rudder": None if st is None else st.delta,
+            "rudder_cmd": self.cmd_sent, "speed": None if st is None else st.u,
+            "position": None if st is None else [st.x_n, st.y_e],
+            "alarms": self.alarms.snapshot(), "controller": self.ctrl.name,
+            "link": {k: v for k, v in self.filter.counts.items()},
+            "route": [list(w) for w in self.route.waypoints] if self.route else [],
+            "off_course_limit": self.config.off_course_limit,
+            "ship_status": None if st is None else st.status,
+        }
+
+    # ------------------------------------------------------------ I/O
+    def _send_order(self, t: float) -> None:
+        body = self.order()
+        if body is not None:
+            send(self.transport, self.sender.pack(body, time.time()), self.connect)
+        if self.nmea_to is not None:
+            from steerlab.runtime.nmea import htd_sentence
+
+            line = htd_sentence(self.psi_set, self.cmd_sent, self.latest.psi if self.latest else None,
+                                self.ctrl.delta_max, self.config.off_course_limit,
+                                self.alarms.active(OFF_COURSE))
+            send(self.transport, line.encode("ascii"), self.nmea_to)
+        if self.signalk_to is not None:
+            from steerlab.runtime.signalk import autopilot_delta_json
+
+            send(self.transport, autopilot_delta_json(self, time.time()).encode(), self.signalk_to)
+
+    def _open_log(self):
+        if self.log_path is None:
+            return
+        try:
+            self._log_file = open(self.log_path, "w", newline="", encoding="utf-8")
+        except OSError as err:
+            raise InputError("--log", f"cannot write {str(self.log_path)!r}: {err.strerror}") from None
+        self._log = csv.DictWriter(self._log_file, fieldnames=LOG_COLUMNS)
+        self._log.writeheader()
+
+    def _write_log(self, row: dict) -> None:
+        if self._log is not None:
+            self._log.writerow({k: (f"{v:.6g}" if isinstance(v, float) else v) for k, v in row.items()})
+            if self.samples % 16 == 0:
+                self._log_file.flush()
+
+    def stop(self) -> None:
+        if self._stop is not None:
+            self._stop.set()
+
+    async def run(self, duration: float = 0.0, started=None) -> "Autopilot":
+        """Sample until ``duration`` ship seconds (0: until :meth:`stop`)."""
+        loop = asyncio.get_running_loop()
+        self._stop = asyncio.Event()
+        self._open_log()
+        try:
+            self.transport = await open_udp(self.on_state_datagram, self.bind)
+            for addr, cb, field in ((self.nmea_listen, self.on_nmea_datagram, "--nmea-listen"),
+                                    (self.signalk_listen, self.on_signalk_datagram, "--signalk-listen")):
+                if addr is not None:
+                    try:
+                        self._listeners.append(await open_udp(cb, addr))
+                    except OSError as err:
+                        raise InputError(field, f"cannot bind {addr[0]}:{addr[1]}: {err.strerror}") from None
+            self._t0 = time.monotonic()
+            if started is not None:
+                started(self)
+            cfg = self.config
+            wall_h = cfg.sample_time / cfg.speedup
+            hello_every = max(1, round(cfg.hello_period / cfg.sample_time))
+            t_start = loop.time()
+            k = 0
+            while not self._stop.is_set():
+                t = k * cfg.sample_time
+                if duration > 0 and t > duration + 1e-9:
+                    break
+                if k % hello_every == 0:
+                    send(self.transport, self.sender.pack(P.Hello(), time.time()), self.connect)
+                row = self.sample(t, self.clock())
+                self._send_order(t)
+                self._write_log(row)
+                k += 1
+                delay = t_start + k * wall_h - loop.time()
+                await asyncio.sleep(max(0.0, delay))
+        finally:
+            for tr in [self.transport, *self._listeners]:
+                if tr is not None:
+                    tr.close()
+            if self._log_file is not None:
+                self._log_file.close()
+        return self

@@ -1,0 +1,92 @@
+"""Signal K delta messages (JSON, SI units) for the ship state and the autopilot.
+
+Paths (Signal K specification, ``vessels.self`` context; radians, rad/s, m/s)::
+
+    navigation.headingTrue                   psi wrapped to [0, 2 pi)
+    navigation.rateOfTurn                    r (> 0 to starboard)
+    navigation.speedThroughWater             u
+    steering.rudderAngle                     delta (> 0 turns to starboard, as steerlab)
+    steering.rudderAngleTarget               the rudder order in effect / commanded
+    steering.autopilot.target.headingTrue    the set course
+    steering.autopilot.state                 "auto" | "standby" | "alarm"
+
+A delta is ``{"context": "vessels.self", "updates": [{"source": {...}, "timestamp": ISO 8601,
+"values": [{"path": ..., "value": ...}, ...]}]}``, one JSON document per UDP datagram (or
+WebSocket message). :func:`parse_delta` accepts exactly that shape and returns ``{path: value}``
+or None (never raises).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import time
+
+from steerlab.angles import wrap_to_2pi
+
+SOURCE = {"label": "steerlab", "type": "steerlab-runtime"}
+MAX_DELTA_BYTES = 65536
+
+
+def iso_time(wall: float) -> str:
+    return time.strftime("%Y-%m-%dT%H:%M:%S", time.gmtime(wall)) + f".{int((wall % 1) * 1000):03d}Z"
+
+
+def delta(values: dict, wall: float | None = None) -> dict:
+    """A delta message for ``{path: value}`` (None values are left out)."""
+    wall = time.time() if wall is None else wall
+    return {"context": "vessels.self",
+            "updates": [{"source": SOURCE, "timestamp": iso_time(wall),
+                         "values": [{"path": p, "value": v} for p, v in values.items() if v is not None]}]}
+
+
+def state_values(state) -> dict:
+    return {"navigation.headingTrue": wrap_to_2pi(state.psi), "navigation.rateOfTurn": state.r,
+            "navigation.speedThroughWater": state.u, "steering.rudderAngle": state.delta,
+            "steering.rudderAngleTarget": state.delta_cmd}
+
+
+def state_delta_json(state, wall: float | None = None) -> str:
+    return json.dumps(delta(state_values(state), wall))
+
+
+def autopilot_values(ap) -> dict:
+    mode = ap.mode
+    return {"steering.autopilot.state": "alarm" if mode == "safe" else mode,
+            "steering.autopilot.target.headingTrue": None if ap.psi_set is None else wrap_to_2pi(ap.psi_set),
+            "steering.rudderAngleTarget": ap.cmd_sent}
+
+
+def autopilot_delta_json(ap, wall: float | None = None) -> str:
+    return json.dumps(delta(autopilot_values(ap), wall))
+
+
+def parse_delta(data) -> dict | None:
+    """``{path: value}`` from a delta message (bytes or str), or None if it is not one."""
+    try:
+        if isinstance(data, (bytes, bytearray)):
+            if len(data) > MAX_DELTA_BYTES:
+                return None
+            data = bytes(data).decode("utf-8")
+        if len(data) > MAX_DELTA_BYTES:
+            return None
+        msg = json.loads(data)
+        if not isinstance(msg, dict) or not isinstance(msg.get("updates"), list):
+            return None
+        ctx = msg.get("context", "vessels.self")
+        if ctx not in ("vessels.self",) and not (isinstance(ctx, str) and ctx.startswith("vessels.")):
+            return None
+        out = {}
+        for upd in msg["updates"]:
+            if not isinstance(upd, dict) or not isinstance(upd.get("values"), list):
+                return None
+            for v in upd["values"]:
+                if not isinstance(v, dict) or not isinstance(v.get("path"), str) or "value" not in v:
+                    return None
+                val = v["value"]
+                if isinstance(val, float) and not math.isfinite(val):
+                    return None
+                out[v["path"]] = val
+        return out
+    except (ValueError, TypeError, RecursionError, UnicodeDecodeError):
+        return None

@@ -1,0 +1,113 @@
+// steerlab bridge page: WebSocket status in, actions out. SI from the server; degrees here.
+"use strict";
+(function () {
+  const DEG = 180 / Math.PI;
+  const $ = (id) => document.getElementById(id);
+  const fmt = (x, unit, nd = 1) => (x === null || x === undefined) ? "-" : (x.toFixed(nd) + unit);
+  const fmtDeg = (rad, nd = 1) => (rad === null || rad === undefined) ? "-" : ((rad * DEG + 360) % 360).toFixed(nd) + "\u00b0";
+  let ws = null;
+  let track = [];
+  let lastT = null;
+
+  // compass ticks every 10 degrees, labels every 30
+  const ticks = $("ticks");
+  const NS = "http://www.w3.org/2000/svg";
+  for (let d = 0; d < 360; d += 10) {
+    const a = d / DEG, long = d % 30 === 0;
+    const l = document.createElementNS(NS, "line");
+    l.setAttribute("x1", Math.sin(a) * 100); l.setAttribute("y1", -Math.cos(a) * 100);
+    l.setAttribute("x2", Math.sin(a) * (long ? 88 : 94)); l.setAttribute("y2", -Math.cos(a) * (long ? 88 : 94));
+    l.setAttribute("stroke", "#9ab"); ticks.appendChild(l);
+    if (long) {
+      const t = document.createElementNS(NS, "text");
+      t.setAttribute("x", Math.sin(a) * 74); t.setAttribute("y", -Math.cos(a) * 74 + 4);
+      t.setAttribute("fill", "#9ab"); t.setAttribute("font-size", "10"); t.setAttribute("text-anchor", "middle");
+      t.textContent = d === 0 ? "N" : d === 90 ? "E" : d === 180 ? "S" : d === 270 ? "W" : String(d);
+      ticks.appendChild(t);
+    }
+  }
+
+  function rotate(id, rad) {
+    if (rad === null || rad === undefined) return;
+    $(id).setAttribute("transform", "rotate(" + (rad * DEG) + ")");
+  }
+
+  function drawTrack(s) {
+    if (s.position) {
+      if (lastT !== null && s.t < lastT) track = [];
+      lastT = s.t;
+      const p = s.position;
+      const q = track[track.length - 1];
+      if (!q || Math.hypot(q[0] - p[0], q[1] - p[1]) > 1) track.push(p);
+      if (track.length > 3000) track.shift();
+    }
+    const pts = track.concat(s.route || []);
+    if (!pts.length) return;
+    let xmin = Infinity, xmax = -Infinity, ymin = Infinity, ymax = -Infinity;
+    for (const [x, y] of pts) { xmin = Math.min(xmin, x); xmax = Math.max(xmax, x); ymin = Math.min(ymin, y); ymax = Math.max(ymax, y); }
+    const span = Math.max(xmax - xmin, ymax - ymin, 200) * 1.1;
+    const cx = (xmin + xmax) / 2, cy = (ymin + ymax) / 2;
+    const toSvg = ([x, y]) => [150 + (y - cy) / span * 300, 150 - (x - cx) / span * 300];  // east right, north up
+    const poly = (arr) => arr.map(toSvg).map(([a, b]) => a.toFixed(1) + "," + b.toFixed(1)).join(" ");
+    $("track-line").setAttribute("points", poly(track));
+    $("route-line").setAttribute("points", poly(s.route || []));
+    if (track.length) {
+      const [a, b] = toSvg(track[track.length - 1]);
+      $("ship-dot").setAttribute("cx", a); $("ship-dot").setAttribute("cy", b);
+    }
+  }
+
+  function show(s) {
+    $("mode").textContent = s.mode;
+    $("mode").className = "badge " + s.mode;
+    $("link").textContent = s.link_ok ? "link OK" : "link LOST";
+    $("link").className = "badge " + (s.link_ok ? "ok" : "bad");
+    $("controller").textContent = "controller: " + s.controller + "   t = " + fmt(s.t, " s", 1);
+    $("heading").textContent = fmtDeg(s.heading);
+    $("set-course").textContent = fmtDeg(s.set_course);
+    $("reference").textContent = fmtDeg(s.reference);
+    $("yaw-rate").textContent = s.yaw_rate === null ? "-" : fmt(s.yaw_rate * DEG * 60, " \u00b0/min", 1);
+    $("speed").textContent = s.speed === null ? "-" : fmt(s.speed / 0.514444, " kn", 1);
+    $("rudder-angle").textContent = s.rudder === null ? "-" : fmt(s.rudder * DEG, "\u00b0", 1);
+    $("rudder-order").textContent = s.rudder_cmd === null ? "-" : fmt(s.rudder_cmd * DEG, "\u00b0", 1);
+    rotate("ship-needle", s.heading);
+    rotate("set-marker", s.set_course);
+    rotate("ref-marker", s.reference);
+    const r = s.rudder === null ? 0 : Math.max(-35, Math.min(35, s.rudder * DEG)) / 35 * 100;
+    $("rudder-bar").setAttribute("x", Math.min(0, r)); $("rudder-bar").setAttribute("width", Math.abs(r));
+    const c = s.rudder_cmd === null ? 0 : Math.max(-35, Math.min(35, s.rudder_cmd * DEG)) / 35 * 100;
+    $("rudder-cmd").setAttribute("x1", c); $("rudder-cmd").setAttribute("x2", c);
+    const ul = $("alarms");
+    ul.textContent = "";
+    if (!s.alarms.length) { const li = document.createElement("li"); li.className = "muted"; li.textContent = "none"; ul.appendChild(li); }
+    for (const a of s.alarms) {
+      const li = document.createElement("li");
+      li.className = (a.active ? "active" : "") + (a.acknowledged ? "" : " unack");
+      li.textContent = a.name + ": " + a.message + (a.active ? "" : " (cleared)") + (a.acknowledged ? " - acknowledged" : "");
+      li.dataset.alarm = a.name;
+      ul.appendChild(li);
+    }
+    const k = s.link || {};
+    $("counts").textContent = "states accepted " + (k.accepted || 0) + ", rejected " +
+      Object.entries(k).filter(([n]) => n !== "accepted").reduce((acc, [, v]) => acc + v, 0);
+    drawTrack(s);
+  }
+
+  function send(obj) { if (ws && ws.readyState === 1) ws.send(JSON.stringify(obj)); }
+
+  function connect() {
+    ws = new WebSocket((location.protocol === "https:" ? "wss://" : "ws://") + location.host + "/ws");
+    ws.onmessage = (ev) => {
+      const m = JSON.parse(ev.data);
+      if (m.type === "status") show(m);
+      else if (m.type === "reply") $("reply").textContent = m.ok ? ("ok: " + m.action) : ("refused: " + m.error);
+    };
+    ws.onclose = () => { $("link").textContent = "page disconnected"; $("link").className = "badge bad"; setTimeout(connect, 1000); };
+  }
+
+  $("engage").onclick = () => send({ action: "engage" });
+  $("standby").onclick = () => send({ action: "standby" });
+  $("ack").onclick = () => send({ action: "ack" });
+  for (const b of document.querySelectorAll("[data-adjust]")) b.onclick = () => send({ action: "adjust", deg: Number(b.dataset.adjust) });
+  connect();
+})();

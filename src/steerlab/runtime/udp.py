@@ -1,0 +1,67 @@
+"""asyncio UDP endpoints and ``HOST:PORT`` parsing for the runtime (loopback by default)."""
+
+from __future__ import annotations
+
+import asyncio
+import ipaddress
+
+from steerlab.errors import InputError
+
+LOOPBACK = "127.0.0.1"
+
+
+def parse_hostport(text: str, field: str, default_host: str = LOOPBACK) -> tuple[str, int]:
+    """``"HOST:PORT"``, ``":PORT"`` or ``"PORT"`` -> ``(host, port)``; port 0 = any free port."""
+    s = str(text).strip()
+    host, sep, port = s.rpartition(":")
+    if not sep:
+        host, port = "", s
+    host = host.strip("[]") or default_host
+    try:
+        p = int(port)
+    except ValueError:
+        raise InputError(field, f"expected HOST:PORT with PORT in [0, 65535], got {text!r}") from None
+    if not 0 <= p <= 65535:
+        raise InputError(field, f"port must be in [0, 65535], got {p}")
+    if not host or any(c.isspace() for c in host):
+        raise InputError(field, f"bad host in {text!r}")
+    return host, p
+
+
+def is_loopback(host: str) -> bool:
+    """True for 127.0.0.0/8, ::1 and ``localhost``."""
+    if host == "localhost":
+        return True
+    try:
+        return ipaddress.ip_address(host).is_loopback
+    except ValueError:
+        return False
+
+
+class _Protocol(asyncio.DatagramProtocol):
+    def __init__(self, on_datagram):
+        self.on_datagram = on_datagram
+        self.errors = 0
+
+    def datagram_received(self, data, addr):
+        self.on_datagram(data, addr)
+
+    def error_received(self, exc):   # e.g. ICMP port unreachable when a peer is gone
+        self.errors += 1
+
+
+async def open_udp(on_datagram, local_addr=(LOOPBACK, 0), remote_addr=None):
+    """A bound UDP transport calling ``on_datagram(data, addr)`` for each datagram received."""
+    loop = asyncio.get_running_loop()
+    transport, _ = await loop.create_datagram_endpoint(
+        lambda: _Protocol(on_datagram), local_addr=local_addr, remote_addr=remote_addr)
+    return transport
+
+
+def send(transport, data: bytes, addr) -> None:
+    """Fire and forget (a closed transport or unreachable peer is not an error here)."""
+    if transport is not None and not transport.is_closing():
+        try:
+            transport.sendto(data, addr)
+        except OSError:
+            pass

@@ -1,0 +1,148 @@
+"""Autopilot and ship-server safety logic without sockets: watchdog, safe action, alarms, route."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from steerlab.errors import InputError
+from steerlab.runtime import protocol as P
+from steerlab.runtime.alarms import LINK, OFF_COURSE, AlarmBoard
+from steerlab.runtime.autopilot import Autopilot, AutopilotConfig
+from steerlab.runtime.controller_runtime import ControllerRuntime
+from steerlab.runtime.route import Route, load_route
+from steerlab.runtime.ship_server import order_in_effect
+from steerlab.sim.scenario import scenario_from_dict
+
+RUNTIME_SCENARIO = {
+    "name": "runtime-test", "dt": 0.025, "duration": 60.0,
+    "ship": {"model": "nomoto1", "speed_kn": 10.0, "options": {"K": 0.5, "T": 10.0}},
+    "gear": {"rate_max_deg_s": 10.0, "T_sg": 0.5},
+    "controller": {"type": "pid", "Kp": 2.0, "Kd": 8.0, "Ki": 0.0},
+    "guidance": {"psi0_deg": 0.0},
+}
+H = 0.125
+
+
+@pytest.fixture(scope="module")
+def ctrl():
+    return ControllerRuntime(scenario_from_dict(RUNTIME_SCENARIO), "pid", H)
+
+
+def _ap(ctrl, **cfg):
+    return Autopilot(ctrl, ("127.0.0.1", 9), AutopilotConfig(**cfg), heading=0.0)
+
+
+def _feed(ap, t, psi=0.0, r=0.0):
+    ap.latest = P.State(t, 0.0, 0.0, psi, r, 5.0, 0.0, 0.0, math.nan, 0.0, 0)
+    ap.latest_t = t
+
+
+def test_order_in_effect_holds_then_centres():
+    assert order_in_effect(None, 0.3, 1.0, 3.0) == (0.0, P.STATUS_CMD_CENTRED)
+    assert order_in_effect(0.5, 0.3, 1.0, 3.0) == (0.3, 0)
+    assert order_in_effect(1.5, 0.3, 1.0, 3.0) == (0.3, P.STATUS_CMD_HOLD)
+    assert order_in_effect(3.01, 0.3, 1.0, 3.0) == (0.0, P.STATUS_CMD_CENTRED)
+
+
+def test_controller_runtime_is_the_registry_kernel(ctrl):
+    from steerlab.control.pid import pid_update
+
+    assert ctrl.kernel is pid_update and ctrl.h == H
+    assert ctrl.setup.pc.tolist() == [2.0, 0.0, 8.0, math.radians(35.0)]
+    x = ctrl.measured_state(1.0, 2.0, 0.1, 5.0, 0.0, 0.01, 0.02)
+    assert x.shape == (7,) and x[2] == 0.1 and x[-1] == 0.02
+    # same number as the law written out: Kp e - Kd (r - r_ref)
+    assert ctrl.update(0.0, x, np.array([0.2, 0.0])) == pytest.approx(2.0 * 0.1 - 8.0 * 0.01)
+    with pytest.raises(InputError, match="controller.type"):
+        ControllerRuntime(scenario_from_dict(RUNTIME_SCENARIO), "no-such-controller", H)
+
+
+@pytest.mark.parametrize("safe", ["midships", "hold"])
+def test_watchdog_alarm_and_safe_action_after_timeout(ctrl, safe):
+    ap = _ap(ctrl, watchdog_timeout=1.0, safe_action=safe)
+    t = 0.0
+    for k in range(40):                      # 5 s with states: heading 5 deg off -> port rudder
+        t = k * H
+        _feed(ap, t, psi=math.radians(5.0))
+        ap.sample(t)
+    assert ap.mode == "auto" and ap.cmd_sent < 0
+    held = ap.cmd_sent
+    t_last = t
+    rows = [ap.sample(t_last + k * H) for k in range(1, 17)]      # link lost for 2 s
+    for row in rows:
+        age = row["t"] - t_last
+        if age <= 1.0:                                             # state held, still steering
+            assert row["link_ok"] == 1 and row["mode"] == "auto" and "link" not in row["alarms"]
+        else:                                                      # alarm + safe action
+            assert row["link_ok"] == 0 and row["mode"] == "safe" and "link" in row["alarms"]
+            assert row["delta_cmd_deg"] == (0.0 if safe == "midships" else pytest.approx(math.degrees(held)))
+    assert ap.alarms.first_raised(LINK) == pytest.approx(t_last + 9 * H)   # first sample with age > 1 s
+    _feed(ap, t_last + 2.5)                                        # link back: steering resumes
+    assert ap.sample(t_last + 2.5)["mode"] == "auto" and not ap.alarms.active(LINK)
+    assert ap.alarms.alarms[LINK].acknowledged is False            # stays listed until acknowledged
+    ap.acknowledge(t_last + 3.0)
+    assert LINK not in ap.alarms.alarms
+
+
+def test_no_state_at_start_raises_link_alarm_after_timeout(ctrl):
+    ap = _ap(ctrl, watchdog_timeout=0.5)
+    assert ap.sample(0.25)["alarms"] == "" and ap.sample(0.625)["alarms"] == "link"
+    assert ap.cmd_sent == 0.0 and ap.mode == "safe"
+
+
+def test_off_course_alarm_armed_only_after_reaching_the_course(ctrl):
+    ap = _ap(ctrl, off_course_limit=math.radians(10.0))
+    ap.set_course(math.radians(30.0), 0.0)      # 30 deg away: turning, no alarm yet
+    _feed(ap, 0.0)
+    assert ap.sample(0.0)["alarms"] == ""
+    _feed(ap, 1.0, psi=math.radians(25.0))       # within the limit: armed
+    assert ap.sample(1.0)["alarms"] == "" and ap.off_course_armed
+    _feed(ap, 2.0, psi=math.radians(15.0))       # 15 deg off: alarm
+    assert ap.sample(2.0)["alarms"] == OFF_COURSE
+    ap.adjust(-10.0, 2.1)                        # new set course disarms it
+    _feed(ap, 2.2, psi=math.radians(-5.0))
+    assert ap.sample(2.2)["alarms"] == ""
+    assert [w for _, n, w in ap.alarms.history] == ["raised", "cleared"]
+
+
+def test_standby_sends_nothing_and_engage_resets_the_controller(ctrl):
+    ap = Autopilot(ctrl, ("127.0.0.1", 9), AutopilotConfig(), heading=None, engaged=False)
+    _feed(ap, 0.0, psi=math.radians(40.0))
+    ap.sample(0.0)
+    assert ap.mode == "standby" and ap.order() is None
+    assert ap.psi_set == pytest.approx(math.radians(40.0))       # set course = heading at start
+    ap.engage(0.1)
+    ap.sample(0.125)
+    body = ap.order()
+    assert ap.mode == "auto" and body.mode == P.MODE_ENGAGED and body.delta_cmd == pytest.approx(0.0)
+
+
+def test_alarm_board_semantics():
+    b = AlarmBoard()
+    b.set("x", True, 1.0, "m")
+    b.set("x", True, 2.0, "m")                 # still active: not raised twice
+    b.acknowledge(3.0)
+    assert b.active("x") and b.alarms["x"].acknowledged
+    b.set("x", False, 4.0)                     # acknowledged and cleared: gone
+    assert "x" not in b.alarms
+    assert [w for _, _, w in b.history] == ["raised", "acknowledged", "cleared"]
+
+
+def test_route_bearing_and_waypoint_switching(tmp_path):
+    r = Route([(1000.0, 0.0), (1000.0, 1000.0)], accept_radius=100.0)
+    assert r.set_course(0.0, 0.0) == pytest.approx(0.0)              # due north
+    assert r.set_course(950.0, 0.0) == pytest.approx(math.atan2(1000.0, 50.0))  # wp 1 reached: to wp 2
+    assert r.set_course(1000.0, 950.0) == pytest.approx(math.atan2(1000.0, 50.0))  # last reached: keep
+    assert r.finished
+    f = tmp_path / "route.csv"
+    f.write_text("x_n,y_e\n0,0\n-500,10\n")
+    assert load_route(f) == [(0.0, 0.0), (-500.0, 10.0)]
+    f.write_text("a,b\n1,2\n")
+    with pytest.raises(InputError, match="--route"):
+        load_route(f)
+    f.write_text("x_n,y_e\n1,nan\n")
+    with pytest.raises(InputError, match="line 2"):
+        load_route(f)

@@ -1,0 +1,106 @@
+"""serve-ship and autopilot commands: bad input (exit 2, one line) and one real run of both."""
+
+from __future__ import annotations
+
+import csv
+import pytest
+
+from steerlab.cli import main
+
+SCENARIO_TOML = """
+name = "cli-runtime"
+dt = 0.025
+duration = 60.0
+[ship]
+model = "nomoto1"
+speed_kn = 10.0
+options = { K = 0.5, T = 10.0 }
+[gear]
+rate_max_deg_s = 10.0
+T_sg = 0.5
+[controller]
+type = "pid"
+Kp = 2.0
+Kd = 8.0
+Ki = 0.0
+"""
+
+
+@pytest.mark.parametrize("argv, field", [
+    (["serve-ship", "--bind", "0.0.0.0:47110"], "--bind"),
+    (["serve-ship", "--bind", "127.0.0.1:notaport"], "--bind"),
+    (["serve-ship", "--key-env", "STEERLAB_TEST_UNSET_VAR"], "--key-env"),
+    (["serve-ship", "--origin", "95,0"], "--origin"),
+    (["serve-ship", "no-such-file.toml"], "scenario"),
+    (["autopilot", "--connect", "127.0.0.1:0"], "--connect"),
+    (["autopilot", "--connect", "127.0.0.1:70000"], "--connect"),
+    (["autopilot", "--connect", "127.0.0.1:47110", "--controller", "nope"], "controller.type"),
+    (["autopilot", "--connect", "127.0.0.1:47110", "--route", "missing.csv"], "--route"),
+    (["autopilot", "--connect", "127.0.0.1:47110", "--heading", "nan"], "--heading"),
+    (["autopilot", "--connect", "127.0.0.1:47110", "--watchdog", "-1"], "--watchdog"),
+])
+def test_bad_input_one_line_exit_2(argv, field, capsys, monkeypatch):
+    monkeypatch.delenv("STEERLAB_TEST_UNSET_VAR", raising=False)
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("steerlab: error: ") and field in err[0]
+
+
+def _free_port() -> int:
+    import socket
+
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def _wait_for_ship(port: int, limit_s: float = 120.0) -> bool:
+    """Send HELLOs until the ship server answers with a valid state (it compiles first)."""
+    import socket
+    import time
+
+    from steerlab.runtime import protocol as P
+
+    sender = P.Sender()
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as s:
+        s.settimeout(0.2)
+        end = time.monotonic() + limit_s
+        while time.monotonic() < end:
+            s.sendto(sender.pack(P.Hello(), time.time()), ("127.0.0.1", port))
+            try:
+                data, _ = s.recvfrom(1024)
+            except (socket.timeout, ConnectionRefusedError):
+                continue
+            if P.decode(data)[1] == "ok":
+                return True
+    return False
+
+
+def test_serve_ship_and_autopilot_commands_run_together(tmp_path, capsys):
+    """Both commands, in-process (no second interpreter to start and compile), real sockets."""
+    import threading
+
+    sc = tmp_path / "rt.toml"
+    sc.write_text(SCENARIO_TOML)
+    log = tmp_path / "log.csv"
+    port = _free_port()
+    codes = {}
+    server = threading.Thread(target=lambda: codes.update(server=main(
+        ["serve-ship", str(sc), "--bind", f"127.0.0.1:{port}", "--speedup", "10", "--duration", "30"])))
+    server.start()
+    try:
+        assert _wait_for_ship(port)
+        codes["autopilot"] = main(["autopilot", "--connect", f"127.0.0.1:{port}", "--scenario", str(sc),
+                                   "--controller", "pid", "--heading", "10", "--speedup", "10",
+                                   "--duration", "20", "--log", str(log)])
+    finally:
+        server.join(timeout=120)
+    assert codes == {"server": 0, "autopilot": 0}
+    err = capsys.readouterr().err
+    assert f"on 127.0.0.1:{port}" in err and "autopilot: 161 samples, mode auto" in err
+    with open(log, newline="") as f:
+        rows = list(csv.DictReader(f))
+    assert len(rows) == 161
+    late = [r for r in rows if float(r["t"]) > 15.0]
+    assert all(r["link_ok"] == "1" and r["mode"] == "auto" for r in late)
+    assert max(abs(float(r["psi_deg"]) - 10.0) for r in late) < 1.0
