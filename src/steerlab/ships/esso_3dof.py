@@ -41,7 +41,6 @@ import numba
 import numpy as np
 
 from steerlab.environment.channels import W_RUDDER
-from steerlab.trig import sincos
 
 
 class EssoTable2(NamedTuple):
@@ -146,7 +145,8 @@ def esso_rhs(t, x, delta, w, p, dx):
     r = x[5]
     d = delta + w[W_RUDDER]
     au = abs(u)
-    s, c = sincos(psi)
+    c = math.cos(psi)
+    s = math.sin(psi)
     dx[0] = u * c - v * s
     dx[1] = u * s + v * c
     dx[2] = r

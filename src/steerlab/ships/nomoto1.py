@@ -21,13 +21,14 @@ In a scenario::
 
 from __future__ import annotations
 
+import math
+
 import numba
 import numpy as np
 from pydantic import Field, field_validator
 
 from steerlab.config_base import FrozenConfig
 from steerlab.environment.channels import W_RUDDER
-from steerlab.trig import sincos
 
 P_K, P_T = 0, 1
 N_PARAMS = 2
@@ -39,9 +40,8 @@ def nomoto1_rhs(t, x, delta, w, p, dx):
     psi = x[2]
     u = x[3]
     r = x[5]
-    s, c = sincos(psi)
-    dx[0] = u * c
-    dx[1] = u * s
+    dx[0] = u * math.cos(psi)
+    dx[1] = u * math.sin(psi)
     dx[2] = r
     dx[3] = 0.0
     dx[4] = 0.0
