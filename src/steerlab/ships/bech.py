@@ -40,9 +40,10 @@ import numpy as np
 from pydantic import Field
 
 from steerlab.config_base import FrozenConfig
-from steerlab.environment.channels import W_CURRENT_DIR, W_CURRENT_SPEED, W_RUDDER, W_YAW_MOMENT
+from steerlab.environment.channels import W_RUDDER, W_YAW_MOMENT
 from steerlab.ships.nomoto2 import N_STATES, STATE_NAMES, STATE_UNITS
 from steerlab.ships.spiral_polynomial import spiral_polynomial
+from steerlab.ships.kinematics import earth_velocity
 
 P_A, P_B, P_T3, P_C0, P_C1, P_C2, P_C2A, P_C3 = 0, 1, 2, 3, 4, 5, 6, 7
 N_PARAMS = 8
@@ -58,9 +59,7 @@ def bech_rhs(t, x, delta, w, p, dx):
     z = x[6]
     b = p[P_B]
     d = delta + w[W_RUDDER]
-    vc = w[W_CURRENT_SPEED]
-    dx[0] = u * math.cos(psi) + vc * math.cos(w[W_CURRENT_DIR])
-    dx[1] = u * math.sin(psi) + vc * math.sin(w[W_CURRENT_DIR])
+    earth_velocity(psi, u, 0.0, w, dx)
     dx[2] = r
     dx[3] = 0.0
     dx[4] = 0.0

@@ -47,16 +47,16 @@ models: K > 0), ``r > 0`` to starboard.
 
 from __future__ import annotations
 
-import math
 
 import numba
 import numpy as np
-from pydantic import Field, field_validator, model_validator
+from pydantic import Field, field_validator
 
 from steerlab.config_base import FrozenConfig
-from steerlab.environment.channels import W_CURRENT_DIR, W_CURRENT_SPEED, W_RUDDER, W_YAW_MOMENT
+from steerlab.environment.channels import W_RUDDER, W_YAW_MOMENT
 from steerlab.errors import InputError
 from steerlab.ships.rpm_schedule import check_rpm_schedule, pack_rate, scheduled_rate
+from steerlab.ships.kinematics import earth_velocity
 
 U_MIN = 0.05
 """Floor of the speed [m/s] used in ``L/U`` (keeps the model finite near standstill)."""
@@ -81,9 +81,7 @@ def de_keizer_rhs(t, x, delta, w, p, dx):
     L = p[P_L]
     Ue = max(U, U_MIN)
     U0e = max(U0, U_MIN)
-    vc = w[W_CURRENT_SPEED]
-    dx[0] = U * math.cos(psi) + vc * math.cos(w[W_CURRENT_DIR])
-    dx[1] = U * math.sin(psi) + vc * math.sin(w[W_CURRENT_DIR])
+    earth_velocity(psi, U, 0.0, w, dx)
     dx[2] = r
     # yaw (2.41)
     rs = r * L / Ue

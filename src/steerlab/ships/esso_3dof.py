@@ -41,6 +41,7 @@ import numba
 import numpy as np
 
 from steerlab.environment.channels import W_RUDDER
+from steerlab.ships.kinematics import earth_velocity
 
 
 class EssoTable2(NamedTuple):
@@ -145,10 +146,7 @@ def esso_rhs(t, x, delta, w, p, dx):
     r = x[5]
     d = delta + w[W_RUDDER]
     au = abs(u)
-    c = math.cos(psi)
-    s = math.sin(psi)
-    dx[0] = u * c - v * s
-    dx[1] = u * s + v * c
+    earth_velocity(psi, u, v, w, dx)
     dx[2] = r
     n = p[P_N]
     u2d = u * u * d

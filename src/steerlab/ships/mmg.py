@@ -69,6 +69,7 @@ from steerlab.errors import InputError
 from steerlab.ships.clarke import (ClarkeDerivatives, PrimeMass, clarke_derivatives, nomoto_KT_eq11,
                                    prime_mass, state_space_eq10)
 from steerlab.ships.rpm_schedule import check_rpm_schedule, pack_rate, scheduled_rate
+from steerlab.ships.kinematics import earth_velocity
 
 # ---------------------------------------------------------------------------------------------
 # ship data (from a TOML file)
@@ -300,15 +301,12 @@ def mmg_rhs(t, x, delta, w, p, dx):
     v = x[4]
     r = x[5]
     d = delta + w[W_RUDDER]
-    c = math.cos(psi)
-    s = math.sin(psi)
     # current (flowing towards beta_c) in body axes
     vc = w[W_CURRENT_SPEED]
     bc = w[W_CURRENT_DIR] - psi
     uc = vc * math.cos(bc)
     vcb = vc * math.sin(bc)
-    dx[0] = u * c - v * s + vc * math.cos(w[W_CURRENT_DIR])
-    dx[1] = u * s + v * c + vc * math.sin(w[W_CURRENT_DIR])
+    earth_velocity(psi, u, v, w, dx)
     dx[2] = r
     U = math.sqrt(u * u + v * v)
     # propeller

@@ -21,7 +21,6 @@ In a scenario::
 
 from __future__ import annotations
 
-import math
 
 import numba
 import numpy as np
@@ -29,6 +28,7 @@ from pydantic import Field, field_validator
 
 from steerlab.config_base import FrozenConfig
 from steerlab.environment.channels import W_RUDDER
+from steerlab.ships.kinematics import earth_velocity
 
 P_K, P_T = 0, 1
 N_PARAMS = 2
@@ -40,8 +40,7 @@ def nomoto1_rhs(t, x, delta, w, p, dx):
     psi = x[2]
     u = x[3]
     r = x[5]
-    dx[0] = u * math.cos(psi)
-    dx[1] = u * math.sin(psi)
+    earth_velocity(psi, u, 0.0, w, dx)
     dx[2] = r
     dx[3] = 0.0
     dx[4] = 0.0

@@ -33,14 +33,14 @@ In a scenario::
 
 from __future__ import annotations
 
-import math
 
 import numba
 import numpy as np
 from pydantic import Field, model_validator
 
 from steerlab.config_base import FrozenConfig
-from steerlab.environment.channels import W_CURRENT_DIR, W_CURRENT_SPEED, W_RUDDER, W_YAW_MOMENT
+from steerlab.environment.channels import W_RUDDER, W_YAW_MOMENT
+from steerlab.ships.kinematics import earth_velocity
 
 P_K, P_T1, P_T2, P_T3 = 0, 1, 2, 3
 N_PARAMS = 4
@@ -60,9 +60,7 @@ def nomoto2_rhs(t, x, delta, w, p, dx):
     a = (p[P_T1] + p[P_T2]) / t12
     b = p[P_K] / t12
     d = delta + w[W_RUDDER]
-    vc = w[W_CURRENT_SPEED]
-    dx[0] = u * math.cos(psi) + vc * math.cos(w[W_CURRENT_DIR])
-    dx[1] = u * math.sin(psi) + vc * math.sin(w[W_CURRENT_DIR])
+    earth_velocity(psi, u, 0.0, w, dx)
     dx[2] = r
     dx[3] = 0.0
     dx[4] = 0.0

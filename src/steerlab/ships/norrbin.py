@@ -32,9 +32,10 @@ import numpy as np
 from pydantic import Field
 
 from steerlab.config_base import FrozenConfig
-from steerlab.environment.channels import W_CURRENT_DIR, W_CURRENT_SPEED, W_RUDDER, W_YAW_MOMENT
+from steerlab.environment.channels import W_RUDDER, W_YAW_MOMENT
 from steerlab.ships.spiral_polynomial import spiral_polynomial
 from steerlab.ships.state import PLANAR_NAMES, PLANAR_UNITS
+from steerlab.ships.kinematics import earth_velocity
 
 P_K, P_T, P_N0, P_N1, P_N2, P_N2A, P_N3 = 0, 1, 2, 3, 4, 5, 6
 N_PARAMS = 7
@@ -47,9 +48,7 @@ def norrbin_rhs(t, x, delta, w, p, dx):
     psi = x[2]
     u = x[3]
     r = x[5]
-    vc = w[W_CURRENT_SPEED]
-    dx[0] = u * math.cos(psi) + vc * math.cos(w[W_CURRENT_DIR])
-    dx[1] = u * math.sin(psi) + vc * math.sin(w[W_CURRENT_DIR])
+    earth_velocity(psi, u, 0.0, w, dx)
     dx[2] = r
     dx[3] = 0.0
     dx[4] = 0.0

@@ -15,7 +15,6 @@ base spec does not carry:
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Callable
 
 from steerlab.errors import InputError
 from steerlab.ships.registry import ShipSpec

@@ -81,6 +81,7 @@ from pydantic import Field, model_validator
 
 from steerlab.config_base import FrozenConfig
 from steerlab.environment.channels import W_RUDDER, W_YAW_RATE
+from steerlab.ships.kinematics import earth_velocity
 
 DATA_DIR = Path(__file__).resolve().parent / "data"
 
@@ -155,8 +156,7 @@ def van_leeuwen_rhs(t, x, delta, w, p, dx):
     r = x[5]
     rd = x[6]
     mu = U / p[P_L]
-    dx[0] = U * math.cos(psi)
-    dx[1] = U * math.sin(psi)
+    earth_velocity(psi, U, 0.0, w, dx)
     dx[2] = r + w[W_YAW_RATE]
     dx[3] = 0.0
     dx[4] = 0.0
