@@ -141,7 +141,7 @@ def add_waves(w: np.ndarray, cfg, ctx: SeaContext, dt: float, seed: int) -> None
     comp = wave_components(S, wp, cfg.n_components, stream(seed, "wave_components"), ctx.speed, gamma)
     c_B, L, B = ctx.ship.dims
     gain = cfg.yaw_accel_per_slope if cfg.yaw_accel_per_slope is not None else daidola_gain(L, B, c_B)
-    acc = wave_yaw_acceleration(comp, np.arange(n_steps + 1) * dt, gain, L, gamma)
+    acc = wave_yaw_acceleration(comp, n_steps + 1, dt, gain, L, gamma)
     route = _route(cfg, ctx, ("yaw_moment", "rudder"))
     if route == "yaw_moment":
         w[:, W_YAW_MOMENT] += acc

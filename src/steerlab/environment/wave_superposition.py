@@ -84,28 +84,36 @@ def daidola_gain(L: float, B: float, c_B: float) -> float:
     return 0.9 * G * (1.0 - (B / L) ** 2) / (c_B * B)
 
 
-def superpose(comp: WaveComponents, t: np.ndarray, weights=None, kind: str = "cos",
-              chunk: int = 4096) -> np.ndarray:
-    """``sum_i weights_i a_i cos|sin(w_e,i t + phi_i)`` on the times ``t`` (chunked)."""
+def superpose(comp: WaveComponents, n: int, dt: float, weights=None, kind: str = "cos",
+              chunk: int = 2048) -> np.ndarray:
+    """``sum_i weights_i a_i cos|sin(w_e,i t_k + phi_i)`` on the grid ``t_k = k dt``, ``k < n``.
+
+    Evaluated block by block as a complex matrix-vector product: the phasors
+    ``exp(i w_e,i j dt)`` of one block (``j < chunk``) are computed once, and each block
+    starts from the exact phase ``w_e,i t0 + phi_i`` (no accumulated drift).
+    """
     amp = comp.a if weights is None else comp.a * weights
-    fn = np.cos if kind == "cos" else np.sin
-    out = np.empty(t.shape[0])
-    for i0 in range(0, t.shape[0], chunk):
-        tt = t[i0:i0 + chunk, None]
-        out[i0:i0 + chunk] = fn(tt * comp.we[None, :] + comp.phase[None, :]) @ amp
+    rot = np.exp(1j * np.outer(np.arange(min(chunk, n)) * dt, comp.we))
+    out = np.empty(n)
+    for k0 in range(0, n, chunk):
+        m = min(chunk, n - k0)
+        c = amp * np.exp(1j * (comp.we * (k0 * dt) + comp.phase))
+        v = rot[:m] @ c
+        out[k0:k0 + m] = v.real if kind == "cos" else v.imag
     return out
 
 
-def wave_elevation(comp: WaveComponents, t) -> np.ndarray:
-    """Wave elevation at the ship [m] on the times ``t`` [s]."""
-    return superpose(comp, np.asarray(t, dtype=float), None, "cos")
+def wave_elevation(comp: WaveComponents, n: int, dt: float) -> np.ndarray:
+    """Wave elevation at the ship [m] on the grid ``k dt``, ``k < n``."""
+    return superpose(comp, n, dt, None, "cos")
 
 
-def wave_yaw_acceleration(comp: WaveComponents, t, gain: float, L: float, gamma: float) -> np.ndarray:
-    """Yaw acceleration [rad/s^2]: ``gain sin(2 gamma) sum a_i k_i F_i sin(w_e,i t + phi_i)``."""
+def wave_yaw_acceleration(comp: WaveComponents, n: int, dt: float, gain: float, L: float,
+                          gamma: float) -> np.ndarray:
+    """Yaw acceleration [rad/s^2] on the grid ``k dt``: ``gain sin(2 gamma) sum a_i k_i F_i sin(w_e,i t + phi_i)``."""
     k = comp.w**2 / G
     weights = k * length_factor(k, L, gamma) * gain * math.sin(2.0 * gamma)
-    return superpose(comp, np.asarray(t, dtype=float), weights, "sin")
+    return superpose(comp, n, dt, weights, "sin")
 
 
 def encounter_spectrum(comp: WaveComponents, edges: np.ndarray, weights=None) -> np.ndarray:
