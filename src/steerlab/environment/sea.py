@@ -104,6 +104,19 @@ def thesis_omega_n(cfg, speed: float) -> tuple[float, float]:
     return w0, wn
 
 
+def spectrum_components(cfg, speed: float, seed: int):
+    """The seeded wave components of the spectrum model (the same for every controller compared)."""
+    S, wp, _, _ = target_spectrum_fn(cfg)
+    return wave_components(S, wp, cfg.n_components, stream(seed, "wave_components"), speed,
+                           math.radians(cfg.wave_angle_deg))
+
+
+def yaw_gain(cfg, ship) -> tuple[float, float]:
+    """``(L [m], yaw acceleration per unit slope [1/s^2])``: configured, or Daidola-Graham's estimate."""
+    c_B, L, B = ship.dims
+    return L, (cfg.yaw_accel_per_slope if cfg.yaw_accel_per_slope is not None else daidola_gain(L, B, c_B))
+
+
 def _route(cfg, ctx: SeaContext, allowed):
     ch = cfg.channel
     if ch == "auto":
@@ -137,10 +150,8 @@ def add_waves(w: np.ndarray, cfg, ctx: SeaContext, dt: float, seed: int) -> None
             w[:, W_YAW_MOMENT] += dd[:, 1] + dd[:, 0] / T
         return
     # spectrum
-    S, wp, _, _ = target_spectrum_fn(cfg)
-    comp = wave_components(S, wp, cfg.n_components, stream(seed, "wave_components"), ctx.speed, gamma)
-    c_B, L, B = ctx.ship.dims
-    gain = cfg.yaw_accel_per_slope if cfg.yaw_accel_per_slope is not None else daidola_gain(L, B, c_B)
+    comp = spectrum_components(cfg, ctx.speed, seed)
+    L, gain = yaw_gain(cfg, ctx.ship)
     acc = wave_yaw_acceleration(comp, n_steps + 1, dt, gain, L, gamma)
     route = _route(cfg, ctx, ("yaw_moment", "rudder"))
     if route == "yaw_moment":
