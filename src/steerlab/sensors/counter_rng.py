@@ -68,3 +68,26 @@ def split_seed(seed: int) -> tuple[float, float]:
     """``(hi, lo)``: the 32-bit halves of a seed ``0 <= seed < 2^64`` as exact float64."""
     seed = int(seed)
     return float(seed >> 32), float(seed & 0xFFFFFFFF)
+
+
+if numba.config.DISABLE_JIT:  # pragma: no cover - debugging mode: same numbers with Python ints
+    _MASK = (1 << 64) - 1
+
+    def mix64(z):  # noqa: F811
+        z = int(z)
+        z = ((z ^ (z >> 30)) * int(M1)) & _MASK
+        z = ((z ^ (z >> 27)) * int(M2)) & _MASK
+        return z ^ (z >> 31)
+
+    def make_key(hi, lo, stream):  # noqa: F811
+        s = (int(hi) << 32) | int(lo)
+        return mix64((s + (int(stream) + 1) * int(M2)) & _MASK)
+
+    def uniform(key, i):  # noqa: F811
+        z = mix64((int(key) + (int(i) + 1) * int(GOLDEN)) & _MASK)
+        return (float(z >> 11) + 1.0) * INV53
+
+    def normal(key, i):  # noqa: F811
+        u1 = uniform(key, 2 * i)
+        u2 = uniform(key, 2 * i + 1)
+        return math.sqrt(-2.0 * math.log(u1)) * math.cos(2.0 * math.pi * u2)
