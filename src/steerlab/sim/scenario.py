@@ -40,6 +40,9 @@ from pydantic import BaseModel, Field, ValidationError
 from steerlab.config_base import FrozenConfig
 from steerlab.control.adrc import ADRCConfig
 from steerlab.control.registry import CONTROLLERS
+from steerlab.environment.sea_config import (CurrentVariationConfig, GustConfig, WaveConfig,
+                                             WindRudderConfig)
+from steerlab.sensors.config import SensorsConfig
 
 from steerlab.errors import InputError
 
@@ -94,6 +97,11 @@ class EnvironmentConfig(_Frozen):
     current_speed: float = Field(0.0, ge=0.0, le=10.0, description="constant current speed [m/s]")
     current_dir_deg: float = Field(0.0, ge=-360.0, le=360.0,
                                    description="direction the current flows TOWARDS [deg], clockwise from north")
+    # optional sea blocks (steerlab.environment.sea_config), all off by default
+    wave: Optional[WaveConfig] = None
+    gusts: Optional[GustConfig] = None
+    current_variation: Optional[CurrentVariationConfig] = None
+    wind_rudder: Optional[WindRudderConfig] = None
 
 
 class Scenario(_Frozen):
@@ -107,6 +115,7 @@ class Scenario(_Frozen):
     controller: ControllerConfig = Field(default_factory=lambda: ADRCConfig(type="adrc"))
     guidance: GuidanceConfig = GuidanceConfig()
     environment: EnvironmentConfig = EnvironmentConfig()
+    sensors: Optional[SensorsConfig] = None   # steerlab.sensors: off by default
 
     @property
     def n_steps(self) -> int:

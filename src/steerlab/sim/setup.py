@@ -9,8 +9,10 @@ import numpy as np
 from steerlab.control.design_context import DesignContext
 from steerlab.control.registry import ControllerSpec, get_controller
 from steerlab.environment.disturbance import Disturbance, build_disturbance
+from steerlab.environment.sea import SeaContext, add_sea, uses_sea
 from steerlab.errors import InputError
 from steerlab.guidance.reference_models import course_schedule
+from steerlab.sensors.wrapper import with_sensors
 from steerlab.ships.registry import ShipSpec, get_ship
 from steerlab.steering_gear import SteeringGear
 from steerlab.units import knots_to_ms, rad
@@ -76,14 +78,42 @@ def build(scenario) -> SimSetup:
     x0[3] = speed
     z0 = ctrl.init_state(x0, (psi0, 0.0))
     ws = s.environment.wave_sample_time
-    if s.environment.waves and abs(ws / s.dt - round(ws / s.dt)) > 1e-9 * max(1.0, ws / s.dt):
+    eq39 = s.environment.waves or (s.environment.wave is not None and s.environment.wave.model == "eq39")
+    if eq39 and abs(ws / s.dt - round(ws / s.dt)) > 1e-9 * max(1.0, ws / s.dt):
         raise InputError("environment.wave_sample_time",
                          f"must be a positive integer multiple of dt={s.dt} s, got {ws} s")
     env = s.environment
-    dist = Disturbance(rad(env.constant_rudder_deg), env.constant_start, env.waves,
+    dist = Disturbance(rad(env.constant_rudder_deg), env.constant_start, eq39,
                        env.wave_sample_time, env.wave_power, wind_speed=env.wind_speed,
                        wind_dir=rad(env.wind_dir_deg), current_speed=env.current_speed,
                        current_dir=rad(env.current_dir_deg))
     w = build_disturbance(dist, n_steps, s.dt, s.seed)
-    return SimSetup(ship, ctrl_spec, ps, pg, pc, gd, x0, np.asarray(z0, dtype=float), w, s.dt, nc,
+    if uses_sea(env):
+        add_sea(w, env, SeaContext(ship, ps, x0, speed, lambda: ship.nomoto(speed, ship_options),
+                                   lambda t: reference_headings(gd, t), lambda: _rudder_b2(ship, speed, ship_options)),
+                s.dt, s.seed)
+    z0 = np.asarray(z0, dtype=float)
+    if s.sensors is not None:
+        ctrl_spec, pc, z0 = with_sensors(ctrl_spec, pc, z0, s.sensors, s.seed, ts, x0.shape[0])
+    return SimSetup(ship, ctrl_spec, ps, pg, pc, gd, x0, z0, w, s.dt, nc,
                     n_steps, s.name, s.seed)
+
+
+def _rudder_b2(ship, speed, options) -> float:
+    """Rudder yaw acceleration per rad [1/s^2]: the linearisation's b2, else eq (29)'s estimate."""
+    try:
+        return ship.b2(speed, "exact", options)
+    except Exception:  # noqa: BLE001 - ships without a linearisation
+        return ship.b2(speed, "estimate", options)
+
+
+def reference_headings(gd, t) -> np.ndarray:
+    """The guidance's reference heading [rad] at the times ``t`` (for up-front disturbances)."""
+    from steerlab.guidance.reference_models import course_reference
+
+    ref = np.zeros(2)
+    out = np.empty(len(t))
+    for i, ti in enumerate(t):
+        course_reference(float(ti), gd, ref)
+        out[i] = ref[0]
+    return out

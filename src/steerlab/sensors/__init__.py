@@ -1,0 +1,1 @@
+"""Sensor models: heading / yaw-rate noise, sample rate, quantisation and dropouts (``[sensors]``)."""
