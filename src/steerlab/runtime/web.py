@@ -1,6 +1,6 @@
 """Bridge page: a live web page for the autopilot (HTTP + WebSocket on one port, no internet assets).
 
-``GET /`` serves ``static/bridge.html`` (+ ``/bridge.js``, ``/bridge.css``); ``GET /status.json``
+``GET /`` serves ``static/bridge.html`` (+ ``/bridge.js``, ``/bridge.css``, ``/favicon.svg``); ``GET /status.json``
 the current status; the WebSocket at ``/ws`` pushes ``{"type": "status", ...}`` (SI units, see
 :meth:`steerlab.runtime.autopilot.Autopilot.status`) every ``period`` seconds and accepts
 actions as JSON::
@@ -29,7 +29,8 @@ from steerlab.errors import InputError
 
 STATIC = {"/": ("bridge.html", "text/html; charset=utf-8"),
           "/bridge.js": ("bridge.js", "text/javascript; charset=utf-8"),
-          "/bridge.css": ("bridge.css", "text/css; charset=utf-8")}
+          "/bridge.css": ("bridge.css", "text/css; charset=utf-8"),
+          "/favicon.svg": ("favicon.svg", "image/svg+xml")}
 ADJUST_STEPS = (-10.0, -1.0, 1.0, 10.0)
 
 
