@@ -55,6 +55,13 @@ def _response(status: HTTPStatus, body: bytes, ctype: str) -> Response:
     return Response(status.value, status.phrase, headers, body)
 
 
+def same_origin(request) -> bool:
+    """False for a browser's cross-site WebSocket (an ``Origin`` that is not this host's)."""
+    origin = request.headers.get("Origin")
+    host = request.headers.get("Host", "")
+    return origin is None or origin in (f"http://{host}", f"https://{host}")
+
+
 def handle_action(ap, msg, t: float) -> dict:
     """Apply one page action to the autopilot; the reply (never raises)."""
     try:
@@ -96,9 +103,7 @@ class BridgeServer:
     def _process_request(self, connection, request):
         path = request.path.split("?", 1)[0]
         if path == "/ws":
-            origin = request.headers.get("Origin")
-            host = request.headers.get("Host", "")
-            if origin is not None and origin not in (f"http://{host}", f"https://{host}"):
+            if not same_origin(request):
                 return _response(HTTPStatus.FORBIDDEN, b"cross-origin WebSocket refused\n", "text/plain")
             return None
         if path == "/status.json":
