@@ -89,15 +89,26 @@ class _Proc:
             time.sleep(0.02)
         raise AssertionError(f"no line matching {pattern!r}; stderr:\n" + "\n".join(self.lines))
 
-    def stop(self, sig=signal.SIGINT) -> int:
+    def interrupt(self) -> None:
+        """Ctrl-C (after SIGCONT, in case it is frozen)."""
         if self.p.poll() is None:
-            try:
-                os.kill(self.p.pid, signal.SIGCONT)
-                os.kill(self.p.pid, sig)
-                return self.p.wait(timeout=30)
-            except subprocess.TimeoutExpired:
-                self.p.kill()
-        return self.p.wait(timeout=30)
+            os.kill(self.p.pid, signal.SIGCONT)
+            os.kill(self.p.pid, signal.SIGINT)
+
+    def wait(self) -> int:
+        try:
+            return self.p.wait(timeout=30)
+        except subprocess.TimeoutExpired:
+            self.p.kill()
+            return self.p.wait(timeout=30)
+
+
+def _free_udp_port() -> int:
+    import socket
+
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
 
 
 def _read_log(path):
@@ -121,17 +132,18 @@ def test_bridge_page_in_headless_chromium(tmp_path):
     sc = tmp_path / "ship.toml"
     sc.write_text(SCENARIO_TOML)
     log = tmp_path / "autopilot.csv"
-    server = _Proc(["serve-ship", str(sc), "--bind", "127.0.0.1:0", "--speedup", str(SPEEDUP)])
-    autopilot = None
+    port = _free_udp_port()
+    # both start (import, compile) at once; the autopilot may raise a link alarm until the ship is up
+    server = _Proc(["serve-ship", str(sc), "--bind", f"127.0.0.1:{port}", "--speedup", str(SPEEDUP)])
+    autopilot = _Proc(["autopilot", "--connect", f"127.0.0.1:{port}", "--scenario", str(sc),
+                       "--controller", "pid", "--heading", "0", "--speedup", str(SPEEDUP),
+                       "--watchdog", str(WATCHDOG), "--log", str(log), "--web", "127.0.0.1:0"])
     console_errors, requests = [], []
     try:
         with sync_playwright() as pw:
             browser = pw.chromium.launch(executable_path=chromium, args=["--headless=new", "--no-sandbox"])
             try:
-                port = server.wait_for(r" on 127\.0\.0\.1:(\d+),").group(1)
-                autopilot = _Proc(["autopilot", "--connect", f"127.0.0.1:{port}", "--scenario", str(sc),
-                                   "--controller", "pid", "--heading", "0", "--speedup", str(SPEEDUP),
-                                   "--watchdog", str(WATCHDOG), "--log", str(log), "--web", "127.0.0.1:0"])
+                server.wait_for(rf" on 127\.0\.0\.1:{port},")
                 url = autopilot.wait_for(r"bridge page (http://127\.0\.0\.1:\d+/)").group(1)
                 page = browser.new_page()
                 page.set_default_timeout(TIMEOUT_MS)
@@ -146,12 +158,15 @@ def test_bridge_page_in_headless_chromium(tmp_path):
             finally:
                 browser.close()
     finally:
-        codes = {"autopilot": autopilot.stop() if autopilot else None, "server": server.stop()}
+        for proc in (autopilot, server):
+            proc.interrupt()
+        codes = {"autopilot": autopilot.wait(), "server": server.wait()}
     assert console_errors == []                                   # no script error, no CSP violation
     origin = url.rstrip("/")
     assert requests and all(u.startswith(origin) or u.startswith(origin.replace("http", "ws"))
                             for u in requests), requests           # no internet assets
-    assert codes["autopilot"] in (0, 130), "\n".join(autopilot.lines)
+    assert codes["autopilot"] in (0, 130), "\n".join(autopilot.lines)     # 130: stopped by Ctrl-C
+    assert codes["server"] in (0, 130), "\n".join(server.lines)
     _check_log(_read_log(log))
 
 
@@ -165,6 +180,8 @@ def _attr(page, id_, name):
 
 def _check_live_values(page):
     expect(page.locator("#link")).to_have_text("link OK")
+    if page.locator("#alarms li[data-alarm='link']").count():      # raised before the ship was up
+        page.click("#ack")
     expect(page.locator("#mode")).to_have_text("auto")
     expect(page.locator("#set-course")).to_have_text("0.0\u00b0")
     expect(page.locator("#speed")).to_have_text("10.0 kn")
