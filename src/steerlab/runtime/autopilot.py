@@ -151,6 +151,10 @@ class Autopilot:
         self._listeners = []
         self._log_file = None
         self._log = None
+        # compile the guidance kernels now, not at the first steering sample (with a cold numba
+        # cache that costs about a second, while the ship keeps moving)
+        course_reference(0.0, course_schedule(0.0, [(0.0, 0.1)], cfg.turn_rate), np.zeros(2))
+        wrap_to_pi(0.0)
 
     # ------------------------------------------------------------ clock and inputs
     def clock(self) -> float:
