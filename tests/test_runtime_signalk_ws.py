@@ -203,7 +203,7 @@ def test_ship_and_autopilot_signalk_streams(controller):  # noqa: F811
         async with connect(url + "?subscribe=none") as ws:   # the autopilot: subscribe, then steer
             assert json.loads(await ws.recv())["roles"] == ["master", "main"]
             await ws.send(json.dumps({"context": "vessels.self", "subscribe": [{"path": "steering.autopilot.*"}]}))
-            first = await _deltas(ws, 3)
+            first = await _deltas(ws, 3, lambda v: v.get("steering.autopilot.state") == "auto")
             for d in first:
                 assert set(d) == {"steering.autopilot.state", "steering.autopilot.target.headingTrue"}
             assert first[-1] == {"steering.autopilot.state": "auto", "steering.autopilot.target.headingTrue": 0.0}
