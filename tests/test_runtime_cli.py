@@ -80,8 +80,14 @@ def test_serve_ship_and_autopilot_commands_run_together(tmp_path, capsys):
     """Both commands, in-process (no second interpreter to start and compile), real sockets."""
     import threading
 
+    from steerlab.runtime.controller_runtime import ControllerRuntime
+    from steerlab.sim.scenario import load_scenario
+
     sc = tmp_path / "rt.toml"
     sc.write_text(SCENARIO_TOML)
+    # compile the controller first: with a cold numba cache the autopilot command would spend
+    # ~1 s (10 ship seconds) compiling while the 30 s server runs, and outlive it
+    ControllerRuntime(load_scenario(sc), "pid", 0.125)
     log = tmp_path / "log.csv"
     port = _free_port()
     codes = {}

@@ -138,20 +138,24 @@ def test_link_cut_alarm_and_safe_state_in_time(controller, tmp_path):
 
     def cut(ctx):
         ctx["proxy"].cut = True
+        ctx["t_cut"] = ctx["ap"].clock()
 
     ctx = asyncio.run(_session(controller, log, 12.0, [(3.0, _course_change), (8.0, cut)],
                                proxy={"seed": 1}, ap_cfg=AutopilotConfig(speedup=SPEEDUP, watchdog_timeout=1.0)))
     rows = _read_log(log)
     ap, server = ctx["ap"], ctx["server"]
-    t_alarm = ap.alarms.first_raised(LINK)
-    assert t_alarm is not None
-    first = next(r for r in rows if "link" in r["alarms"])
-    assert first["t"] == t_alarm
-    last_ok = max(r["t"] for r in rows if r["link_ok"])
-    assert 1.0 < first["state_age"] <= 1.0 + 0.5                   # within the watchdog time (+ jitter)
-    assert t_alarm - last_ok <= 2 * 0.125 + 0.25
-    after = [r for r in rows if r["t"] >= t_alarm]
-    assert after and all(r["mode"] == "safe" and r["delta_cmd_deg"] == 0.0 for r in after)
+    # anchored at the cut: a scheduling stall of the test process longer than the watchdog time
+    # (0.1 s wall) before it may rightly raise and clear a link alarm earlier
+    raised = [t for t, n, what in ap.alarms.history if n == LINK and what == "raised" and t >= ctx["t_cut"]]
+    assert raised
+    i = next(i for i, r in enumerate(rows) if r["t"] == raised[0])
+    first, prev = rows[i], rows[i - 1]
+    assert "link" in first["alarms"] and "link" not in prev["alarms"]
+    assert prev["link_ok"] and prev["state_age"] <= 1.0 < first["state_age"]   # the first sample past the watchdog
+    assert first["state_age"] <= 1.0 + 0.5                          # within the watchdog time (+ one sample, jitter)
+    assert first["t"] - ctx["t_cut"] <= 1.0 + 0.5
+    after = rows[i:]
+    assert all(r["mode"] == "safe" and r["delta_cmd_deg"] == 0.0 for r in after)
     # the ship server, cut off too, held the last order, then centred the rudder
     changes = dict((status, t) for t, status in server.stats.status_changes)
     t_hold, t_centre = changes[P.STATUS_CMD_HOLD], changes[P.STATUS_CMD_CENTRED]

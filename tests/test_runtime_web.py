@@ -1,8 +1,8 @@
 """Bridge page: HTTP + WebSocket protocol against a running ship server and autopilot.
 
-No headless browser is installed here (no chromium, no playwright). The first test drives the
-HTTP and WebSocket protocol the page uses with a real ``websockets`` client; the second runs the
-page's own ``bridge.js`` in Node.js (if installed) with a stub DOM against the live page.
+The first test drives the HTTP and WebSocket protocol the page uses with a real ``websockets``
+client; the second runs the page's own ``bridge.js`` in Node.js (if installed) with a stub DOM
+against the live page. The page in a real browser: ``test_runtime_browser.py``.
 """
 
 from __future__ import annotations
@@ -119,21 +119,25 @@ let statuses = 0;
 global.WebSocket = function (url) { const s = new RealWS(url); s.addEventListener("message", () => statuses++); return s; };
 eval(src);
 const wait = (ms) => new Promise((r) => setTimeout(r, ms));
+async function until(what, pred) {   // poll, bounded: a loaded machine is slow, never wrong
+  for (let i = 0; i < 500; i++) { if (pred()) return; await wait(20); }
+  console.error("timed out waiting for " + what); process.exit(3);
+}
 const E = (id) => document.getElementById(id);
 const snap = () => ({ mode: E("mode").textContent, link: E("link").textContent, heading: E("heading").textContent,
   set_course: E("set-course").textContent, rudder: E("rudder-angle").textContent,
   needle: E("ship-needle").attrs.transform, track: E("track-line").attrs.points,
   reply: E("reply").textContent, counts: E("counts").textContent, ticks: E("ticks").children.length });
 (async () => {
-  await wait(600);
+  await until("status", () => statuses > 5 && E("track-line").attrs.points && E("track-line").attrs.points.split(" ").length > 2);
   const first = snap();
   buttons[3].onclick();            // +10 deg
-  await wait(300);
+  await until("+10 reply", () => E("reply").textContent === "ok: adjust");
   E("standby").onclick();
-  await wait(400);
+  await until("standby", () => E("mode").textContent === "standby" && E("reply").textContent === "ok: standby");
   const standby = snap();
   E("engage").onclick();
-  await wait(400);
+  await until("engage", () => E("reply").textContent === "ok: engage" && E("mode").textContent === "auto");
   console.log(JSON.stringify({ first, standby, engaged: snap(), statuses }));
   process.exit(0);
 })();

@@ -10,6 +10,7 @@ EXAMPLES = """examples:
   steerlab autopilot --connect 127.0.0.1:47110 --controller adrc --scenario my.toml --route route.csv
   steerlab autopilot --connect 127.0.0.1:47110 --controller pid --heading 0 --web 127.0.0.1:8080
   steerlab autopilot --connect 127.0.0.1:47110 --controller pid --nmea-listen 127.0.0.1:10111   # follow OpenCPN APB/RMB
+  steerlab autopilot --connect 127.0.0.1:47110 --controller pid --signalk-ws 127.0.0.1:3000      # Signal K WebSocket
 
 The controller is designed for the scenario's ship (--scenario, default: the bundled one); use
 the same scenario as serve-ship. Every sample is logged to --log (CSV). docs/runtime.md"""
@@ -46,6 +47,8 @@ def register(sub, formatter_class) -> None:
     p.add_argument("--xte-lookahead", type=float, default=500.0, help="cross-track correction lookahead [m]")
     p.add_argument("--signalk-listen", metavar="HOST:PORT", help="UDP port for Signal K deltas (target heading, state)")
     p.add_argument("--signalk-to", metavar="HOST:PORT", help="send Signal K autopilot deltas here")
+    p.add_argument("--signalk-ws", metavar="HOST:PORT",
+                   help="serve the Signal K stream here (WebSocket; ship and autopilot paths; PUT target heading/state)")
     p.add_argument("--web", metavar="HOST:PORT", help="serve the bridge page here (e.g. 127.0.0.1:8080)")
     add_link_security(p)
     p.add_argument("--quiet", action="store_true")
@@ -84,11 +87,15 @@ def build_autopilot(args):
         print(f"autopilot: warning: the bridge page on {web[0]} is reachable from the network and has no login",
               file=sys.stderr)
     hp = lambda v, f: parse_hostport(v, f) if v else None  # noqa: E731
+    signalk_ws = hp(args.signalk_ws, "--signalk-ws")
+    if signalk_ws is not None and not is_loopback(signalk_ws[0]):
+        print(f"autopilot: warning: the Signal K stream on {signalk_ws[0]} accepts course/state PUTs from the "
+              "network without authentication", file=sys.stderr)
     ap = Autopilot(ctrl, connect, cfg, heading=None if args.heading is None else rad(args.heading),
                    route=route, key=key, log_path=args.log, engaged=not args.standby,
                    nmea_listen=hp(args.nmea_listen, "--nmea-listen"), nmea_to=hp(args.nmea_to, "--nmea-to"),
                    signalk_listen=hp(args.signalk_listen, "--signalk-listen"),
-                   signalk_to=hp(args.signalk_to, "--signalk-to"))
+                   signalk_to=hp(args.signalk_to, "--signalk-to"), signalk_ws=signalk_ws)
     return ap, web
 
 
@@ -115,6 +122,8 @@ def run(args) -> int:
     def started(a, bridge):
         if not args.quiet:
             page = f", bridge page http://{bridge.address[0]}:{bridge.address[1]}/" if bridge else ""
+            if a.signalk_stream is not None:
+                page += ", Signal K ws://%s:%d/signalk/v1/stream" % tuple(a.signalk_stream.address)
             print(f"autopilot: {a.ctrl.name} -> {a.connect[0]}:{a.connect[1]}, sample {a.config.sample_time:g} s, "
                   f"watchdog {a.config.watchdog_timeout:g} s ({a.config.safe_action}), log {args.log}{page}; "
                   "Ctrl-C stops", file=sys.stderr, flush=True)

@@ -9,6 +9,7 @@ EXAMPLES = """examples:
   steerlab serve-ship my.toml --bind 127.0.0.1:47110 --speedup 5
   STEERLAB_LINK_KEY=$(cat key) steerlab serve-ship my.toml --key-env STEERLAB_LINK_KEY
   steerlab serve-ship my.toml --nmea-to 127.0.0.1:10110 --signalk-to 127.0.0.1:8375
+  steerlab serve-ship my.toml --signalk-ws 127.0.0.1:3000       # Signal K WebSocket stream
 
 Then: steerlab autopilot --connect 127.0.0.1:47110 --controller pid --heading 20
 Protocol, safety behaviour and NMEA/Signal K mapping: docs/runtime.md"""
@@ -44,6 +45,8 @@ def register(sub, formatter_class) -> None:
                    help="no valid command for longer: rudder midships [s] (default 3)")
     p.add_argument("--nmea-to", metavar="HOST:PORT", help="send HDT, THS, ROT, RSA, RMC, VTG here (UDP)")
     p.add_argument("--signalk-to", metavar="HOST:PORT", help="send Signal K deltas here (UDP)")
+    p.add_argument("--signalk-ws", metavar="HOST:PORT",
+                   help="serve the Signal K stream here (WebSocket ws://HOST:PORT/signalk/v1/stream, read-only)")
     p.add_argument("--nmea-period", type=float, default=0.2, help="NMEA / Signal K period [s] (default 0.2)")
     p.add_argument("--origin", default="54.5,18.55", help="LAT,LON [deg] of the model origin for RMC")
     add_link_security(p)
@@ -75,6 +78,9 @@ def run(args) -> int:
     bind = parse_hostport(args.bind, "--bind")
     if not is_loopback(bind[0]) and not args.allow_remote:
         raise InputError("--bind", f"{bind[0]} is not a loopback address; add --allow-remote to expose the ship")
+    signalk_ws = parse_hostport(args.signalk_ws, "--signalk-ws") if args.signalk_ws else None
+    if signalk_ws is not None and not is_loopback(signalk_ws[0]) and not args.allow_remote:
+        raise InputError("--signalk-ws", f"{signalk_ws[0]} is not a loopback address; add --allow-remote to expose it")
     key = load_key(args.key_file, args.key_env)
     scenario = load_scenario(args.scenario) if args.scenario else default_scenario()
     cfg = ShipServerConfig(publish_period=args.publish_period, speedup=args.speedup,
@@ -84,13 +90,16 @@ def run(args) -> int:
                         publish_to=[parse_hostport(a, "--publish") for a in args.publish],
                         nmea_to=parse_hostport(args.nmea_to, "--nmea-to") if args.nmea_to else None,
                         signalk_to=parse_hostport(args.signalk_to, "--signalk-to") if args.signalk_to else None,
-                        origin=_origin(args.origin))
+                        origin=_origin(args.origin), signalk_ws=signalk_ws)
 
     def started(s):
         if not args.quiet:
             host, port = s.address
+            sk = ""
+            if s.signalk_stream is not None:
+                sk = ", Signal K ws://%s:%d/signalk/v1/stream" % tuple(s.signalk_stream.address)
             print(f"serve-ship: {scenario.ship.model} ({scenario.name}) on {host}:{port}, speedup {cfg.speedup:g}, "
-                  f"state every {cfg.publish_period:g} s, HMAC {'on' if key else 'off'}; Ctrl-C stops",
+                  f"state every {cfg.publish_period:g} s, HMAC {'on' if key else 'off'}{sk}; Ctrl-C stops",
                   file=sys.stderr, flush=True)
 
     try:

@@ -14,7 +14,8 @@ module                 concept
 ``alarms``             raise / clear / acknowledge
 ``route``              waypoint following (bearing to the next waypoint)
 ``nmea``               NMEA 0183 out (HDT, THS, ROT, RSA, RMC, VTG, HTD) and in (APB, RMB, HTC)
-``signalk``            Signal K delta messages
+``signalk``            Signal K delta messages (paths, SI units) and PUT on the autopilot
+``signalk_ws``         Signal K over WebSocket (discovery, stream, subscriptions, PUT)
 ``web``                the bridge page (HTTP + WebSocket)
 ``lossy_proxy``        loss, duplication, reordering and cuts, for tests
 =====================  ==========================================================

@@ -98,11 +98,15 @@ class Autopilot:
         deltas (``steering.autopilot.target.headingTrue``, ``steering.autopilot.state``).
     signalk_to, nmea_to : (host, port) or None
         Where to send the autopilot's Signal K delta / NMEA HTD sentence each sample.
+    signalk_ws : (host, port) or None
+        Serve the Signal K stream here (WebSocket, :mod:`steerlab.runtime.signalk_ws`): the
+        ship state and autopilot paths each sample; PUT of the target heading and state.
     """
 
     def __init__(self, controller, connect, config: AutopilotConfig = AutopilotConfig(),
                  heading=None, route=None, key=None, log_path=None, engaged=True,
-                 nmea_listen=None, signalk_listen=None, signalk_to=None, nmea_to=None, bind=None):
+                 nmea_listen=None, signalk_listen=None, signalk_to=None, nmea_to=None, bind=None,
+                 signalk_ws=None):
         self.ctrl = controller
         self.connect = connect
         self.config = cfg = config.validate()
@@ -138,6 +142,8 @@ class Autopilot:
         self.signalk_listen = signalk_listen
         self.signalk_to = signalk_to
         self.nmea_to = nmea_to
+        self.signalk_ws = signalk_ws
+        self.signalk_stream = None
         self.bind = bind or (LOOPBACK if connect[0] in (LOOPBACK, "localhost") else "0.0.0.0", 0)
         self.transport = None
         self._t0 = None
@@ -145,6 +151,10 @@ class Autopilot:
         self._listeners = []
         self._log_file = None
         self._log = None
+        # compile the guidance kernels now, not at the first steering sample (with a cold numba
+        # cache that costs about a second, while the ship keeps moving)
+        course_reference(0.0, course_schedule(0.0, [(0.0, 0.1)], cfg.turn_rate), np.zeros(2))
+        wrap_to_pi(0.0)
 
     # ------------------------------------------------------------ clock and inputs
     def clock(self) -> float:
@@ -336,6 +346,11 @@ class Autopilot:
             from steerlab.runtime.signalk import autopilot_delta_json
 
             send(self.transport, autopilot_delta_json(self, time.time()).encode(), self.signalk_to)
+        if self.signalk_stream is not None:
+            from steerlab.runtime.signalk import autopilot_values, state_values
+
+            values = state_values(self.latest) if self.last_row.get("link_ok") else {}
+            self.signalk_stream.publish({**values, **autopilot_values(self)}, time.time())
 
     def _open_log(self):
         if self.log_path is None:
@@ -371,6 +386,12 @@ class Autopilot:
                         self._listeners.append(await open_udp(cb, addr))
                     except OSError as err:
                         raise InputError(field, f"cannot bind {addr[0]}:{addr[1]}: {err.strerror}") from None
+            if self.signalk_ws is not None:
+                from steerlab.runtime.signalk import autopilot_put
+                from steerlab.runtime.signalk_ws import SignalKStreamServer
+
+                self.signalk_stream = await SignalKStreamServer(
+                    *self.signalk_ws, on_put=lambda path, v: autopilot_put(self, path, v, self.clock())).start()
             self._t0 = time.monotonic()
             if started is not None:
                 started(self)
@@ -397,4 +418,6 @@ class Autopilot:
                     tr.close()
             if self._log_file is not None:
                 self._log_file.close()
+            if self.signalk_stream is not None:
+                await self.signalk_stream.close()
         return self

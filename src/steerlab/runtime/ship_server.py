@@ -93,13 +93,15 @@ class ShipServer:
         Fixed state receivers in addition to the subscribers (senders of HELLO/COMMAND).
     nmea_to, signalk_to : (host, port) or None
         Where to send NMEA 0183 sentences / Signal K deltas every ``nmea_period``.
+    signalk_ws : (host, port) or None
+        Serve the Signal K stream here (WebSocket, read-only), updated every ``nmea_period``.
     origin : (lat_deg, lon_deg)
         Geographic position of the model's origin (for RMC).
     """
 
     def __init__(self, scenario, config: ShipServerConfig = ShipServerConfig(), key=None,
                  bind=(LOOPBACK, 0), publish_to=(), nmea_to=None, signalk_to=None,
-                 origin=(54.5, 18.55)):
+                 origin=(54.5, 18.55), signalk_ws=None):
         from steerlab.sim.kernels import plant_step
         from steerlab.sim.setup import build
         from steerlab.units import knots_to_ms
@@ -130,6 +132,8 @@ class ShipServer:
         self.subscribers: dict = {}
         self.nmea_to = nmea_to
         self.signalk_to = signalk_to
+        self.signalk_ws = signalk_ws
+        self.signalk_stream = None
         self.origin = origin
         self.stats = ShipServerStats()
         self.rk4_step(0.0, self.x.copy(), 0.0, s.w[0], self.ps, s.pg, self.h, self.work)  # compile now
@@ -192,7 +196,7 @@ class ShipServer:
         for addr in self.publish_to:
             send(self.transport, data, addr)
         self.stats.published += 1
-        if (self.nmea_to or self.signalk_to) and self.t_sim + 1e-9 >= self._next_nmea:
+        if (self.nmea_to or self.signalk_to or self.signalk_stream) and self.t_sim + 1e-9 >= self._next_nmea:
             self._next_nmea = self.t_sim + self.config.nmea_period
             self._publish_marine(st)
 
@@ -206,6 +210,10 @@ class ShipServer:
             from steerlab.runtime.signalk import state_delta_json
 
             send(self.out_transport, state_delta_json(st, time.time()).encode(), self.signalk_to)
+        if self.signalk_stream is not None:
+            from steerlab.runtime.signalk import state_values
+
+            self.signalk_stream.publish(state_values(st), time.time())
 
     @property
     def address(self):
@@ -226,6 +234,14 @@ class ShipServer:
             raise InputError("--bind", f"cannot bind {self.bind[0]}:{self.bind[1]}: {err.strerror}") from None
         if self.nmea_to or self.signalk_to:
             self.out_transport = await open_udp(lambda d, a: None, (LOOPBACK if self.bind[0] == LOOPBACK else "0.0.0.0", 0))
+        if self.signalk_ws is not None:
+            from steerlab.runtime.signalk_ws import SignalKStreamServer
+
+            try:
+                self.signalk_stream = await SignalKStreamServer(*self.signalk_ws).start()
+            except InputError:
+                self.transport.close()
+                raise
         if started is not None:
             started(self)
         cfg = self.config
@@ -252,4 +268,6 @@ class ShipServer:
             self.transport.close()
             if self.out_transport is not None:
                 self.out_transport.close()
+            if self.signalk_stream is not None:
+                await self.signalk_stream.close()
         return self.stats

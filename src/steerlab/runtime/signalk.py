@@ -12,8 +12,9 @@ Paths (Signal K specification, ``vessels.self`` context; radians, rad/s, m/s)::
 
 A delta is ``{"context": "vessels.self", "updates": [{"source": {...}, "timestamp": ISO 8601,
 "values": [{"path": ..., "value": ...}, ...]}]}``, one JSON document per UDP datagram (or
-WebSocket message). :func:`parse_delta` accepts exactly that shape and returns ``{path: value}``
-or None (never raises).
+WebSocket message, :mod:`steerlab.runtime.signalk_ws`). :func:`parse_delta` accepts exactly that
+shape and returns ``{path: value}`` or None (never raises). :func:`autopilot_put` applies a
+Signal K PUT request to the autopilot (the writable paths: :data:`WRITABLE`).
 """
 
 from __future__ import annotations
@@ -26,6 +27,9 @@ from steerlab.angles import wrap_to_2pi
 
 SOURCE = {"label": "steerlab", "type": "steerlab-runtime"}
 MAX_DELTA_BYTES = 65536
+TARGET_HEADING = "steering.autopilot.target.headingTrue"
+AUTOPILOT_STATE = "steering.autopilot.state"
+WRITABLE = (TARGET_HEADING, AUTOPILOT_STATE)   #: paths a PUT may set on the autopilot
 
 
 def iso_time(wall: float) -> str:
@@ -90,3 +94,27 @@ def parse_delta(data) -> dict | None:
         return out
     except (ValueError, TypeError, RecursionError, UnicodeDecodeError):
         return None
+
+
+def autopilot_put(ap, path, value, t: float) -> tuple[int, str]:
+    """Apply a PUT of ``value`` to ``path`` on the autopilot at ship time ``t`` [s].
+
+    ``steering.autopilot.target.headingTrue``: the set course [rad, |value| <= 2 pi];
+    ``steering.autopilot.state``: ``"auto"`` (engage) or ``"standby"``. Returns
+    ``(HTTP status code, message)``: 200, 400 (bad value) or 405 (path not writable).
+    """
+    if path == TARGET_HEADING:
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) \
+                or abs(value) > 2 * math.pi:
+            return 400, "value must be a heading in radians, |value| <= 2 pi"
+        ap.set_course(float(value), t)
+        return 200, ""
+    if path == AUTOPILOT_STATE:
+        if value == "auto":
+            ap.engage(t)
+        elif value == "standby":
+            ap.standby(t)
+        else:
+            return 400, "value must be 'auto' or 'standby'"
+        return 200, ""
+    return 405, f"not writable here (writable: {', '.join(WRITABLE)})"

@@ -1,6 +1,6 @@
 """Bridge page: a live web page for the autopilot (HTTP + WebSocket on one port, no internet assets).
 
-``GET /`` serves ``static/bridge.html`` (+ ``/bridge.js``, ``/bridge.css``); ``GET /status.json``
+``GET /`` serves ``static/bridge.html`` (+ ``/bridge.js``, ``/bridge.css``, ``/favicon.svg``); ``GET /status.json``
 the current status; the WebSocket at ``/ws`` pushes ``{"type": "status", ...}`` (SI units, see
 :meth:`steerlab.runtime.autopilot.Autopilot.status`) every ``period`` seconds and accepts
 actions as JSON::
@@ -29,7 +29,8 @@ from steerlab.errors import InputError
 
 STATIC = {"/": ("bridge.html", "text/html; charset=utf-8"),
           "/bridge.js": ("bridge.js", "text/javascript; charset=utf-8"),
-          "/bridge.css": ("bridge.css", "text/css; charset=utf-8")}
+          "/bridge.css": ("bridge.css", "text/css; charset=utf-8"),
+          "/favicon.svg": ("favicon.svg", "image/svg+xml")}
 ADJUST_STEPS = (-10.0, -1.0, 1.0, 10.0)
 
 
@@ -52,6 +53,13 @@ def _response(status: HTTPStatus, body: bytes, ctype: str) -> Response:
                        ("Cache-Control", "no-store"), ("X-Content-Type-Options", "nosniff"),
                        ("Content-Security-Policy", "default-src 'self'; connect-src 'self'")])
     return Response(status.value, status.phrase, headers, body)
+
+
+def same_origin(request) -> bool:
+    """False for a browser's cross-site WebSocket (an ``Origin`` that is not this host's)."""
+    origin = request.headers.get("Origin")
+    host = request.headers.get("Host", "")
+    return origin is None or origin in (f"http://{host}", f"https://{host}")
 
 
 def handle_action(ap, msg, t: float) -> dict:
@@ -95,9 +103,7 @@ class BridgeServer:
     def _process_request(self, connection, request):
         path = request.path.split("?", 1)[0]
         if path == "/ws":
-            origin = request.headers.get("Origin")
-            host = request.headers.get("Host", "")
-            if origin is not None and origin not in (f"http://{host}", f"https://{host}"):
+            if not same_origin(request):
                 return _response(HTTPStatus.FORBIDDEN, b"cross-origin WebSocket refused\n", "text/plain")
             return None
         if path == "/status.json":

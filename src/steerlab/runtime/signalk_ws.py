@@ -1,0 +1,257 @@
+"""Signal K over WebSocket: the streaming API (``/signalk/v1/stream``) of the ship server and autopilot.
+
+The part of the Signal K specification (1.7, "Streaming API", "Subscription Protocol",
+"Request/Response") that an instrument display or a chart plotter needs:
+
+``GET /signalk``
+    Discovery: ``{"endpoints": {"v1": {"version": "1.7.0", "signalk-ws": "ws://HOST:PORT/signalk/v1/stream"}},
+    "server": {"id": "steerlab", "version": ...}}``.
+``WS /signalk/v1/stream[?subscribe=self|all|none][&sendCachedValues=true|false]``
+    On connection a *hello* (``{"name", "version", "timestamp", "self": "vessels.self", "roles"}``),
+    the cached values (unless ``sendCachedValues=false``), then every update as a delta message
+    (:func:`steerlab.runtime.signalk.delta`, SI units; the same paths as over UDP), filtered by
+    the client's subscriptions. ``subscribe=self`` (default) and ``all`` stream every path,
+    ``none`` nothing until the client subscribes; another value is answered HTTP 501 as the
+    specification asks.
+
+Messages from the client (JSON, at most 64 KiB, at most ``msg_rate`` per second per connection):
+
+* ``{"context": "vessels.self" | "*", "subscribe": [{"path": "navigation.*"}, ...]}`` adds path
+  patterns (``*`` matches any characters); ``period``/``policy`` are accepted and ignored (every
+  update is sent as it is made: the "instant" policy).
+* ``{"context": ..., "unsubscribe": [{"path": "*"}]}`` removes patterns (``*``: all).
+* ``{"requestId": ..., "put": {"path": ..., "value": ...}}`` calls ``on_put(path, value)`` and is
+  answered ``{"requestId", "state": "COMPLETED", "statusCode": 200 | 400 | 405, "message"}``;
+  an endpoint without ``on_put`` (the ship server's: read-only) answers 405.
+
+Anything else is counted as ``rejected`` and otherwise ignored; nothing a client sends closes
+the stream or raises. A WebSocket from a browser page of another origin is refused (403), more
+than ``max_clients`` connections are refused (503), and a client that does not read (its write
+buffer above ``max_buffer`` bytes) misses updates rather than growing the sender's memory.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import re
+import time
+from http import HTTPStatus
+
+from websockets.asyncio.server import broadcast, serve
+
+from steerlab.errors import InputError
+from steerlab.runtime.rate_limit import RateLimiter
+from steerlab.runtime.signalk import MAX_DELTA_BYTES, delta, iso_time
+from steerlab.runtime.web import _response, same_origin
+
+SIGNALK_VERSION = "1.7.0"
+STREAM_PATH = "/signalk/v1/stream"
+SUBSCRIBE_MODES = ("self", "all", "none")
+CONTEXTS = ("vessels.self", "*")
+
+
+def path_pattern(pattern: str) -> re.Pattern:
+    """A Signal K path pattern (``*`` = any characters) as a compiled regular expression."""
+    return re.compile("".join(".*" if c == "*" else re.escape(c) for c in pattern))
+
+
+class Subscriptions:
+    """The path patterns one client subscribed to (``all_paths``: everything)."""
+
+    def __init__(self, mode: str = "self"):
+        self.patterns: dict[str, re.Pattern] = {}
+        if mode in ("self", "all"):
+            self.patterns["*"] = path_pattern("*")
+
+    def wants(self, path: str) -> bool:
+        return any(p.fullmatch(path) for p in self.patterns.values())
+
+    def filter(self, values: dict) -> dict:
+        return {p: v for p, v in values.items() if self.wants(p)}
+
+    def apply(self, msg: dict) -> bool:
+        """Apply a subscribe / unsubscribe message; False if it is not a valid one."""
+        ctx = msg.get("context", "vessels.self")
+        if ctx not in CONTEXTS:
+            return False
+        for key, add in (("subscribe", True), ("unsubscribe", False)):
+            items = msg.get(key)
+            if items is None:
+                continue
+            if not isinstance(items, list) or len(items) > 64:
+                return False
+            for item in items:
+                path = item.get("path") if isinstance(item, dict) else None
+                if not isinstance(path, str) or not 0 < len(path) <= 256:
+                    return False
+                if add:
+                    self.patterns[path] = path_pattern(path)
+                elif path == "*":
+                    self.patterns.clear()
+                else:
+                    self.patterns.pop(path, None)
+            return True
+        return False
+
+
+class SignalKStreamServer:
+    """Serves the Signal K stream on ``(host, port)``; :meth:`publish` sends an update.
+
+    Parameters
+    ----------
+    on_put : callable ``(path, value) -> (status_code, message)`` or None
+        Applies a PUT request (None: read-only, every PUT is answered 405).
+    field : str
+        CLI option named in errors (binding failures).
+    """
+
+    def __init__(self, host: str = "127.0.0.1", port: int = 0, on_put=None, field: str = "--signalk-ws",
+                 name: str = "steerlab", max_clients: int = 8, max_buffer: int = 256 * 1024,
+                 msg_rate: float = 20.0):
+        self.host, self.port = host, port
+        self.on_put = on_put
+        self.field = field
+        self.name = name
+        self.max_clients = max_clients
+        self.max_buffer = max_buffer
+        self.limiter = RateLimiter(msg_rate, 2 * msg_rate, max_sources=4 * max_clients)
+        self.cache: dict = {}
+        self.clients: dict = {}          # connection -> Subscriptions
+        self.counts = {"clients": 0, "sent": 0, "skipped_slow": 0, "subscriptions": 0, "put_ok": 0,
+                       "put_refused": 0, "rejected": 0, "rate_limited": 0}
+        self.server = None
+
+    # ------------------------------------------------------------ HTTP side
+    def _process_request(self, connection, request):
+        path, _, query = request.path.partition("?")
+        if path in ("/signalk", "/signalk/"):
+            host = request.headers.get("Host") or "%s:%d" % tuple(self.address)
+            body = {"endpoints": {"v1": {"version": SIGNALK_VERSION, "signalk-ws": f"ws://{host}{STREAM_PATH}"}},
+                    "server": {"id": self.name, "version": _steerlab_version()}}
+            return _response(HTTPStatus.OK, json.dumps(body).encode(), "application/json")
+        if path != STREAM_PATH:
+            return _response(HTTPStatus.NOT_FOUND, b"not found\n", "text/plain")
+        if not same_origin(request):
+            return _response(HTTPStatus.FORBIDDEN, b"cross-origin WebSocket refused\n", "text/plain")
+        opts = _query(query)
+        if opts.get("subscribe", "self") not in SUBSCRIBE_MODES or \
+                opts.get("sendCachedValues", "true") not in ("true", "false"):
+            return _response(HTTPStatus.NOT_IMPLEMENTED, b"subscribe must be self, all or none\n", "text/plain")
+        if len(self.clients) >= self.max_clients:
+            return _response(HTTPStatus.SERVICE_UNAVAILABLE, b"too many Signal K clients\n", "text/plain")
+        return None
+
+    # ------------------------------------------------------------ a connection
+    async def _handler(self, ws):
+        opts = _query(ws.request.path.partition("?")[2])
+        subs = Subscriptions(opts.get("subscribe", "self"))
+        self.counts["clients"] += 1
+        try:
+            await ws.send(json.dumps({"name": self.name, "version": SIGNALK_VERSION, "timestamp": iso_time(time.time()),
+                                      "self": "vessels.self", "roles": ["master", "main"]}))
+            self.clients[ws] = subs
+            if opts.get("sendCachedValues", "true") == "true":
+                self._send(ws, subs, self.cache)
+            async for msg in ws:
+                reply = self.handle_message(ws, subs, msg)
+                if reply is not None:
+                    await ws.send(json.dumps(reply))
+        except Exception:        # a broken connection ends this client only
+            pass
+        finally:
+            self.clients.pop(ws, None)
+
+    def handle_message(self, source, subs: Subscriptions, msg):
+        """Apply one client message; the reply to send (or None). Never raises."""
+        if not self.limiter.allow(id(source), time.monotonic()):
+            self.counts["rate_limited"] += 1
+            return None
+        try:
+            if len(msg) > MAX_DELTA_BYTES:
+                raise ValueError
+            m = json.loads(msg)
+        except (ValueError, TypeError, RecursionError):
+            self.counts["rejected"] += 1
+            return None
+        if not isinstance(m, dict):
+            self.counts["rejected"] += 1
+            return None
+        if "put" in m:
+            return self._put(m)
+        if ("subscribe" in m or "unsubscribe" in m) and subs.apply(m):
+            self.counts["subscriptions"] += 1
+            return None
+        self.counts["rejected"] += 1
+        return None
+
+    def _put(self, m: dict) -> dict:
+        rid = m.get("requestId")
+        rid = rid if isinstance(rid, str) and len(rid) <= 128 else None
+        put = m.get("put")
+        if not isinstance(put, dict) or not isinstance(put.get("path"), str) or "value" not in put:
+            code, text = 400, "expected put: {path, value}"
+        elif self.on_put is None:
+            code, text = 405, "this endpoint is read-only"
+        else:
+            try:
+                code, text = self.on_put(put["path"], put["value"])
+            except Exception as err:     # a handler bug must not end the stream
+                code, text = 502, f"{type(err).__name__}"
+        self.counts["put_ok" if code == 200 else "put_refused"] += 1
+        reply = {"requestId": rid, "state": "COMPLETED", "statusCode": code}
+        if text:
+            reply["message"] = text
+        return reply
+
+    # ------------------------------------------------------------ updates
+    def _send(self, ws, subs: Subscriptions, values: dict, wall: float | None = None) -> None:
+        vals = subs.filter(values)
+        if not vals:
+            return
+        transport = getattr(ws, "transport", None)
+        if transport is not None and transport.get_write_buffer_size() > self.max_buffer:
+            self.counts["skipped_slow"] += 1
+            return
+        broadcast([ws], json.dumps(delta(vals, wall)))
+        self.counts["sent"] += 1
+
+    def publish(self, values: dict, wall: float | None = None) -> None:
+        """Send ``{path: value}`` (None values left out) to every subscribed client."""
+        values = {p: v for p, v in values.items()
+                  if v is not None and not (isinstance(v, float) and not math.isfinite(v))}
+        self.cache.update(values)
+        for ws, subs in list(self.clients.items()):
+            self._send(ws, subs, values, wall)
+
+    # ------------------------------------------------------------ lifecycle
+    @property
+    def address(self):
+        return self.server.sockets[0].getsockname()[:2] if self.server else None
+
+    async def start(self) -> "SignalKStreamServer":
+        try:
+            self.server = await serve(self._handler, self.host, self.port, process_request=self._process_request,
+                                      max_size=MAX_DELTA_BYTES, compression=None, server_header=None)
+        except OSError as err:
+            raise InputError(self.field, f"cannot bind {self.host}:{self.port}: {err.strerror}") from None
+        return self
+
+    async def close(self) -> None:
+        if self.server is not None:
+            self.server.close()
+            await self.server.wait_closed()
+
+
+def _query(q: str) -> dict:
+    from urllib.parse import parse_qsl
+
+    return dict(parse_qsl(q)[:8])
+
+
+def _steerlab_version() -> str:
+    try:
+        from steerlab import __version__
+    except ImportError:
+        return "unknown"
+    return __version__
