@@ -10,7 +10,8 @@ from steerlab.control.design_context import DesignContext
 from steerlab.control.registry import ControllerSpec, get_controller
 from steerlab.environment.disturbance import Disturbance, build_disturbance
 from steerlab.errors import InputError
-from steerlab.guidance.reference_models import course_schedule
+from steerlab.guidance.plan import GuidancePlan, build_guidance
+from steerlab.guidance.reference_vector import initial_reference
 from steerlab.ships.registry import ShipSpec, get_ship
 from steerlab.steering_gear import SteeringGear
 from steerlab.units import knots_to_ms, rad
@@ -34,6 +35,22 @@ class SimSetup:
     n_steps: int
     name: str = "scenario"
     seed: int = 0
+    guidance: GuidancePlan | None = None   # None: the time-only course schedule in gd
+
+    @property
+    def guide(self):
+        """State-dependent guidance kernel ``guide(t, x, gd, gz, ref, h)``; None = time-only course."""
+        return None if self.guidance is None else self.guidance.guide
+
+    @property
+    def gz0(self) -> np.ndarray:
+        """Initial guidance state."""
+        return np.zeros(0) if self.guidance is None else self.guidance.gz0
+
+    @property
+    def rpm_slot(self) -> int:
+        """Index in ``ps`` of the propeller rate the guidance orders (-1: none)."""
+        return -1 if self.guidance is None else self.guidance.rpm_slot
 
     @property
     def state_names(self):
@@ -66,15 +83,21 @@ def build(scenario) -> SimSetup:
     if nc < 1 or abs(nc * s.dt - ts) > 1e-9 * max(ts, 1.0):
         raise InputError("controller.sample_time", f"must be a positive multiple of dt={s.dt} s, got {ts} s")
     psi0 = rad(s.guidance.psi0_deg)
-    gd = course_schedule(psi0, [(c.t, rad(c.psi_deg)) for c in s.guidance.changes],
-                         rad(s.guidance.rate_max_deg_s))
+    plan = build_guidance(s.guidance, ship, ps)
+    gd = plan.gd
     n_steps = s.n_steps
     if n_steps > 50_000_000:
         raise InputError("duration", f"duration/dt = {n_steps} steps; allowed at most 50000000")
     x0 = np.zeros(ship.n_states + 1)
+    x0[0], x0[1] = s.guidance.start
     x0[2] = psi0
     x0[3] = speed
-    z0 = ctrl.init_state(x0, (psi0, 0.0))
+    ref0 = (psi0, 0.0)
+    if plan.guide is not None:            # the controller starts on the guidance's first reference
+        ref = initial_reference()
+        plan.guide(0.0, x0, gd, plan.gz0.copy(), ref, nc * s.dt)
+        ref0 = (float(ref[0]), float(ref[1]))
+    z0 = ctrl.init_state(x0, ref0)
     ws = s.environment.wave_sample_time
     if s.environment.waves and abs(ws / s.dt - round(ws / s.dt)) > 1e-9 * max(1.0, ws / s.dt):
         raise InputError("environment.wave_sample_time",
@@ -86,4 +109,4 @@ def build(scenario) -> SimSetup:
                        current_dir=rad(env.current_dir_deg))
     w = build_disturbance(dist, n_steps, s.dt, s.seed)
     return SimSetup(ship, ctrl_spec, ps, pg, pc, gd, x0, np.asarray(z0, dtype=float), w, s.dt, nc,
-                    n_steps, s.name, s.seed)
+                    n_steps, s.name, s.seed, plan)
