@@ -33,6 +33,7 @@ def _result(s: SimSetup, X, cmd, ref, engine: str) -> Result:
                  meta={"name": s.name, "seed": s.seed, "ship": s.ship.name,
                        "controller": s.controller.name, "engine": engine, "dt": s.dt,
                        "controller_sample_time": s.nc * s.dt, "n_steps": s.n_steps})
+    res.meta["ship_dims"] = (float(s.ship.dims[1]), float(s.ship.dims[2]))   # L, B [m] for plots
     if s.guidance is not None and s.guide is not None:
         res.meta["guidance"] = s.guidance
         res.meta["guidance_log"] = {name: ref[:, q].copy() for q, name in enumerate(REF_NAMES) if q >= 2}
