@@ -25,7 +25,9 @@ class BatchResult:
 
     ``acc``: (n, N_ACC) integral metrics (see :mod:`steerlab.metrics_online`);
     ``final_states``: (n, nx); ``time``/``states``/``delta_cmd``/``ref``: decimated logs
-    (time axis 1) when ``record_every`` was given, else only the initial row.
+    (time axis 1) when ``record_every`` was given, else only the initial row. ``ref`` has 2
+    columns ``[psi_ref, r_ref]``, or with state-dependent guidance the 6 of
+    :mod:`steerlab.guidance.reference_vector`.
     """
 
     acc: np.ndarray

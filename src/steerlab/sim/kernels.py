@@ -21,6 +21,13 @@ How the fused loop is made fast (and why the numbers do not change)
   function of time, so the loop evaluates it for a block of upcoming controller samples at
   a time (same ``t = k * dt``, same numbers) rather than interleaved with the RK4 step.
 * Sample and record decisions use counters instead of integer ``%`` per step.
+
+State-dependent guidance (LOS, berthing, course-change models with a state: see
+:mod:`steerlab.guidance.plan`) cannot be evaluated ahead: :func:`guided_closed_loop`,
+:func:`guided_lane_loop` and :func:`guided_batch_loop` call the fused guidance kernel
+``guide(t, x, gd, gz, ref, h)`` at each controller sample instead, with the guidance state
+``gz`` and the 6-entry reference vector. ``closed_loop``/``batch_loop`` with ``guide=None``
+are the time-only loops above, unchanged.
 """
 
 from __future__ import annotations
