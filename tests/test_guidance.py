@@ -192,12 +192,17 @@ def test_berthing_in_calm_water_with_the_paper_pid_gains():
     from steerlab.experiments.berthing2019 import PID_PAPER, run_case
 
     res, m = run_case(PID_PAPER, wind=False, duration=55.0)
-    rpm = res.meta["guidance_log"]["rpm_cmd"] * 60.0
-    assert set(np.unique(rpm)) <= {-60.0, 400.0, 200.0, 0.0}
+    rpm = np.round(res.meta["guidance_log"]["rpm_cmd"] * 60.0, 9)
+    assert set(np.unique(rpm)) <= {-60.0, 300.0, 200.0, 100.0, 0.0}
     # stepwise reduction, never back up, ends at 0
     steps = rpm[rpm >= 0.0]
     assert np.all(np.diff(steps) <= 0.0) and steps[-1] == 0.0
-    assert m["rpm_zero_time_s"] is not None and 30.0 < m["rpm_zero_time_s"] < 55.0
+    assert {300.0, 200.0, 100.0} <= set(steps)
+    # the orders follow the distance to the berth (12, 6): 300 rpm from 12 m, 100 rpm from 5 m
+    dist = np.hypot(res.col("x_n") - 12.0, res.col("y_e") - 6.0)
+    assert np.all(dist[rpm == -60.0] > 12.0 - 0.1)
+    assert np.all(dist[rpm == 100.0] <= 5.0 + 0.1)
+    assert m["rpm_zero_time_s"] is not None and 20.0 < m["rpm_zero_time_s"] < 55.0
     assert m["berthed"] is True
     assert m["berth_distance_m"] <= 0.5 * 1.667
     speed = np.hypot(res.col("u"), res.col("v"))
@@ -222,3 +227,18 @@ def test_track_plot_draws_route_and_outlines(tmp_path):
     # a hull heading east (90 deg) has its bow L/2 east of the centre
     poly = hull_outline(10.0, 20.0, math.pi / 2, 100.0, 20.0)
     assert poly[0] == pytest.approx([70.0, 10.0])
+
+
+def test_berthing_parity_readable_compiled_with_propeller_orders():
+    from steerlab.experiments.berthing2019 import PID_PAPER, scenario_dict
+
+    sc = scenario_from_dict(scenario_dict(PID_PAPER, wind=True, duration=25.0))
+    a = simulate(sc)
+    b = simulate(sc, "readable")
+    assert 300.0 in set(np.round(a.meta["guidance_log"]["rpm_cmd"] * 60.0, 9))
+    assert np.array_equal(a.states, b.states)
+    assert np.array_equal(a.meta["guidance_log"]["rpm_cmd"], b.meta["guidance_log"]["rpm_cmd"])
+    s = build(sc)
+    batch = simulate_batch([s, s])
+    assert np.array_equal(batch.final_states[1], a.states[-1])
+    assert np.array_equal(s.ps, build(sc).ps)            # the setup's own record is not touched

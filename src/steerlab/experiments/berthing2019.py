@@ -9,8 +9,11 @@ What the paper does not give, and steerlab assumes (each is also in the notes):
 * the route and the berth (Fig. 6 / Fig. 11 are images): start at the origin heading north at
   the Kosoko's design point (0.5 m/s, 600 rpm), a 4 m straight run, then one leg of 10 m at
   36.9 deg to the berth centre (12, 6) m; look-ahead ``Delta = 2 L``, acceptance ``R = 1 m``;
-* the rpm steps (Fig. 14 is an image): 600 -> 400 rpm at 8 m from the berth, 200 rpm at 4 m,
-  0 inside 0.5 m of the berth centre (or when abeam of it);
+* the rpm steps (Fig. 14 is an image): 600 -> 300 rpm at 12 m from the berth, 200 rpm at
+  8 m, 100 rpm at 5 m, 0 inside 0.5 m of the berth centre (or when abeam of it). Chosen so
+  that in calm water the ship is below the paper's 1 kn (full scale) when it reaches the stop
+  circle; with a shorter plan (400 rpm at 8 m, 200 rpm at 4 m) it arrives at 0.24 m/s and
+  stops about 2.5 m past the berth (PID, calm);
 * the wind direction: from the east (90 deg, on the starboard beam of the first leg);
 * the success criterion: the ship stops (speed below 1 kn full scale, 0.19 m/s at 1:7.2)
   within ``L/2 = 0.83 m`` of the berth centre (the paper's D: 0.4-0.6 m succeed, 1.7 m fails);
@@ -43,7 +46,7 @@ DESCRIPTION = ("LOS + ADRC automatic berthing paper (2019) Table 5 and Fig. 11: 
                "PID and nonlinear ADRC, with and without 1.5 m/s wind")
 
 ROUTE = [[0.0, 0.0], [4.0, 0.0], [12.0, 6.0]]
-RPM_PLAN = [[8.0, 400.0], [4.0, 200.0]]
+RPM_PLAN = [[12.0, 300.0], [8.0, 200.0], [5.0, 100.0]]
 WIND_SPEED = 1.5          # m/s, model scale (paper Sec. 4)
 WIND_FROM_DEG = 90.0      # ASSUMED
 HEADING_BAND_DEG = 5.0

@@ -155,8 +155,8 @@ def los_guidance(t, x, g, z, ref, h):
     ref[4] = e
     ref[5] = k
     # arrival at the last waypoint (the berth) and the propeller plan
-    dxb = xb - px
-    dyb = yb - py
+    dxb = g[G_WP + 2 * n - 2] - px
+    dyb = g[G_WP + 2 * n - 1] - py
     dist = math.sqrt(dxb * dxb + dyb * dyb)
     if k == n - 2 and z[2] == 0.0:
         r_stop = g[4]
