@@ -20,6 +20,7 @@ import math
 import numpy as np
 
 from steerlab.angles import wrap_to_pi, wrap_to_pi_array
+from steerlab.guidance.route_metrics import ROUTE_METRIC_UNITS, route_metrics
 from steerlab.metrics_online import (M_ABS_DELTA, M_D2_DEG, M_DURATION, M_E2_DEG, M_IAE, M_ISE, M_ITAE,
                                      M_MAX_ABS_E, M_REVERSALS, M_TRAVEL)
 
@@ -32,6 +33,7 @@ METRIC_UNITS = {
     "settling_time_2pct_s": "s", "settling_time_1deg_s": "s",
     "rudder_travel_deg": "deg", "rudder_reversals": "-", "mean_abs_rudder_deg": "deg",
     "max_abs_rudder_deg": "deg", "min_speed_kn": "kn",
+    **ROUTE_METRIC_UNITS,
 }
 
 
@@ -136,4 +138,5 @@ def compute_metrics(res, lam: float = 0.1) -> dict:
     if "u" in res.state_names:
         speed = np.hypot(res.col("u"), res.col("v"))
         m["min_speed_kn"] = float(np.min(speed) / (1852.0 / 3600.0))
+    m.update(route_metrics(res))              # LOS / berthing runs only
     return {k: (float(v) if isinstance(v, (np.floating,)) else v) for k, v in m.items()}

@@ -226,6 +226,8 @@ def plot_track(path: Path, result, title: str = "") -> Path:
     ax.plot(east * scale, north * scale, color="C0", lw=1.2, label="track")
     ax.plot(east[0] * scale, north[0] * scale, "o", color="C2", ms=7, label="start")
     ax.plot(east[-1] * scale, north[-1] * scale, "s", color="C3", ms=7, label="end")
+    from steerlab.track_figures import annotate_run
+    annotate_run(ax, result, scale)      # route, berth and ship outlines when the run has them
     ax.set_aspect("equal", adjustable="datalim")
     ax.set_xlabel(f"east y_e [{unit}]")
     ax.set_ylabel(f"north x_n [{unit}]")

@@ -13,6 +13,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from steerlab.errors import InputError
+from steerlab.guidance.reference_vector import N_REF
 from steerlab.metrics_online import N_ACC
 from steerlab.sim.kernels import LANES, batch_loop
 from steerlab.sim.setup import SimSetup
@@ -24,7 +25,9 @@ class BatchResult:
 
     ``acc``: (n, N_ACC) integral metrics (see :mod:`steerlab.metrics_online`);
     ``final_states``: (n, nx); ``time``/``states``/``delta_cmd``/``ref``: decimated logs
-    (time axis 1) when ``record_every`` was given, else only the initial row.
+    (time axis 1) when ``record_every`` was given, else only the initial row. ``ref`` has 2
+    columns ``[psi_ref, r_ref]``, or with state-dependent guidance the 6 of
+    :mod:`steerlab.guidance.reference_vector`.
     """
 
     acc: np.ndarray
@@ -55,6 +58,8 @@ def simulate_batch(setups: list[SimSetup], record_every: int | None = None, lane
     for i, s in enumerate(setups):
         if s.ship.rhs is not s0.ship.rhs or s.controller.update is not s0.controller.update:
             raise InputError(f"setups[{i}]", "all runs of a batch must use the same ship model and controller")
+        if s.guide is not s0.guide or s.rpm_slot != s0.rpm_slot:
+            raise InputError(f"setups[{i}]", "all runs of a batch must use the same kind of guidance")
         if (s.dt, s.nc, s.n_steps) != (s0.dt, s0.nc, s0.n_steps):
             raise InputError(f"setups[{i}]", "all runs of a batch need the same dt, sample time and duration")
     n = len(setups)
@@ -83,12 +88,18 @@ def simulate_batch(setups: list[SimSetup], record_every: int | None = None, lane
     nx = X.shape[1]
     out_x = np.empty((n, n_rec, nx))
     out_cmd = np.empty((n, n_rec))
-    out_ref = np.empty((n, n_rec, 2))
     acc = np.zeros((n, N_ACC))
     if not 1 <= int(lanes) <= 64:
         raise InputError("lanes", f"must be in [1, 64], got {lanes}")
-    run_batch = batch_loop(s0.ship.rhs, s0.controller.update, nx, int(lanes))
-    run_batch(X, Z, PS, PG, PC, GD, W, w_index, s0.dt, s0.nc, N, rec, out_x, out_cmd, out_ref, acc)
+    run_batch = batch_loop(s0.ship.rhs, s0.controller.update, nx, int(lanes), s0.guide)
+    if s0.guide is None:
+        out_ref = np.empty((n, n_rec, 2))
+        run_batch(X, Z, PS, PG, PC, GD, W, w_index, s0.dt, s0.nc, N, rec, out_x, out_cmd, out_ref, acc)
+    else:   # state-dependent guidance: its own state per run; PS is this batch's copy
+        out_ref = np.empty((n, n_rec, N_REF))
+        GZ = _stack([s.gz0 for s in setups], "gz0").copy()
+        run_batch(X, Z, PS, PG, PC, GD, GZ, W, w_index, s0.dt, s0.nc, N, rec, out_x, out_cmd, out_ref,
+                  acc, s0.rpm_slot)
     time = np.arange(n_rec) * rec * s0.dt
     return BatchResult(acc, X, time, out_x, out_cmd, out_ref, s0.state_names)
 

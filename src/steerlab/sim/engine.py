@@ -11,6 +11,7 @@ import numpy as np
 
 from steerlab.angles import wrap_to_pi_array
 from steerlab.guidance.reference_models import course_reference
+from steerlab.guidance.reference_vector import N_REF, REF_NAMES, REF_RPM, initial_reference
 from steerlab.metrics_online import accumulate, new_accumulator
 from steerlab.sim.kernels import closed_loop, plant_step
 from steerlab.sim.result import Result
@@ -27,11 +28,16 @@ def _as_setup(scenario_or_setup) -> SimSetup:
 
 def _result(s: SimSetup, X, cmd, ref, engine: str) -> Result:
     time = np.arange(s.n_steps + 1) * s.dt
-    return Result(time=time, states=X, state_names=s.state_names, state_units=s.state_units,
-                  delta_cmd=cmd, psi_ref=ref[:, 0], r_ref=ref[:, 1], disturbance=s.w,
-                  meta={"name": s.name, "seed": s.seed, "ship": s.ship.name,
-                        "controller": s.controller.name, "engine": engine, "dt": s.dt,
-                        "controller_sample_time": s.nc * s.dt, "n_steps": s.n_steps})
+    res = Result(time=time, states=X, state_names=s.state_names, state_units=s.state_units,
+                 delta_cmd=cmd, psi_ref=ref[:, 0], r_ref=ref[:, 1], disturbance=s.w,
+                 meta={"name": s.name, "seed": s.seed, "ship": s.ship.name,
+                       "controller": s.controller.name, "engine": engine, "dt": s.dt,
+                       "controller_sample_time": s.nc * s.dt, "n_steps": s.n_steps})
+    res.meta["ship_dims"] = (float(s.ship.dims[1]), float(s.ship.dims[2]))   # L, B [m] for plots
+    if s.guidance is not None and s.guide is not None:
+        res.meta["guidance"] = s.guidance
+        res.meta["guidance_log"] = {name: ref[:, q].copy() for q, name in enumerate(REF_NAMES) if q >= 2}
+    return res
 
 
 def simulate_readable(scenario_or_setup) -> Result:
@@ -45,37 +51,51 @@ def simulate_readable(scenario_or_setup) -> Result:
     N = s.n_steps
     X = np.empty((N + 1, nx))
     cmd_log = np.empty(N + 1)
-    ref_log = np.empty((N + 1, 2))
     work = np.empty((5, nx))
-    ref = np.zeros(2)
+    guide = s.guide
+    ref = initial_reference()
+    ref_log = np.empty((N + 1, N_REF if guide is not None else 2))
+    gz = s.gz0.copy()
+    ps = s.ps.copy()                              # the guidance may order the propeller rate
+    slot = s.rpm_slot
     cmd = 0.0
     h = s.nc * s.dt
     for k in range(N + 1):
         t = k * s.dt
         if k % s.nc == 0:                         # controller sample: guidance, then control law
-            course_reference(t, s.gd, ref)
+            if guide is None:
+                course_reference(t, s.gd, ref)    # time-only course schedule
+            else:
+                guide(t, x, s.gd, gz, ref, h)     # state-dependent guidance (LOS, models ...)
+                if slot >= 0 and ref[REF_RPM] >= 0.0:
+                    ps[slot] = ref[REF_RPM]
             cmd = update(z, s.pc, t, x, ref, h)
         X[k] = x
         cmd_log[k] = cmd
-        ref_log[k] = ref
+        ref_log[k] = ref[:ref_log.shape[1]]
         if k == N:
             break
-        rk4_step(t, x, cmd, s.w[k], s.ps, s.pg, s.dt, work)   # ship + gear, order held (ZOH)
+        rk4_step(t, x, cmd, s.w[k], ps, s.pg, s.dt, work)   # ship + gear, order held (ZOH)
     return _result(s, X, cmd_log, ref_log, "readable")
 
 
 def simulate_compiled(scenario_or_setup) -> Result:
     """The compiled closed loop (numba), recording every step."""
     s = _as_setup(scenario_or_setup)
-    run = closed_loop(s.ship.rhs, s.controller.update, s.x0.shape[0])
+    run = closed_loop(s.ship.rhs, s.controller.update, s.x0.shape[0], s.guide)
     x = s.x0.copy()
     z = s.z0.copy()
     N = s.n_steps
     X = np.empty((N + 1, x.shape[0]))
     cmd = np.empty(N + 1)
-    ref = np.empty((N + 1, 2))
     acc = new_accumulator()
-    run(x, z, s.ps, s.pg, s.pc, s.gd, s.w, s.dt, s.nc, N, 1, X, cmd, ref, acc)
+    if s.guide is None:
+        ref = np.empty((N + 1, 2))
+        run(x, z, s.ps, s.pg, s.pc, s.gd, s.w, s.dt, s.nc, N, 1, X, cmd, ref, acc)
+    else:
+        ref = np.empty((N + 1, N_REF))
+        run(x, z, s.ps.copy(), s.pg, s.pc, s.gd, s.gz0.copy(), s.w, s.dt, s.nc, N, 1, X, cmd, ref,
+            acc, s.rpm_slot)
     res = _result(s, X, cmd, ref, "compiled")
     res.meta["online_metrics"] = acc
     return res

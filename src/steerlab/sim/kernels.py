@@ -21,6 +21,13 @@ How the fused loop is made fast (and why the numbers do not change)
   function of time, so the loop evaluates it for a block of upcoming controller samples at
   a time (same ``t = k * dt``, same numbers) rather than interleaved with the RK4 step.
 * Sample and record decisions use counters instead of integer ``%`` per step.
+
+State-dependent guidance (LOS, berthing, course-change models with a state: see
+:mod:`steerlab.guidance.plan`) cannot be evaluated ahead: :func:`guided_closed_loop`,
+:func:`guided_lane_loop` and :func:`guided_batch_loop` call the fused guidance kernel
+``guide(t, x, gd, gz, ref, h)`` at each controller sample instead, with the guidance state
+``gz`` and the 6-entry reference vector. ``closed_loop``/``batch_loop`` with ``guide=None``
+are the time-only loops above, unchanged.
 """
 
 from __future__ import annotations
@@ -34,6 +41,7 @@ from numba.core.registry import CPUDispatcher
 
 from steerlab.angles import wrap_to_pi
 from steerlab.guidance.reference_models import course_reference
+from steerlab.guidance.reference_vector import N_REF, REF_LEG, REF_RPM, REF_XTE
 from steerlab.metrics_online import accumulate
 from steerlab.steering_gear import gear_clamp, gear_rate
 
@@ -139,8 +147,12 @@ def plant_step(ship_rhs):
 
 
 @lru_cache(maxsize=None)
-def closed_loop(ship_rhs, ctrl_update, nx: int | None = None):
-    """Compiled closed loop for one (ship, controller) pair.
+def closed_loop(ship_rhs, ctrl_update, nx: int | None = None, guide=None):
+    """Compiled closed loop for one (ship, controller[, guidance]) combination.
+
+    ``guide = None``: the time-only course schedule (below). Otherwise ``guide`` is a
+    state-dependent guidance kernel ``guide(t, x, gd, gz, ref, h)`` (see
+    :mod:`steerlab.guidance.plan`) and the loop is :func:`guided_closed_loop`'s.
 
     ``run(x, z, ps, pg, pc, gd, w, dt, nc, n_steps, rec_every, out_x, out_cmd, out_ref, acc)``
     advances ``x`` (plant state) and ``z`` (controller state) in place over ``n_steps`` steps
@@ -152,6 +164,8 @@ def closed_loop(ship_rhs, ctrl_update, nx: int | None = None):
     ``nx`` (the plant state size, ship states + rudder), when given, specialises the loop on
     it (faster); ``run`` then raises ``ValueError`` for a state of another size.
     """
+    if guide is not None:
+        return guided_closed_loop(ship_rhs, ctrl_update, guide, nx)
     NX = 0 if nx is None else int(nx)
     rk4 = _plant_kernels(ship_rhs, NX)[0]
     update = _fused(ctrl_update)
@@ -226,6 +240,86 @@ def closed_loop(ship_rhs, ctrl_update, nx: int | None = None):
         rbuf = np.empty((RB, 2))
         loop(x, z, ps, pg, pc, gd, w, dt, nc, n_steps, rec_every, out_x, out_cmd, out_ref, acc,
              k1, k2, k3, k4, xt, ref, rbuf)
+
+    return run
+
+
+@lru_cache(maxsize=None)
+def guided_closed_loop(ship_rhs, ctrl_update, guide, nx: int | None = None):
+    """Compiled closed loop with a state-dependent guidance kernel, evaluated at every sample.
+
+    ``run(x, z, ps, pg, pc, gd, gz, w, dt, nc, n_steps, rec_every, out_x, out_cmd, out_ref,
+    acc, rpm_slot)``: as :func:`closed_loop`'s ``run``, plus the guidance state ``gz``
+    (advanced in place) and ``rpm_slot``: when >= 0, a propeller-rate order of the guidance
+    (``ref[REF_RPM] >= 0``) is written to ``ps[rpm_slot]`` at the sample, so ``ps`` must be
+    the run's own copy. ``out_ref`` has up to ``N_REF`` columns
+    (:mod:`steerlab.guidance.reference_vector`); as many as it has are recorded.
+    """
+    NX = 0 if nx is None else int(nx)
+    rk4 = _plant_kernels(ship_rhs, NX)[0]
+    update = _fused(ctrl_update)
+    reference = _fused(guide)
+    acc_step = _fused(accumulate)
+    wrap = _fused(wrap_to_pi)
+    NR = N_REF
+    RPM = REF_RPM
+
+    @_jit_fused
+    def loop(x, z, ps, pg, pc, gd, gz, w, dt, nc, n_steps, rec_every, out_x, out_cmd, out_ref,
+             acc, rpm_slot, k1, k2, k3, k4, xt, ref):
+        nx = x.shape[0] if NX == 0 else NX
+        nr = min(out_ref.shape[1], NR)
+        cmd = 0.0
+        h = nc * dt
+        j = 0
+        kc = 0
+        kr = 0
+        for k in range(n_steps + 1):
+            t = k * dt
+            sample = kc == 0
+            if sample:
+                reference(t, x, gd, gz, ref, h)
+                if rpm_slot >= 0 and ref[RPM] >= 0.0:
+                    ps[rpm_slot] = ref[RPM]
+            e = wrap(ref[0] - x[2])
+            if sample:
+                cmd = update(z, pc, t, x, ref, h)
+            kc += 1
+            if kc == nc:
+                kc = 0
+            if kr == 0:
+                for i in range(nx):
+                    out_x[j, i] = x[i]
+                out_cmd[j] = cmd
+                for q in range(nr):
+                    out_ref[j, q] = ref[q]
+                j += 1
+            kr += 1
+            if kr == rec_every:
+                kr = 0
+            if k == n_steps:
+                break
+            delta = x[nx - 1]
+            rk4(t, x, cmd, w[k], ps, pg, dt, k1, k2, k3, k4, xt)
+            acc_step(acc, t, e, delta, x[nx - 1], dt)
+
+    @numba.njit
+    def run(x, z, ps, pg, pc, gd, gz, w, dt, nc, n_steps, rec_every, out_x, out_cmd, out_ref, acc,
+            rpm_slot):
+        nx = x.shape[0]
+        if NX != 0 and nx != NX:
+            raise ValueError("plant state size differs from the one this loop was built for")
+        k1 = np.empty(nx)
+        k2 = np.empty(nx)
+        k3 = np.empty(nx)
+        k4 = np.empty(nx)
+        xt = np.empty(nx)
+        ref = np.zeros(NR)
+        ref[RPM] = -1.0
+        ref[REF_XTE] = np.nan
+        ref[REF_LEG] = -1.0
+        loop(x, z, ps, pg, pc, gd, gz, w, dt, nc, n_steps, rec_every, out_x, out_cmd, out_ref, acc,
+             rpm_slot, k1, k2, k3, k4, xt, ref)
 
     return run
 
@@ -341,13 +435,144 @@ def lane_loop(ship_rhs, ctrl_update, nx: int, lanes: int = LANES):
 
 
 @lru_cache(maxsize=None)
-def batch_loop(ship_rhs, ctrl_update, nx: int, lanes: int = LANES):
+def guided_lane_loop(ship_rhs, ctrl_update, guide, nx: int, lanes: int = LANES):
+    """:func:`lane_loop` with a state-dependent guidance kernel (see :func:`guided_closed_loop`).
+
+    ``group(X, Z, PS, PG, PC, GD, GZ, W, w_index, i0, n_act, dt, nc, n_steps, rec_every,
+    out_x, out_cmd, out_ref, ACC, rpm_slot, K1, K2, K3, K4, XT, REF, CMD, E, DPREV)``;
+    ``PS`` rows are overwritten at ``rpm_slot`` (when >= 0) by the guidance's propeller order.
+    """
+    NX = int(nx)
+    _, _, plant_rhs, clamp = _plant_kernels(ship_rhs, NX)
+    update = _fused(ctrl_update)
+    reference = _fused(guide)
+    acc_step = _fused(accumulate)
+    wrap = _fused(wrap_to_pi)
+    NR = N_REF
+    RPM = REF_RPM
+
+    @_jit_fused
+    def group(X, Z, PS, PG, PC, GD, GZ, W, w_index, i0, n_act, dt, nc, n_steps, rec_every,
+              out_x, out_cmd, out_ref, ACC, rpm_slot, K1, K2, K3, K4, XT, REF, CMD, E, DPREV):
+        h = nc * dt
+        h2 = 0.5 * dt
+        s6 = dt / 6.0
+        nr = min(out_ref.shape[2], NR)
+        j = 0
+        kc = 0
+        kr = 0
+        for g in range(n_act):
+            CMD[g] = 0.0
+        for k in range(n_steps + 1):
+            t = k * dt
+            sample = kc == 0
+            for g in range(n_act):
+                i = i0 + g
+                if sample:
+                    reference(t, X[i], GD[i], GZ[i], REF[g], h)
+                    if rpm_slot >= 0 and REF[g, RPM] >= 0.0:
+                        PS[i, rpm_slot] = REF[g, RPM]
+                E[g] = wrap(REF[g, 0] - X[i, 2])
+                if sample:
+                    CMD[g] = update(Z[i], PC[i], t, X[i], REF[g], h)
+            kc += 1
+            if kc == nc:
+                kc = 0
+            if kr == 0:
+                for g in range(n_act):
+                    i = i0 + g
+                    for q in range(NX):
+                        out_x[i, j, q] = X[i, q]
+                    out_cmd[i, j] = CMD[g]
+                    for q in range(nr):
+                        out_ref[i, j, q] = REF[g, q]
+                j += 1
+            kr += 1
+            if kr == rec_every:
+                kr = 0
+            if k == n_steps:
+                break
+            t2 = t + h2
+            for g in range(n_act):
+                i = i0 + g
+                DPREV[g] = X[i, NX - 1]
+                plant_rhs(t, X[i], CMD[g], W[w_index[i], k], PS[i], PG[i], K1[g])
+            for g in range(n_act):
+                i = i0 + g
+                for q in range(NX):
+                    XT[g, q] = X[i, q] + h2 * K1[g, q]
+                plant_rhs(t2, XT[g], CMD[g], W[w_index[i], k], PS[i], PG[i], K2[g])
+            for g in range(n_act):
+                i = i0 + g
+                for q in range(NX):
+                    XT[g, q] = X[i, q] + h2 * K2[g, q]
+                plant_rhs(t2, XT[g], CMD[g], W[w_index[i], k], PS[i], PG[i], K3[g])
+            for g in range(n_act):
+                i = i0 + g
+                for q in range(NX):
+                    XT[g, q] = X[i, q] + dt * K3[g, q]
+                plant_rhs(t + dt, XT[g], CMD[g], W[w_index[i], k], PS[i], PG[i], K4[g])
+            for g in range(n_act):
+                i = i0 + g
+                for q in range(NX):
+                    X[i, q] += s6 * (K1[g, q] + 2.0 * K2[g, q] + 2.0 * K3[g, q] + K4[g, q])
+                X[i, NX - 1] = clamp(X[i, NX - 1], PG[i])
+                acc_step(ACC[i], t, E[g], DPREV[g], X[i, NX - 1], dt)
+
+    return group
+
+
+@lru_cache(maxsize=None)
+def guided_batch_loop(ship_rhs, ctrl_update, guide, nx: int, lanes: int = LANES):
+    """:func:`batch_loop` with a state-dependent guidance kernel.
+
+    ``run_batch(X, Z, PS, PG, PC, GD, GZ, W, w_index, dt, nc, n_steps, rec_every, out_x,
+    out_cmd, out_ref, ACC, rpm_slot)``; ``PS`` and ``GZ`` are modified in place.
+    """
+    group = guided_lane_loop(ship_rhs, ctrl_update, guide, int(nx), int(lanes))
+    G = int(lanes)
+    NX = int(nx)
+    NR = N_REF
+
+    @numba.njit(parallel=True)
+    def run_batch(X, Z, PS, PG, PC, GD, GZ, W, w_index, dt, nc, n_steps, rec_every,
+                  out_x, out_cmd, out_ref, ACC, rpm_slot):
+        n = X.shape[0]
+        if X.shape[1] != NX:
+            raise ValueError("plant state size differs from the one this loop was built for")
+        n_groups = (n + G - 1) // G
+        for gi in numba.prange(n_groups):
+            i0 = gi * G
+            n_act = min(G, n - i0)
+            K1 = np.empty((G, NX))
+            K2 = np.empty((G, NX))
+            K3 = np.empty((G, NX))
+            K4 = np.empty((G, NX))
+            XT = np.empty((G, NX))
+            REF = np.zeros((G, NR))
+            for g in range(G):
+                REF[g, REF_RPM] = -1.0
+                REF[g, REF_XTE] = np.nan
+                REF[g, REF_LEG] = -1.0
+            CMD = np.empty(G)
+            E = np.empty(G)
+            DPREV = np.empty(G)
+            group(X, Z, PS, PG, PC, GD, GZ, W, w_index, i0, n_act, dt, nc, n_steps, rec_every,
+                  out_x, out_cmd, out_ref, ACC, rpm_slot, K1, K2, K3, K4, XT, REF, CMD, E, DPREV)
+
+    return run_batch
+
+
+@lru_cache(maxsize=None)
+def batch_loop(ship_rhs, ctrl_update, nx: int, lanes: int = LANES, guide=None):
     """Parallel batch over scenarios: groups of ``lanes`` runs (:func:`lane_loop`) spread over
-    the cores with numba ``prange``.
+    the cores with numba ``prange``. With a ``guide`` kernel: :func:`guided_batch_loop`.
 
     Per-run 2-D inputs have a leading run axis; ``w`` is a stack of disturbance sequences
     shared by index ``w_index[i]`` (so 1000 runs in the same sea store it once).
     """
+    if guide is not None:
+        return guided_batch_loop(ship_rhs, ctrl_update, guide, int(nx), int(lanes))
     group = lane_loop(ship_rhs, ctrl_update, int(nx), int(lanes))
     G = int(lanes)
     NX = int(nx)

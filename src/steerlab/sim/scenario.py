@@ -77,12 +77,38 @@ ControllerConfig = _controller_union()
 class CourseChange(_Frozen):
     t: float = Field(ge=0.0, description="time of the change [s]")
     psi_deg: float = Field(ge=-360.0, le=360.0, description="new set heading [deg]")
+    direction: Literal["shortest", "starboard", "port"] = Field(
+        "shortest", description="which way to turn (types rate_limited, third_order)")
 
 
 class GuidanceConfig(_Frozen):
+    """``[guidance]``: see :mod:`steerlab.guidance.plan` and docs/guidance.md."""
+
+    type: Literal["course", "rate_limited", "third_order", "los", "berthing"] = "course"
     psi0_deg: float = Field(0.0, ge=-360.0, le=360.0)
     rate_max_deg_s: float = Field(0.0, ge=0.0, le=10.0, description="0 = step set-point")
     changes: tuple[CourseChange, ...] = ()
+    # course-change reference models
+    omega_n: float = Field(0.1, gt=0.0, le=10.0, description="natural frequency [rad/s]")
+    zeta: float = Field(1.0, gt=0.0, le=10.0, description="damping ratio [-]")
+    accel_max_deg_s2: Optional[float] = Field(None, gt=0.0, le=100.0,
+                                              description="yaw-acceleration limit [deg/s^2]; none if absent")
+    # routes (los, berthing)
+    start: tuple[float, float] = Field((0.0, 0.0), description="initial position [x_n, y_e] [m]")
+    route: tuple[tuple[float, float], ...] = Field((), description="waypoints [[x_n, y_e], ...] [m]")
+    route_file: Optional[str] = Field(None, description="CSV of waypoints x_n, y_e [m]")
+    lookahead_L: float = Field(2.0, gt=0.0, le=100.0, description="n in Delta = n L [-]")
+    accept_radius_m: Optional[float] = Field(None, gt=0.0, le=1e6, description="R [m]; default L")
+    xte_tolerance_m: Optional[float] = Field(None, gt=0.0, le=1e6,
+                                             description="|XTE| counted on route [m]; default R")
+    # berthing
+    rpm_plan: tuple[tuple[float, float], ...] = Field(
+        (), description="[[distance to berth [m], rpm], ...], distances decreasing")
+    stop_radius_m: Optional[float] = Field(None, gt=0.0, le=1e6, description="rpm 0 inside [m]; default R")
+    success_radius_m: Optional[float] = Field(None, gt=0.0, le=1e6,
+                                              description="berthed if the final D is within [m]; default L/2")
+    berth_speed_max_kn: float = Field(1.0, gt=0.0, le=10.0, description="full-scale speed limit [kn]")
+    model_scale: float = Field(1.0, ge=1.0, le=1000.0, description="Froude scale of the ship model [-]")
 
 
 class EnvironmentConfig(_Frozen):
@@ -171,6 +197,9 @@ def load_scenario(path) -> Scenario:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as err:
         raise InputError("scenario", f"malformed TOML in {p.name}: {err}") from None
+    g = data.get("guidance") if isinstance(data, dict) else None
+    if isinstance(g, dict) and isinstance(g.get("route_file"), str) and not Path(g["route_file"]).is_absolute():
+        g["route_file"] = str(p.parent / g["route_file"])     # relative to the scenario file
     return scenario_from_dict(data)
 
 

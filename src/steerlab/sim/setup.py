@@ -11,7 +11,8 @@ from steerlab.control.registry import ControllerSpec, get_controller
 from steerlab.environment.disturbance import Disturbance, build_disturbance
 from steerlab.environment.sea import SeaContext, add_sea, uses_sea
 from steerlab.errors import InputError
-from steerlab.guidance.reference_models import course_schedule
+from steerlab.guidance.plan import GuidancePlan, build_guidance
+from steerlab.guidance.reference_vector import initial_reference
 from steerlab.sensors.wrapper import with_sensors
 from steerlab.ships.registry import ShipSpec, get_ship
 from steerlab.steering_gear import SteeringGear
@@ -36,6 +37,22 @@ class SimSetup:
     n_steps: int
     name: str = "scenario"
     seed: int = 0
+    guidance: GuidancePlan | None = None   # None: the time-only course schedule in gd
+
+    @property
+    def guide(self):
+        """State-dependent guidance kernel ``guide(t, x, gd, gz, ref, h)``; None = time-only course."""
+        return None if self.guidance is None else self.guidance.guide
+
+    @property
+    def gz0(self) -> np.ndarray:
+        """Initial guidance state."""
+        return np.zeros(0) if self.guidance is None else self.guidance.gz0
+
+    @property
+    def rpm_slot(self) -> int:
+        """Index in ``ps`` of the propeller rate the guidance orders (-1: none)."""
+        return -1 if self.guidance is None else self.guidance.rpm_slot
 
     @property
     def state_names(self):
@@ -68,15 +85,21 @@ def build(scenario) -> SimSetup:
     if nc < 1 or abs(nc * s.dt - ts) > 1e-9 * max(ts, 1.0):
         raise InputError("controller.sample_time", f"must be a positive multiple of dt={s.dt} s, got {ts} s")
     psi0 = rad(s.guidance.psi0_deg)
-    gd = course_schedule(psi0, [(c.t, rad(c.psi_deg)) for c in s.guidance.changes],
-                         rad(s.guidance.rate_max_deg_s))
+    plan = build_guidance(s.guidance, ship, ps)
+    gd = plan.gd
     n_steps = s.n_steps
     if n_steps > 50_000_000:
         raise InputError("duration", f"duration/dt = {n_steps} steps; allowed at most 50000000")
     x0 = np.zeros(ship.n_states + 1)
+    x0[0], x0[1] = s.guidance.start
     x0[2] = psi0
     x0[3] = speed
-    z0 = ctrl.init_state(x0, (psi0, 0.0))
+    ref0 = (psi0, 0.0)
+    if plan.guide is not None:            # the controller starts on the guidance's first reference
+        ref = initial_reference()
+        plan.guide(0.0, x0, gd, plan.gz0.copy(), ref, nc * s.dt)
+        ref0 = (float(ref[0]), float(ref[1]))
+    z0 = ctrl.init_state(x0, ref0)
     ws = s.environment.wave_sample_time
     eq39 = s.environment.waves or (s.environment.wave is not None and s.environment.wave.model == "eq39")
     if eq39 and abs(ws / s.dt - round(ws / s.dt)) > 1e-9 * max(1.0, ws / s.dt):
@@ -89,14 +112,18 @@ def build(scenario) -> SimSetup:
                        current_dir=rad(env.current_dir_deg))
     w = build_disturbance(dist, n_steps, s.dt, s.seed)
     if uses_sea(env):
+        if plan.guide is None:
+            headings = lambda t: reference_headings(gd, t)  # noqa: E731
+        else:  # state-dependent guidance: its headings are unknown before the run; use the first
+            headings = lambda t: np.full(len(t), ref0[0])  # noqa: E731
         add_sea(w, env, SeaContext(ship, ps, x0, speed, lambda: ship.nomoto(speed, ship_options),
-                                   lambda t: reference_headings(gd, t), lambda: _rudder_b2(ship, speed, ship_options)),
+                                   headings, lambda: _rudder_b2(ship, speed, ship_options)),
                 s.dt, s.seed)
     z0 = np.asarray(z0, dtype=float)
     if s.sensors is not None:
         ctrl_spec, pc, z0 = with_sensors(ctrl_spec, pc, z0, s.sensors, s.seed, ts, x0.shape[0])
     return SimSetup(ship, ctrl_spec, ps, pg, pc, gd, x0, z0, w, s.dt, nc,
-                    n_steps, s.name, s.seed)
+                    n_steps, s.name, s.seed, plan)
 
 
 def _rudder_b2(ship, speed, options) -> float:

@@ -1,0 +1,180 @@
+r"""Line-of-sight (LOS) route following, with an optional distance-based propeller plan.
+
+Source: LOS + ADRC automatic berthing paper (J. Mar. Sci. Eng. 7 (2019) 300), Sec. 2.1,
+eqs (1)-(3). Positions ``(x_n, y_e)`` [m] north and east, headings clockwise from north.
+On the leg from waypoint ``P_k`` to ``P_{k+1}``::
+
+    alpha_k   = atan2(y_{k+1} - y_k, x_{k+1} - x_k)                  leg course     (Fig. 4)
+    e         = -(x - x_k) sin alpha_k + (y - y_k) cos alpha_k        cross-track error
+    psi_ref   = alpha_k + atan(-e / Delta),   Delta = n L              LOS heading    (2)
+    next leg  when (x_{k+1} - x)^2 + (y_{k+1} - y)^2 <= R^2           acceptance circle (3)
+
+``e > 0`` when the ship is to starboard of the leg, so ``psi_ref`` turns it to port. (Eq (1),
+the bearing of ``P_{k+1}`` from the ship, is the limit ``Delta -> 0`` of the look-ahead law
+and is not used: eq (2) is what the paper steers by.) ``r_ref = 0``: the law gives a heading,
+not a rate. After the last waypoint the last leg is continued (the ship holds its line).
+
+Propeller plan (berthing paper Sec. 4: "the speed control adopts the step-by-step descending
+mode ... the speed changes to 0 when the specified berth arrives"): stages ``(d_j, n_j)``
+with ``d_1 > d_2 > ...``: once the straight-line distance to the last waypoint (the berth)
+has come down to ``d_j``, the propeller-rate order is ``n_j`` (it never goes back up); on
+arrival it is 0. Arrival: inside the circle of radius ``R_stop`` around the berth, or
+passing abeam of it on the last leg (a ship that misses the circle stops there too, rather
+than sailing on; steerlab's choice, the paper does not say).
+
+Packed record ``g``::
+
+    g[0] Delta [m]   g[1] R [m]   g[2] n_wp   g[3] n_stages   g[4] R_stop [m]
+    g[5 : 5 + 2 n_wp]                 waypoints x_0, y_0, x_1, y_1, ...
+    then n_stages distances [m], then n_stages rates [rev/s]
+
+State ``z = [k (leg), stages passed, arrived (0/1)]``. Logged leg: ``k``, or ``n_wp - 1`` after arrival.
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+from pathlib import Path
+
+import numba
+import numpy as np
+
+from steerlab.angles import wrap_to_pi
+from steerlab.errors import InputError, require_finite_range
+
+G_WP = 5
+N_STATE = 3
+MAX_WAYPOINTS = 10_000
+
+
+def check_route(route, field: str = "guidance.route") -> np.ndarray:
+    """``route`` as an (n, 2) float array [m]; at least 2 finite waypoints, no zero-length leg."""
+    try:
+        a = np.asarray(route, dtype=float)
+    except (TypeError, ValueError):
+        raise InputError(field, "must be a list of [x_n, y_e] pairs in metres") from None
+    if a.ndim != 2 or a.shape[1] != 2:
+        raise InputError(field, f"must be a list of [x_n, y_e] pairs in metres, got shape {a.shape}")
+    if not 2 <= a.shape[0] <= MAX_WAYPOINTS:
+        raise InputError(field, f"needs 2 to {MAX_WAYPOINTS} waypoints, got {a.shape[0]}")
+    bad = np.argwhere(~np.isfinite(a))
+    if bad.size:
+        i, j = bad[0]
+        raise InputError(f"{field}[{i}]", f"waypoint coordinates must be finite, got {a[i].tolist()}")
+    if np.any(np.abs(a) > 1e8):
+        raise InputError(field, "waypoint coordinates must be within +-1e8 m")
+    legs = np.hypot(*np.diff(a, axis=0).T)
+    if np.any(legs <= 0.0):
+        i = int(np.argmax(legs <= 0.0))
+        raise InputError(f"{field}[{i + 1}]", "repeats the previous waypoint (legs must have length > 0)")
+    return a
+
+
+def read_route_csv(path) -> np.ndarray:
+    """Waypoints from a CSV file: two columns ``x_n, y_e`` [m]; an optional header line; ``#`` comments."""
+    p = Path(path)
+    try:
+        text = p.read_text(encoding="utf-8")
+    except OSError as err:
+        raise InputError("guidance.route_file", f"cannot read {str(p)!r}: {err.strerror}") from None
+    rows = []
+    for n, row in enumerate(csv.reader(line for line in text.splitlines()
+                                       if line.strip() and not line.lstrip().startswith("#"))):
+        try:
+            vals = [float(c) for c in row]
+        except ValueError:
+            if n == 0 and not rows:
+                continue          # header
+            raise InputError("guidance.route_file", f"{p.name}: row {n + 1} is not two numbers: {row}") from None
+        if len(vals) != 2:
+            raise InputError("guidance.route_file", f"{p.name}: row {n + 1} needs 2 columns (x_n, y_e), got {len(vals)}")
+        rows.append(vals)
+    return check_route(rows, "guidance.route_file")
+
+
+def pack_los(route, lookahead: float, accept_radius: float, stages=(), stop_radius: float | None = None) -> np.ndarray:
+    """Pack the record; ``lookahead`` = Delta [m], ``accept_radius`` = R [m];
+    ``stages``: ``(distance [m], rate [rev/s])`` in decreasing distance."""
+    wp = check_route(route)
+    require_finite_range("guidance.lookahead", lookahead, 0.0, lo_open=True)
+    require_finite_range("guidance.accept_radius_m", accept_radius, 0.0, lo_open=True)
+    r_stop = accept_radius if stop_radius is None else stop_radius
+    require_finite_range("guidance.stop_radius_m", r_stop, 0.0, lo_open=True)
+    d_prev = math.inf
+    for j, (d, n) in enumerate(stages):
+        require_finite_range(f"guidance.rpm_plan[{j}].distance", d, 0.0, lo_open=True)
+        require_finite_range(f"guidance.rpm_plan[{j}].rpm", n * 60.0, 0.0, 5000.0)
+        if d >= d_prev:
+            raise InputError(f"guidance.rpm_plan[{j}]", "distances must decrease along the plan")
+        d_prev = d
+    g = [lookahead, accept_radius, float(len(wp)), float(len(stages)), r_stop]
+    g += wp.ravel().tolist()
+    g += [float(d) for d, _ in stages] + [float(n) for _, n in stages]
+    return np.array(g, dtype=np.float64)
+
+
+def initial_los_state(g: np.ndarray) -> np.ndarray:
+    return np.zeros(N_STATE)
+
+
+@numba.njit(cache=True)
+def los_guidance(t, x, g, z, ref, h):
+    """Guidance kernel: LOS heading (eq 2) for the ship at ``x[0], x[1]``; advances the leg (eq 3).
+
+    Writes ``ref[0] = psi_ref``, ``ref[1] = ref[2] = 0``, ``ref[3]`` the propeller order
+    [rev/s] (< 0: none), ``ref[4]`` the cross-track error [m], ``ref[5]`` the leg (``n_wp - 1``
+    once the last waypoint is reached).
+    """
+    delta_la = g[0]
+    R = g[1]
+    n = int(g[2])
+    ns = int(g[3])
+    px = x[0]
+    py = x[1]
+    k = int(z[0])
+    while k < n - 2:
+        dxn = g[G_WP + 2 * k + 2] - px
+        dyn = g[G_WP + 2 * k + 3] - py
+        if dxn * dxn + dyn * dyn <= R * R:
+            k += 1
+        else:
+            break
+    z[0] = k
+    xa = g[G_WP + 2 * k]
+    ya = g[G_WP + 2 * k + 1]
+    xb = g[G_WP + 2 * k + 2]
+    yb = g[G_WP + 2 * k + 3]
+    alpha = math.atan2(yb - ya, xb - xa)
+    ca = math.cos(alpha)
+    sa = math.sin(alpha)
+    e = -(px - xa) * sa + (py - ya) * ca
+    ref[0] = wrap_to_pi(alpha + math.atan2(-e, delta_la))
+    ref[1] = 0.0
+    ref[2] = 0.0
+    ref[4] = e
+    ref[5] = k
+    # arrival at the last waypoint (the berth) and the propeller plan
+    dxb = g[G_WP + 2 * n - 2] - px
+    dyb = g[G_WP + 2 * n - 1] - py
+    dist = math.sqrt(dxb * dxb + dyb * dyb)
+    if k == n - 2 and z[2] == 0.0:
+        r_stop = g[4]
+        if dist <= r_stop or dxb * ca + dyb * sa <= 0.0:
+            z[2] = 1.0
+    if z[2] != 0.0:
+        ref[5] = n - 1
+    if ns == 0:
+        ref[3] = -1.0
+        return
+    s = int(z[1])
+    o = G_WP + 2 * n
+    while s < ns and dist <= g[o + s]:
+        s += 1
+    z[1] = s
+    if z[2] != 0.0:
+        ref[3] = 0.0
+    elif s == 0:
+        ref[3] = -1.0
+    else:
+        ref[3] = g[o + ns + s - 1]
