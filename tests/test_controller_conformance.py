@@ -1,0 +1,104 @@
+"""Every registered controller on every registered ship (issue 4's conformance matrix).
+
+* readable engine, all pairs: a short course change runs with finite states and the rudder
+  within the gear's angle and rate limits, or the controller's design rule refuses the ship
+  with a one-line :class:`~steerlab.errors.InputError` naming a field (never another
+  exception). A refusal is accepted only for a reason a design rule can have: the ship is not
+  course-stable with a finite first-order Nomoto model (model-based designs), it has no block
+  coefficient and beam for ADRC's ``c0`` estimate, or its ``K*`` is outside ASA's range.
+  The readable loop calls the kernels one by one, so each kernel compiles once, not per pair.
+* compiled engine: bit-identical to the readable one for every controller on ``nomoto1``.
+  The other half of the matrix (every ship with ``pid``) is
+  ``tests/test_ship_conformance.py::test_pid_course_change_gear_limits_and_engine_parity``.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from steerlab.control.registry import CONTROLLERS
+from steerlab.errors import InputError
+from steerlab.ships.registry import SHIPS
+from steerlab.sim.engine import simulate
+from steerlab.sim.scenario import scenario_from_dict
+from steerlab.sim.setup import build
+from steerlab.units import knots_to_ms, ms_to_knots, rad
+
+CONTROLLER_NAMES = sorted(CONTROLLERS)
+SHIP_NAMES = sorted(SHIPS)
+DT = 0.2
+GEAR = {"delta_max_deg": 30.0, "rate_max_deg_s": 3.0, "T_sg": 0.5}
+REFUSAL_FIELDS = {"controller.c0", "controller.K_star0"}
+"""Fields a design rule may refuse a course-stable ship with (c0: no c_B, B; K*: ASA's range)."""
+
+
+def nominal_speed(spec) -> float:
+    """[m/s]: the catalogue's nominal speed, else the middle of the validity range (or 10 kn)."""
+    if "speed_range_kn" in (getattr(spec, "catalogue", None) or {}):
+        from steerlab.ships.catalogue import get_entry
+
+        return get_entry(spec.name).nominal
+    lo, hi = spec.speed_range
+    return 0.5 * (lo + hi) if math.isfinite(hi) else knots_to_ms(10.0)
+
+
+def course_stable(spec, speed) -> bool:
+    K, T = spec.nomoto(speed)
+    return math.isfinite(K) and math.isfinite(T) and K > 0.0 and T > 0.0
+
+
+def course_change(ship: str, controller: str, duration: float):
+    return scenario_from_dict({
+        "dt": DT, "duration": duration,
+        "ship": {"model": ship, "speed_kn": ms_to_knots(nominal_speed(SHIPS[ship]))},
+        "gear": GEAR, "controller": {"type": controller},
+        "guidance": {"changes": [{"t": 2.0, "psi_deg": 20.0}]},
+    })
+
+
+def assert_within_gear(res) -> None:
+    assert np.all(np.isfinite(res.states))
+    delta = res.delta
+    assert np.max(np.abs(delta)) <= rad(GEAR["delta_max_deg"]) * (1 + 1e-12)
+    assert np.max(np.abs(np.diff(delta))) / DT <= rad(GEAR["rate_max_deg_s"]) * (1 + 1e-9)
+
+
+@pytest.mark.parametrize("controller", CONTROLLER_NAMES)
+def test_runs_on_every_ship_or_refuses_clearly(controller):
+    ran = 0
+    for ship in SHIP_NAMES:
+        try:
+            setup = build(course_change(ship, controller, 60.0))
+        except InputError as err:
+            assert err.field and "\n" not in str(err), (ship, str(err))
+            assert err.field in REFUSAL_FIELDS or not course_stable(SHIPS[ship], nominal_speed(SHIPS[ship])), \
+                f"{controller} refused course-stable {ship}: {err}"
+            continue
+        res = simulate(setup, "readable")
+        assert_within_gear(res)
+        assert abs(res.states[-1, 2]) > rad(1.0), (ship, "the course change did not start")
+        ran += 1
+    assert ran >= len(SHIP_NAMES) // 2
+
+
+@pytest.mark.parametrize("controller", CONTROLLER_NAMES)
+def test_compiled_equals_readable_on_nomoto1(controller):
+    s = build(course_change("nomoto1", controller, 40.0))
+    a = simulate(s, "compiled")
+    b = simulate(s, "readable")
+    np.testing.assert_array_equal(a.states, b.states)
+    np.testing.assert_array_equal(a.delta_cmd, b.delta_cmd)
+    assert_within_gear(a)
+
+
+def test_unstable_or_infinite_nomoto_model_is_refused_by_model_based_designs():
+    """Defects found by the matrix: K = T = inf (small-tanker-bech, c1 = 0) gave NaN states
+    (backstepping) and a LinAlgError (sliding mode) instead of an InputError."""
+    assert SHIPS["small-tanker-bech"].nomoto(nominal_speed(SHIPS["small-tanker-bech"]))[0] == math.inf
+    for controller in ("backstepping_a", "backstepping_b", "sliding_mode"):
+        for ship in ("small-tanker-bech", "esso"):
+            with pytest.raises(InputError, match="course-stable"):
+                build(course_change(ship, controller, 10.0))
