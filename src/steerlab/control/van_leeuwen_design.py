@@ -25,6 +25,8 @@ over one sample (:func:`yaw_accel`), which it keeps in its own state.
 
 from __future__ import annotations
 
+import math
+
 import numba
 import numpy as np
 
@@ -56,8 +58,9 @@ def design_model(ctx, design_loading: str | None, T2: float | None):
     L = float(ship.dims[1])
     mu = ctx.speed / L
     T2s = ctx.gear.T_sg if T2 is None else T2
-    if not (T > 0.0 and K > 0.0):
-        raise InputError("ship.model", f"the design needs a course-stable ship (K > 0, T > 0); got K={K}, T={T}")
+    if not (math.isfinite(K) and math.isfinite(T) and T > 0.0 and K > 0.0):
+        raise InputError("ship.model", "the design needs a course-stable ship with a finite first-order "
+                                       f"Nomoto model (0 < K, T < inf); got K={K}, T={T}")
     if not (T2s > 0.0):
         raise InputError("controller.design_T2", f"must be > 0 s, got {T2s}")
     s = vl.Loading(K=K / mu, T1=T * mu, T2=T2s * mu, a0=0.0, a1=1.0, a2=0.0, a3=0.0).packed()
