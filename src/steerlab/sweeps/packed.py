@@ -85,6 +85,11 @@ class PackedBatch:
             raise InputError("conditions", "a batch needs at least one run")
         s0 = setups[0]
         for i, s in enumerate(setups):
+            if s.guide is not None:
+                raise InputError("guidance.type",
+                                 "tuning, Monte-Carlo and robustness sweeps support the time-based course "
+                                 "guidance only (type = \"course\"); state-dependent guidance (LOS, berthing, "
+                                 "reference models) runs with 'steerlab run' or steerlab.sim.batch.simulate_batch")
             if s.ship.rhs is not s0.ship.rhs or s.controller.update is not s0.controller.update:
                 raise InputError(f"conditions[{i}]",
                                  "all runs of a batch must use the same ship model and controller "
@@ -138,7 +143,7 @@ class PackedBatch:
         """Run every row with the compiled batch engine (numba ``prange`` over local cores)."""
         from steerlab.control.registry import get_controller
         from steerlab.ships.registry import get_ship
-        from steerlab.sim.kernels import batch_loop
+        from steerlab.sim.kernels import LANES, batch_loop
 
         ship = get_ship(self.ship_name)
         ctrl = get_controller(self.controller_name)
@@ -154,7 +159,7 @@ class PackedBatch:
         acc = np.zeros((n, N_ACC))
         X = self.X.copy()
         Z = self.Z.copy()
-        run_batch = batch_loop(ship.rhs, ctrl.update, nx)
+        run_batch = batch_loop(ship.rhs, ctrl.update, nx, LANES, None)  # same cache key as simulate_batch
         run_batch(X, Z, self.PS, self.PG, self.PC, self.GD, self.W, self.w_index, self.dt, self.nc,
                   N, rec, out_x, out_cmd, out_ref, acc)
         if record_every is None:
