@@ -329,6 +329,51 @@ LANES = 4
 
 
 @lru_cache(maxsize=None)
+def _rk4_lanes(ship_rhs, nx: int):
+    """RK4 of a group of runs, stage by stage over the group, then the metrics accumulator.
+
+    The same operations, in the same order, per run as ``rk4`` of :func:`_plant_kernels`
+    (so each run is bit-identical to its single run); shared by :func:`lane_loop` and
+    :func:`guided_lane_loop`.
+    """
+    NX = int(nx)
+    _, _, plant_rhs, clamp = _plant_kernels(ship_rhs, NX)
+    acc_step = _fused(accumulate)
+
+    @_jit_fused
+    def rk4_lanes(t, k, X, i0, n_act, CMD, W, w_index, PS, PG, dt, h2, s6, ACC, E, DPREV,
+                  K1, K2, K3, K4, XT):
+        t2 = t + h2
+        for g in range(n_act):
+            i = i0 + g
+            DPREV[g] = X[i, NX - 1]
+            plant_rhs(t, X[i], CMD[g], W[w_index[i], k], PS[i], PG[i], K1[g])
+        for g in range(n_act):
+            i = i0 + g
+            for q in range(NX):
+                XT[g, q] = X[i, q] + h2 * K1[g, q]
+            plant_rhs(t2, XT[g], CMD[g], W[w_index[i], k], PS[i], PG[i], K2[g])
+        for g in range(n_act):
+            i = i0 + g
+            for q in range(NX):
+                XT[g, q] = X[i, q] + h2 * K2[g, q]
+            plant_rhs(t2, XT[g], CMD[g], W[w_index[i], k], PS[i], PG[i], K3[g])
+        for g in range(n_act):
+            i = i0 + g
+            for q in range(NX):
+                XT[g, q] = X[i, q] + dt * K3[g, q]
+            plant_rhs(t + dt, XT[g], CMD[g], W[w_index[i], k], PS[i], PG[i], K4[g])
+        for g in range(n_act):
+            i = i0 + g
+            for q in range(NX):
+                X[i, q] += s6 * (K1[g, q] + 2.0 * K2[g, q] + 2.0 * K3[g, q] + K4[g, q])
+            X[i, NX - 1] = clamp(X[i, NX - 1], PG[i])
+            acc_step(ACC[i], t, E[g], DPREV[g], X[i, NX - 1], dt)
+
+    return rk4_lanes
+
+
+@lru_cache(maxsize=None)
 def lane_loop(ship_rhs, ctrl_update, nx: int, lanes: int = LANES):
     """Compiled loop advancing a group of up to ``lanes`` independent runs in lock step.
 
@@ -342,11 +387,9 @@ def lane_loop(ship_rhs, ctrl_update, nx: int, lanes: int = LANES):
     ``i0 .. i0 + n_act - 1`` of the batch arrays in place.
     """
     NX = int(nx)
-    G = int(lanes)
-    _, _, plant_rhs, clamp = _plant_kernels(ship_rhs, NX)
+    rk4_lanes = _rk4_lanes(ship_rhs, NX)
     update = _fused(ctrl_update)
     reference = _fused(course_reference)
-    acc_step = _fused(accumulate)
     wrap = _fused(wrap_to_pi)
     RB = REF_BLOCK
 
@@ -403,33 +446,8 @@ def lane_loop(ship_rhs, ctrl_update, nx: int, lanes: int = LANES):
                 kr = 0
             if k == n_steps:
                 break
-            # RK4, stage by stage over the group (see rk4 in _plant_kernels: same operations)
-            t2 = t + h2
-            for g in range(n_act):
-                i = i0 + g
-                DPREV[g] = X[i, NX - 1]
-                plant_rhs(t, X[i], CMD[g], W[w_index[i], k], PS[i], PG[i], K1[g])
-            for g in range(n_act):
-                i = i0 + g
-                for q in range(NX):
-                    XT[g, q] = X[i, q] + h2 * K1[g, q]
-                plant_rhs(t2, XT[g], CMD[g], W[w_index[i], k], PS[i], PG[i], K2[g])
-            for g in range(n_act):
-                i = i0 + g
-                for q in range(NX):
-                    XT[g, q] = X[i, q] + h2 * K2[g, q]
-                plant_rhs(t2, XT[g], CMD[g], W[w_index[i], k], PS[i], PG[i], K3[g])
-            for g in range(n_act):
-                i = i0 + g
-                for q in range(NX):
-                    XT[g, q] = X[i, q] + dt * K3[g, q]
-                plant_rhs(t + dt, XT[g], CMD[g], W[w_index[i], k], PS[i], PG[i], K4[g])
-            for g in range(n_act):
-                i = i0 + g
-                for q in range(NX):
-                    X[i, q] += s6 * (K1[g, q] + 2.0 * K2[g, q] + 2.0 * K3[g, q] + K4[g, q])
-                X[i, NX - 1] = clamp(X[i, NX - 1], PG[i])
-                acc_step(ACC[i], t, E[g], DPREV[g], X[i, NX - 1], dt)
+            rk4_lanes(t, k, X, i0, n_act, CMD, W, w_index, PS, PG, dt, h2, s6, ACC, E, DPREV,
+                      K1, K2, K3, K4, XT)
 
     return group
 
@@ -443,10 +461,9 @@ def guided_lane_loop(ship_rhs, ctrl_update, guide, nx: int, lanes: int = LANES):
     ``PS`` rows are overwritten at ``rpm_slot`` (when >= 0) by the guidance's propeller order.
     """
     NX = int(nx)
-    _, _, plant_rhs, clamp = _plant_kernels(ship_rhs, NX)
+    rk4_lanes = _rk4_lanes(ship_rhs, NX)
     update = _fused(ctrl_update)
     reference = _fused(guide)
-    acc_step = _fused(accumulate)
     wrap = _fused(wrap_to_pi)
     NR = N_REF
     RPM = REF_RPM
@@ -492,32 +509,8 @@ def guided_lane_loop(ship_rhs, ctrl_update, guide, nx: int, lanes: int = LANES):
                 kr = 0
             if k == n_steps:
                 break
-            t2 = t + h2
-            for g in range(n_act):
-                i = i0 + g
-                DPREV[g] = X[i, NX - 1]
-                plant_rhs(t, X[i], CMD[g], W[w_index[i], k], PS[i], PG[i], K1[g])
-            for g in range(n_act):
-                i = i0 + g
-                for q in range(NX):
-                    XT[g, q] = X[i, q] + h2 * K1[g, q]
-                plant_rhs(t2, XT[g], CMD[g], W[w_index[i], k], PS[i], PG[i], K2[g])
-            for g in range(n_act):
-                i = i0 + g
-                for q in range(NX):
-                    XT[g, q] = X[i, q] + h2 * K2[g, q]
-                plant_rhs(t2, XT[g], CMD[g], W[w_index[i], k], PS[i], PG[i], K3[g])
-            for g in range(n_act):
-                i = i0 + g
-                for q in range(NX):
-                    XT[g, q] = X[i, q] + dt * K3[g, q]
-                plant_rhs(t + dt, XT[g], CMD[g], W[w_index[i], k], PS[i], PG[i], K4[g])
-            for g in range(n_act):
-                i = i0 + g
-                for q in range(NX):
-                    X[i, q] += s6 * (K1[g, q] + 2.0 * K2[g, q] + 2.0 * K3[g, q] + K4[g, q])
-                X[i, NX - 1] = clamp(X[i, NX - 1], PG[i])
-                acc_step(ACC[i], t, E[g], DPREV[g], X[i, NX - 1], dt)
+            rk4_lanes(t, k, X, i0, n_act, CMD, W, w_index, PS, PG, dt, h2, s6, ACC, E, DPREV,
+                      K1, K2, K3, K4, XT)
 
     return group
 
