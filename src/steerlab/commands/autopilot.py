@@ -138,7 +138,7 @@ def run(args) -> int:
         asyncio.run(run_with_web(ap, web, args.duration, started))
     finally:
         if not args.quiet:
-            print(f"autopilot: {ap.samples} samples ({ap.skipped} skipped after stalls), mode {ap.mode}, "
+            print(f"autopilot: {ap.samples} samples, mode {ap.mode}, {ap.skipped} skipped after stalls, "
                   f"link {dict(ap.filter.counts)}, "
                   f"alarms raised {[n for _, n, w in ap.alarms.history if w == 'raised']}",
                   file=sys.stderr, flush=True)
