@@ -12,7 +12,6 @@ from steerlab.runtime import protocol as P
 from steerlab.runtime.alarms import LINK, OFF_COURSE, AlarmBoard
 from steerlab.runtime.autopilot import Autopilot, AutopilotConfig
 from steerlab.runtime.controller_runtime import ControllerRuntime
-from steerlab.runtime.route import Route, load_route
 from steerlab.runtime.ship_server import order_in_effect
 from steerlab.sim.scenario import scenario_from_dict
 
@@ -131,18 +130,78 @@ def test_alarm_board_semantics():
     assert [w for _, _, w in b.history] == ["raised", "acknowledged", "cleared"]
 
 
-def test_route_bearing_and_waypoint_switching(tmp_path):
-    r = Route([(1000.0, 0.0), (1000.0, 1000.0)], accept_radius=100.0)
-    assert r.set_course(0.0, 0.0) == pytest.approx(0.0)              # due north
-    assert r.set_course(950.0, 0.0) == pytest.approx(math.atan2(1000.0, 50.0))  # wp 1 reached: to wp 2
-    assert r.set_course(1000.0, 950.0) == pytest.approx(math.atan2(1000.0, 50.0))  # last reached: keep
-    assert r.finished
+ROUTE_SCENARIO = {**RUNTIME_SCENARIO, "duration": 90.0,
+                  "guidance": {"type": "los", "start": [0.0, 60.0],
+                               "route": [[0.0, 0.0], [250.0, 0.0], [250.0, 300.0]], "lookahead_L": 1.0}}
+
+
+def _route_file(tmp_path):
     f = tmp_path / "route.csv"
-    f.write_text("x_n,y_e\n0,0\n-500,10\n")
-    assert load_route(f) == [(0.0, 0.0), (-500.0, 10.0)]
-    f.write_text("a,b\n1,2\n")
-    with pytest.raises(InputError, match="--route"):
-        load_route(f)
-    f.write_text("x_n,y_e\n1,nan\n")
-    with pytest.raises(InputError, match="line 2"):
-        load_route(f)
+    f.write_text("x_n,y_e\n# a comment\n0,0\n250,0\n250,300\n")
+    return f
+
+
+def test_runtime_route_guidance_equals_the_simulators_kernel(ctrl, tmp_path):
+    """Parity: the runtime's guidance (and orders) for the simulator's recorded state sequence."""
+    from steerlab.runtime.route import route_guidance
+    from steerlab.sim.engine import simulate_readable
+
+    sc = scenario_from_dict(ROUTE_SCENARIO)
+    res = simulate_readable(sc)
+    log = res.meta["guidance_log"]
+    plan = route_guidance(scenario_from_dict(RUNTIME_SCENARIO), ctrl.setup.ship, ctrl.setup.ps,
+                          _route_file(tmp_path), lookahead_L=1.0)
+    assert plan.guide is res.meta["guidance"].guide                       # one kernel
+    np.testing.assert_array_equal(plan.gd, res.meta["guidance"].gd)       # same record
+    ap = Autopilot(ctrl, ("127.0.0.1", 9), AutopilotConfig(), route=plan)
+    nc = int(round(H / res.dt))
+    names = list(res.state_names)
+    col = {n: res.states[:, names.index(n)] for n in ("x_n", "y_e", "psi", "u", "v", "r")}
+    delta = res.states[:, -1]
+    n_checked = 0
+    for k in range(0, len(res.time), nc):
+        t = k * res.dt
+        ap.latest = P.State(t, col["x_n"][k], col["y_e"][k], col["psi"][k], col["r"][k], col["u"][k],
+                            col["v"][k], delta[k], math.nan, 0.0, 0)
+        ap.latest_t = t
+        row = ap.sample(t)
+        assert ap.ref[0] == res.psi_ref[k] and row["xte_m"] == log["xte"][k] and row["leg"] == log["leg"][k]
+        assert ap.cmd_sent == res.delta_cmd[k]                            # same law, same orders
+        n_checked += 1
+    assert n_checked == 721 and {0.0, 1.0} <= set(log["leg"][::nc])      # the waypoint was passed
+    assert abs(log["xte"][0]) == 60.0 and abs(log["xte"][-1]) < 2.0
+
+
+def test_route_option_errors_name_the_field(ctrl, tmp_path):
+    from steerlab.runtime.route import route_guidance
+
+    sc = scenario_from_dict(RUNTIME_SCENARIO)
+    f = tmp_path / "r.csv"
+    f.write_text("x_n,y_e\n0,0\n")
+    for path, kw, field in ((f, {}, "--route"), (tmp_path / "missing.csv", {}, "--route"),
+                            (_route_file(tmp_path), {"accept_radius": -1.0}, "--accept-radius"),
+                            (_route_file(tmp_path), {"lookahead_L": 0.0}, "--lookahead-L")):
+        with pytest.raises(InputError) as err:
+            route_guidance(sc, ctrl.setup.ship, ctrl.setup.ps, path, **kw)
+        assert err.value.field == field
+
+
+def test_route_is_the_only_course_source(ctrl, tmp_path):
+    from steerlab.runtime.route import route_guidance
+
+    plan = route_guidance(scenario_from_dict(RUNTIME_SCENARIO), ctrl.setup.ship, ctrl.setup.ps,
+                          _route_file(tmp_path), lookahead_L=1.0)
+    ap = Autopilot(ctrl, ("127.0.0.1", 9), AutopilotConfig(), route=plan)
+    _feed(ap, 0.0)
+    ap.sample(0.0)
+    psi_set = ap.psi_set
+    ap.adjust(10.0, 0.1)
+    assert ap.psi_set == psi_set and ap.status()["route"] == [[0.0, 0.0], [250.0, 0.0], [250.0, 300.0]]
+
+
+def test_missed_samples_are_skipped_keeping_the_phase(ctrl):
+    ap = _ap(ctrl)
+    assert ap._next_sample(4, 4.2) == 5 and ap.skipped == 0              # on time
+    assert ap._next_sample(5, 5.99) == 6 and ap.skipped == 0             # a little late: run now
+    assert ap._next_sample(6, 13.4) == 13 and ap.skipped == 6            # stall: 7..12 skipped
+    assert ap._next_sample(13, 13.5) == 14 and ap.skipped == 6

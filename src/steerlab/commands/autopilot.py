@@ -8,6 +8,7 @@ import sys
 EXAMPLES = """examples:
   steerlab autopilot --connect 127.0.0.1:47110 --controller pid --heading 20
   steerlab autopilot --connect 127.0.0.1:47110 --controller adrc --scenario my.toml --route route.csv
+  steerlab autopilot --connect 127.0.0.1:47110 --controller pid --route route.csv --lookahead-L 5 --accept-radius 200
   steerlab autopilot --connect 127.0.0.1:47110 --controller pid --heading 0 --web 127.0.0.1:8080
   steerlab autopilot --connect 127.0.0.1:47110 --controller pid --nmea-listen 127.0.0.1:10111   # follow OpenCPN APB/RMB
   steerlab autopilot --connect 127.0.0.1:47110 --controller pid --signalk-ws 127.0.0.1:3000      # Signal K WebSocket
@@ -28,8 +29,12 @@ def register(sub, formatter_class) -> None:
     p.add_argument("--controller", help="controller name (default: the scenario's)")
     g = p.add_mutually_exclusive_group()
     g.add_argument("--heading", type=float, help="set course [deg] (default: heading at engagement)")
-    g.add_argument("--route", help="CSV of waypoints x_n,y_e [m]: steer the bearing to the next one")
-    p.add_argument("--accept-radius", type=float, default=200.0, help="waypoint acceptance radius [m] (default 200)")
+    g.add_argument("--route", help="CSV of waypoints x_n,y_e [m] (>= 2): follow it with the simulator's LOS "
+                                   "guidance (docs/guidance.md)")
+    p.add_argument("--lookahead-L", type=float, default=None,
+                   help="LOS look-ahead Delta = n L, n in ship lengths (default: the scenario's guidance.lookahead_L)")
+    p.add_argument("--accept-radius", type=float, default=None,
+                   help="waypoint acceptance radius R [m] (default: the scenario's guidance.accept_radius_m, else L)")
     p.add_argument("--scenario", help="scenario TOML the controller is designed for (ship, speed, gear)")
     p.add_argument("--log", default="autopilot-log.csv", help="CSV log, one row per sample (default autopilot-log.csv)")
     p.add_argument("--speedup", type=float, default=1.0, help="must match serve-ship's (default 1)")
@@ -61,7 +66,7 @@ def build_autopilot(args):
     from steerlab.runtime.autopilot import Autopilot, AutopilotConfig
     from steerlab.runtime.controller_runtime import ControllerRuntime
     from steerlab.runtime.keys import load_key
-    from steerlab.runtime.route import Route, load_route
+    from steerlab.runtime.route import route_guidance
     from steerlab.runtime.udp import is_loopback, parse_hostport
     from steerlab.sim.scenario import default_scenario, load_scenario
     from steerlab.units import rad
@@ -81,7 +86,8 @@ def build_autopilot(args):
                           safe_action=args.safe_action, off_course_limit=rad(args.off_course_deg),
                           turn_rate=rad(turn), max_age=args.max_age,
                           rpm_cmd=math.nan if args.rpm is None else args.rpm, xte_lookahead=args.xte_lookahead)
-    route = Route(load_route(args.route), args.accept_radius) if args.route else None
+    route = (route_guidance(scenario, ctrl.setup.ship, ctrl.setup.ps, args.route, args.lookahead_L,
+                            args.accept_radius) if args.route else None)
     web = parse_hostport(args.web, "--web") if args.web else None
     if web is not None and not is_loopback(web[0]):
         print(f"autopilot: warning: the bridge page on {web[0]} is reachable from the network and has no login",
@@ -132,7 +138,8 @@ def run(args) -> int:
         asyncio.run(run_with_web(ap, web, args.duration, started))
     finally:
         if not args.quiet:
-            print(f"autopilot: {ap.samples} samples, mode {ap.mode}, link {dict(ap.filter.counts)}, "
+            print(f"autopilot: {ap.samples} samples, mode {ap.mode}, {ap.skipped} skipped after stalls, "
+                  f"link {dict(ap.filter.counts)}, "
                   f"alarms raised {[n for _, n, w in ap.alarms.history if w == 'raised']}",
                   file=sys.stderr, flush=True)
     return 0

@@ -12,7 +12,7 @@ module                 concept
 ``controller_runtime`` any registered controller kernel, sample by sample
 ``autopilot``          the client: guidance, controller, watchdog, alarms, CSV log
 ``alarms``             raise / clear / acknowledge
-``route``              waypoint following (bearing to the next waypoint)
+``route``              route following with the library's LOS guidance kernel
 ``nmea``               NMEA 0183 out (HDT, THS, ROT, RSA, RMC, VTG, HTD) and in (APB, RMB, HTC)
 ``signalk``            Signal K delta messages (paths, SI units) and PUT on the autopilot
 ``signalk_ws``         Signal K over WebSocket (discovery, stream, subscriptions, PUT)

@@ -11,12 +11,17 @@ exceeds its limit; it is armed only once the heading has come within the limit a
 change, so a commanded turn does not trip it.
 
 Guidance: a set course (``--heading``; ``course_reference`` slews the reference at the turn-rate
-limit), a route (bearing to the next waypoint, :mod:`steerlab.runtime.route`) or a chart
-plotter's APB/RMB/XTE sentences (:mod:`steerlab.runtime.nmea`). The heading may come from
-NMEA HDT/THS instead of the state datagram.
+limit), a route (the simulator's LOS kernel ``guide(t, x, gd, gz, ref, h)`` called with the
+received state, :mod:`steerlab.runtime.route`; the route is then the only course source) or a
+chart plotter's APB/RMB/XTE sentences (:mod:`steerlab.runtime.nmea`). The heading may come
+from NMEA HDT/THS instead of the state datagram.
 
 Clock: ship time ``t = speedup * (wall time since start)``; all periods and timeouts are in
-ship seconds (freshness limits on datagram stamps are in wall seconds).
+ship seconds (freshness limits on datagram stamps are in wall seconds). Samples are due at
+``t = k * sample_time``; after a stall (the process or the event loop blocked for more than a
+sample) the missed samples are **skipped**, not replayed: one sample runs at once with the
+newest state, at the latest due slot, so the sample clock keeps its phase and the ship never
+gets a burst of orders computed from one old state (``skipped`` counts them).
 """
 
 from __future__ import annotations
@@ -33,6 +38,7 @@ import numpy as np
 from steerlab.angles import wrap_to_2pi, wrap_to_pi
 from steerlab.errors import InputError, require_finite_range
 from steerlab.guidance.reference_models import course_reference, course_schedule
+from steerlab.guidance.reference_vector import REF_LEG, REF_PSI, REF_XTE, initial_reference
 from steerlab.runtime import protocol as P
 from steerlab.runtime.alarms import LINK, OFF_COURSE, AlarmBoard
 from steerlab.runtime.link_filter import LinkFilter
@@ -43,8 +49,9 @@ SAFE_ACTIONS = ("midships", "hold")
 
 LOG_COLUMNS = ("t", "wall", "t_sim", "state_age", "link_ok", "mode", "psi_deg", "r_deg_s",
                "delta_deg", "u", "x_n", "y_e", "psi_set_deg", "psi_ref_deg", "r_ref_deg_s",
-               "delta_cmd_deg", "heading_source", "alarms", "accepted", "rejected")
-"""CSV log columns (one row per sample; ship time ``t`` [s], degrees at this edge)."""
+               "delta_cmd_deg", "heading_source", "alarms", "accepted", "rejected", "xte_m", "leg")
+"""CSV log columns (one row per sample; ship time ``t`` [s], degrees at this edge; ``xte_m``
+cross-track error [m], > 0 to starboard of the leg, and ``leg`` only with a route)."""
 
 
 @dataclass(frozen=True)
@@ -86,7 +93,9 @@ class Autopilot:
         The ship server.
     heading : float or None
         Initial set course [rad]; None: the heading at engagement (or the route's course).
-    route : steerlab.runtime.route.Route or None
+    route : steerlab.guidance.plan.GuidancePlan or None
+        Route guidance (:func:`steerlab.runtime.route.route_guidance`): its kernel gives the
+        reference every sample; the set course is its ``psi_ref``.
     key : bytes or None
         HMAC key (states must be signed; commands are signed).
     log_path : path or None
@@ -113,6 +122,7 @@ class Autopilot:
         if abs(cfg.sample_time - controller.h) > 1e-12:
             raise InputError("--sample-time", "differs from the controller's sample time")
         self.route = route
+        self.gz = None if route is None else route.gz0.copy()
         self.key = key
         self.sender = P.Sender(key)
         # states come at 20/s of ship time; allow 5x that per source before rate limiting
@@ -122,7 +132,7 @@ class Autopilot:
         self.alarms = AlarmBoard()
         self.psi_set = None if heading is None else wrap_to_pi(float(heading))
         self.gd = None
-        self.ref = np.zeros(2)
+        self.ref = initial_reference()
         self.want_engaged = bool(engaged)
         self.engaged = False           # controlling (engaged and reset on a valid state)
         self.off_course_armed = False
@@ -132,6 +142,7 @@ class Autopilot:
         self.cmd_sent = None
         self.mode = "standby"
         self.samples = 0
+        self.skipped = 0               # samples skipped after stalls (not replayed)
         self.nmea_heading = None       # (psi [rad], t)
         self.nmea_course = None        # (psi_set [rad], t)
         self.nmea_counts = {"accepted": 0, "rejected": 0}
@@ -154,6 +165,9 @@ class Autopilot:
         # compile the guidance kernels now, not at the first steering sample (with a cold numba
         # cache that costs about a second, while the ship keeps moving)
         course_reference(0.0, course_schedule(0.0, [(0.0, 0.1)], cfg.turn_rate), np.zeros(2))
+        if route is not None:
+            route.guide(0.0, np.zeros(controller.nx), route.gd, route.gz0.copy(), initial_reference(),
+                        cfg.sample_time)
         wrap_to_pi(0.0)
 
     # ------------------------------------------------------------ clock and inputs
@@ -201,7 +215,12 @@ class Autopilot:
 
     # ------------------------------------------------------------ operator actions
     def set_course(self, psi: float, t: float) -> None:
-        """New set course [rad]; the reference slews to it at the turn-rate limit."""
+        """New set course [rad]; the reference slews to it at the turn-rate limit.
+
+        Ignored while following a route (the route guidance is the only course source).
+        """
+        if self.route is not None:
+            return
         psi = wrap_to_pi(float(psi))
         if self.psi_set is not None and abs(wrap_to_pi(psi - self.psi_set)) < 1e-9 and self.gd is not None:
             return
@@ -250,17 +269,18 @@ class Autopilot:
             psi, src = self._heading(t)
             x = self.ctrl.measured_state(st.x_n, st.y_e, psi, st.u, st.v, st.r, st.delta)
             self.track.append((st.x_n, st.y_e))
-            if self.route is not None:
-                c = self.route.set_course(st.x_n, st.y_e)
-                if c is not None:
-                    self.set_course(c, t)
-            if self.nmea_course is not None and t - self.nmea_course[1] <= cfg.nmea_timeout:
-                self.set_course(self.nmea_course[0], t)
-            if self.psi_set is None:
-                self.set_course(psi, t)
-            if self.gd is None:
-                self.set_course(self.psi_set, t)
-            course_reference(t, self.gd, self.ref)
+            if self.route is not None:       # the simulator's guidance kernel, same call
+                self.route.guide(t, x, self.route.gd, self.gz, self.ref, cfg.sample_time)
+                self.psi_set = float(self.ref[REF_PSI])
+                self.gd = self.route.gd
+            else:
+                if self.nmea_course is not None and t - self.nmea_course[1] <= cfg.nmea_timeout:
+                    self.set_course(self.nmea_course[0], t)
+                if self.psi_set is None:
+                    self.set_course(psi, t)
+                if self.gd is None:
+                    self.set_course(self.psi_set, t)
+                course_reference(t, self.gd, self.ref)
             if self.want_engaged and not self.engaged:
                 self.ctrl.reset(x, self.ref)
                 self.engaged = True
@@ -299,6 +319,8 @@ class Autopilot:
             "heading_source": src or "",
             "alarms": ";".join(a["name"] for a in self.alarms.snapshot() if a["active"]),
             "accepted": self.filter.counts["accepted"], "rejected": self.filter.rejected(),
+            "xte_m": float(self.ref[REF_XTE]) if link_ok and self.route is not None else math.nan,
+            "leg": int(self.ref[REF_LEG]) if link_ok and self.route is not None else "",
         }
         self.last_row = row
         return row
@@ -325,7 +347,7 @@ class Autopilot:
             "position": None if st is None else [st.x_n, st.y_e],
             "alarms": self.alarms.snapshot(), "controller": self.ctrl.name,
             "link": {k: v for k, v in self.filter.counts.items()},
-            "route": [list(w) for w in self.route.waypoints] if self.route else [],
+            "route": self.route.route.tolist() if self.route is not None else [],
             "off_course_limit": self.config.off_course_limit,
             "ship_status": None if st is None else st.status,
         }
@@ -368,6 +390,19 @@ class Autopilot:
             if self.samples % 16 == 0:
                 self._log_file.flush()
 
+    def _next_sample(self, k: int, elapsed: float) -> int:
+        """The next sample's index after sample ``k``, ``elapsed`` sample periods since start.
+
+        Normally ``k + 1``. After a stall, slots ``k + 1 .. due - 1`` have passed unserved:
+        they are skipped (counted in ``skipped``) and slot ``due = floor(elapsed)``, the latest
+        one already due, runs at once with the newest state; later ones keep the phase.
+        """
+        due = int(math.floor(elapsed))
+        if due > k + 1:
+            self.skipped += due - (k + 1)
+            return due
+        return k + 1
+
     def stop(self) -> None:
         if self._stop is not None:
             self._stop.set()
@@ -409,9 +444,8 @@ class Autopilot:
                 row = self.sample(t, self.clock())
                 self._send_order(t)
                 self._write_log(row)
-                k += 1
-                delay = t_start + k * wall_h - loop.time()
-                await asyncio.sleep(max(0.0, delay))
+                k = self._next_sample(k, (loop.time() - t_start) / wall_h)
+                await asyncio.sleep(max(0.0, t_start + k * wall_h - loop.time()))
         finally:
             for tr in [self.transport, *self._listeners]:
                 if tr is not None:

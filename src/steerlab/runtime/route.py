@@ -1,68 +1,69 @@
-r"""Route following for the runtime autopilot: steer the bearing to the next waypoint.
+r"""Route following for the runtime autopilot: the simulator's own LOS guidance kernel.
 
-This is the simple rule (no cross-track correction; LOS guidance is not in steerlab yet)::
+``steerlab autopilot --route FILE`` builds the route guidance with the library's builder
+(:func:`steerlab.guidance.plan.build_guidance`, ``[guidance] type = "los"``) for the scenario's
+ship, and the autopilot calls the same kernel, ``los_guidance(t, x, gd, gz, ref, h)``, at
+every sample with the received state, exactly as every simulation engine does before the
+controller (berthing paper eqs 1-3, see :mod:`steerlab.guidance.los`)::
 
-    psi_set = atan2(y_wp - y, x_wp - x)        (north = x_n, east = y_e; clockwise from north)
+    psi_ref = alpha_k + atan(-e / Delta),   Delta = lookahead_L * L,   next leg inside R
 
-The active waypoint advances when the ship comes within ``accept_radius`` of it; after the
-last one the last course is kept. A route file is CSV with a header ``x_n,y_e`` (metres,
-north and east of the model origin), one waypoint per line.
+So the runtime follows a route exactly as ``steerlab run`` does; the cross-track error
+``e`` [m] (> 0 to starboard of the leg) and the leg come back in ``ref`` and are logged.
+The route file is the simulator's CSV (:func:`steerlab.guidance.los.read_route_csv`): columns
+``x_n, y_e`` [m] north and east of the model origin, an optional header line, ``#`` comments,
+at least 2 waypoints.
 """
 
 from __future__ import annotations
 
-import csv
-import math
-from pathlib import Path
-
 from steerlab.errors import InputError
 
 
-def load_route(path) -> list[tuple[float, float]]:
-    """Waypoints ``[(x_n [m], y_e [m]), ...]`` from a CSV file (header ``x_n,y_e``)."""
-    p = Path(path)
+def route_guidance(scenario, ship, ps, route_file, lookahead_L=None, accept_radius=None):
+    """The LOS :class:`~steerlab.guidance.plan.GuidancePlan` for the waypoints in ``route_file``.
+
+    Parameters
+    ----------
+    scenario : steerlab.sim.scenario.Scenario
+        Its ``[guidance]`` section gives the defaults (``lookahead_L``, ``accept_radius_m``,
+        ``xte_tolerance_m``).
+    ship : steerlab.ships.registry.ShipSpec
+        Gives the length ``L`` (``Delta = lookahead_L * L``; default ``R = L``).
+    ps : numpy.ndarray
+        The ship's packed record (not read by LOS).
+    route_file : path
+    lookahead_L : float or None
+        ``n`` in ``Delta = n L`` [-]; None: the scenario's.
+    accept_radius : float or None
+        Acceptance radius ``R`` [m]; None: the scenario's (default ``L``).
+
+    Raises
+    ------
+    InputError
+        Field ``--route`` (unreadable or bad file), ``--lookahead-L`` or ``--accept-radius``.
+    """
+    from pydantic import ValidationError
+
+    from steerlab.guidance.plan import build_guidance
+    from steerlab.sim.scenario import GuidanceConfig
+
+    g = scenario.guidance.model_dump()
+    g.update(type="los", route=(), route_file=str(route_file), rpm_plan=(), changes=())
+    if lookahead_L is not None:
+        g["lookahead_L"] = lookahead_L
+    if accept_radius is not None:
+        g["accept_radius_m"] = accept_radius
     try:
-        text = p.read_text(encoding="utf-8")
-    except OSError as err:
-        raise InputError("--route", f"cannot read {str(p)!r}: {err.strerror}") from None
-    rows = list(csv.DictReader(text.splitlines()))
-    if not rows or "x_n" not in rows[0] or "y_e" not in rows[0]:
-        raise InputError("--route", "expected a CSV file with header x_n,y_e and at least one waypoint")
-    wps = []
-    for i, row in enumerate(rows):
-        try:
-            x, y = float(row["x_n"]), float(row["y_e"])
-        except (TypeError, ValueError):
-            raise InputError(f"--route line {i + 2}", "x_n and y_e must be numbers [m]") from None
-        if not (math.isfinite(x) and math.isfinite(y)):
-            raise InputError(f"--route line {i + 2}", "x_n and y_e must be finite [m]")
-        wps.append((x, y))
-    return wps
-
-
-class Route:
-    """Waypoint list with an active index (see the module docstring)."""
-
-    def __init__(self, waypoints, accept_radius: float = 200.0):
-        if not waypoints:
-            raise InputError("--route", "needs at least one waypoint")
-        if not (math.isfinite(accept_radius) and accept_radius > 0):
-            raise InputError("--accept-radius", f"must be > 0 m, got {accept_radius}")
-        self.waypoints = [tuple(map(float, w)) for w in waypoints]
-        self.accept_radius = float(accept_radius)
-        self.active = 0
-        self.course: float | None = None
-
-    def set_course(self, x_n: float, y_e: float) -> float | None:
-        """The course to steer [rad] from position ``(x_n, y_e)`` [m]; advances waypoints."""
-        while self.active < len(self.waypoints):
-            wx, wy = self.waypoints[self.active]
-            if math.hypot(wx - x_n, wy - y_e) > self.accept_radius:
-                self.course = math.atan2(wy - y_e, wx - x_n)
-                break
-            self.active += 1
-        return self.course
-
-    @property
-    def finished(self) -> bool:
-        return self.active >= len(self.waypoints)
+        cfg = GuidanceConfig(**g)
+    except ValidationError as err:
+        e = err.errors()[0]
+        field = {"lookahead_L": "--lookahead-L", "accept_radius_m": "--accept-radius"}.get(
+            str(e["loc"][0]) if e["loc"] else "", "--route")
+        raise InputError(field, e["msg"]) from None
+    try:
+        return build_guidance(cfg, ship, ps)
+    except InputError as err:
+        field = {"guidance.lookahead": "--lookahead-L", "guidance.accept_radius_m": "--accept-radius"}.get(
+            err.field, "--route")
+        raise InputError(field, err.message if field != "--route" else str(err)) from None
