@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from steerlab.control.asa_layout import (Z_A, Z_B, Z_KI, Z_KP, Z_MODE, Z_PSI_M, Z_SAT)
+from steerlab.control.asa_layout import Z_A, Z_B, Z_KP, Z_MODE, Z_PSI_M
 from steerlab.control.asa_reference import lyapunov_p12_p22, reference_model_step
 from steerlab.control.asa_schedule import kd_lq, keeping_kp
 from steerlab.control.wave_filter import F_PSI, F_R, F_XI, N_WF, WaveFilterParams, wave_filter_init, wave_filter_step

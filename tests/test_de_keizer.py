@@ -12,7 +12,7 @@ from steerlab.ships.registry import get_ship
 from steerlab.sim.engine import simulate_compiled, simulate_readable
 from steerlab.sim.scenario import scenario_from_dict
 from steerlab.sim.setup import build
-from steerlab.units import knots_to_ms, rad
+from steerlab.units import knots_to_ms
 
 V = knots_to_ms(12.0)
 

@@ -112,7 +112,6 @@ def _problems(model: str, rec: Record, spiral: SpiralFit | None):
     """Candidate problems, the best fit wins (Norrbin without a spiral: n1 = +1 and n1 = -1;
     nomoto2: several splits of the ARX time constant into T1, T2, T3)."""
     K0, T0 = arx_nomoto(rec)
-    r0 = float(rec.yaw_rate_estimate()[0])
     d0 = float(rec.delta[0])
     if model == "nomoto1":
         return [(_Problem(nomoto1.nomoto1_rhs, 6, ["K", "T"], [K0, T0], [1e-6, 1e-3], [100.0, 1e5],
