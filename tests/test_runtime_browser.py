@@ -32,29 +32,12 @@ if not hasattr(signal, "SIGSTOP"):
     pytest.skip("the link cut freezes the ship server with SIGSTOP (POSIX only)", allow_module_level=True)
 
 from playwright.sync_api import expect, sync_playwright  # noqa: E402
+from runtime_scenario import runtime_scenario_toml
 
 SPEEDUP = 2.0
 WATCHDOG = 2.0          # ship s (1 s wall): rides out scheduling stalls of a loaded machine
 TIMEOUT_MS = 20_000     # bound on every wait for the page
-SCENARIO_TOML = """
-name = "browser-runtime"
-dt = 0.025
-duration = 120.0
-[ship]
-model = "nomoto1"
-speed_kn = 10.0
-options = { K = 0.5, T = 10.0 }
-[gear]
-rate_max_deg_s = 10.0
-T_sg = 0.5
-[controller]
-type = "pid"
-Kp = 2.0
-Kd = 8.0
-Ki = 0.0
-[environment]
-waves = true
-"""
+SCENARIO_TOML = runtime_scenario_toml("browser-runtime", 120.0, waves=True)
 
 
 def _chromium() -> str | None:

@@ -7,24 +7,9 @@ import re
 import pytest
 
 from steerlab.cli import main
+from runtime_scenario import runtime_scenario_toml
 
-SCENARIO_TOML = """
-name = "cli-runtime"
-dt = 0.025
-duration = 60.0
-[ship]
-model = "nomoto1"
-speed_kn = 10.0
-options = { K = 0.5, T = 10.0 }
-[gear]
-rate_max_deg_s = 10.0
-T_sg = 0.5
-[controller]
-type = "pid"
-Kp = 2.0
-Kd = 8.0
-Ki = 0.0
-"""
+SCENARIO_TOML = runtime_scenario_toml("cli-runtime", 60.0, waves=False)
 
 
 @pytest.mark.parametrize("argv, field", [

@@ -91,6 +91,7 @@ def _lines_ok(data: bytes):
     got = nmea.steering_inputs(data)
     for k in ("heading", "course"):
         assert got[k] is None or (isinstance(got[k], float) and math.isfinite(got[k]))
+    return got
 
 
 @settings(max_examples=300, deadline=None, database=None, derandomize=True,
@@ -99,7 +100,8 @@ def _lines_ok(data: bytes):
                  st.builds(lambda g, i, c: g[:i] + c + g[i + 1:], st.sampled_from(_GOOD),
                            st.integers(0, 80), st.sampled_from(list(_ALPHABET)))))
 def test_hypothesis_nmea_lines_never_crash(line):
-    _lines_ok(line.encode("utf-8", "surrogatepass"))
+    got = _lines_ok(line.encode("utf-8", "surrogatepass"))
+    assert {"heading", "course"} <= set(got)
 
 
 def test_ten_thousand_fuzzed_nmea_lines_are_parsed_or_rejected():

@@ -330,7 +330,8 @@ LANES = 4
 
 @lru_cache(maxsize=None)
 def _rk4_lanes(ship_rhs, nx: int):
-    """RK4 of a group of runs, stage by stage over the group, then the metrics accumulator.
+    """``(rk4_lanes, record_lanes)``: RK4 of a group of runs, stage by stage over the group, then
+    the metrics accumulator; and the logging of a group's row.
 
     The same operations, in the same order, per run as ``rk4`` of :func:`_plant_kernels`
     (so each run is bit-identical to its single run); shared by :func:`lane_loop` and
@@ -370,7 +371,18 @@ def _rk4_lanes(ship_rhs, nx: int):
             X[i, NX - 1] = clamp(X[i, NX - 1], PG[i])
             acc_step(ACC[i], t, E[g], DPREV[g], X[i, NX - 1], dt)
 
-    return rk4_lanes
+    @_jit_fused
+    def record_lanes(X, CMD, REF, i0, n_act, j, nr, out_x, out_cmd, out_ref):
+        """Write row ``j`` of the logs of runs ``i0 .. i0 + n_act - 1`` (first ``nr`` reference entries)."""
+        for g in range(n_act):
+            i = i0 + g
+            for q in range(NX):
+                out_x[i, j, q] = X[i, q]
+            out_cmd[i, j] = CMD[g]
+            for q in range(nr):
+                out_ref[i, j, q] = REF[g, q]
+
+    return rk4_lanes, record_lanes
 
 
 @lru_cache(maxsize=None)
@@ -387,7 +399,7 @@ def lane_loop(ship_rhs, ctrl_update, nx: int, lanes: int = LANES):
     ``i0 .. i0 + n_act - 1`` of the batch arrays in place.
     """
     NX = int(nx)
-    rk4_lanes = _rk4_lanes(ship_rhs, NX)
+    rk4_lanes, record_lanes = _rk4_lanes(ship_rhs, NX)
     update = _fused(ctrl_update)
     reference = _fused(course_reference)
     wrap = _fused(wrap_to_pi)
@@ -433,13 +445,7 @@ def lane_loop(ship_rhs, ctrl_update, nx: int, lanes: int = LANES):
             if kc == nc:
                 kc = 0
             if kr == 0:
-                for g in range(n_act):
-                    i = i0 + g
-                    for q in range(NX):
-                        out_x[i, j, q] = X[i, q]
-                    out_cmd[i, j] = CMD[g]
-                    out_ref[i, j, 0] = REF[g, 0]
-                    out_ref[i, j, 1] = REF[g, 1]
+                record_lanes(X, CMD, REF, i0, n_act, j, 2, out_x, out_cmd, out_ref)
                 j += 1
             kr += 1
             if kr == rec_every:
@@ -461,7 +467,7 @@ def guided_lane_loop(ship_rhs, ctrl_update, guide, nx: int, lanes: int = LANES):
     ``PS`` rows are overwritten at ``rpm_slot`` (when >= 0) by the guidance's propeller order.
     """
     NX = int(nx)
-    rk4_lanes = _rk4_lanes(ship_rhs, NX)
+    rk4_lanes, record_lanes = _rk4_lanes(ship_rhs, NX)
     update = _fused(ctrl_update)
     reference = _fused(guide)
     wrap = _fused(wrap_to_pi)
@@ -496,13 +502,7 @@ def guided_lane_loop(ship_rhs, ctrl_update, guide, nx: int, lanes: int = LANES):
             if kc == nc:
                 kc = 0
             if kr == 0:
-                for g in range(n_act):
-                    i = i0 + g
-                    for q in range(NX):
-                        out_x[i, j, q] = X[i, q]
-                    out_cmd[i, j] = CMD[g]
-                    for q in range(nr):
-                        out_ref[i, j, q] = REF[g, q]
+                record_lanes(X, CMD, REF, i0, n_act, j, nr, out_x, out_cmd, out_ref)
                 j += 1
             kr += 1
             if kr == rec_every:
