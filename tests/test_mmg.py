@@ -5,8 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from steerlab.environment.channels import (N_CHANNELS, W_CURRENT_DIR, W_CURRENT_SPEED, W_WIND_DIR,
-                                           W_WIND_SPEED)
+from steerlab.environment.channels import N_CHANNELS, W_WIND_DIR, W_WIND_SPEED, set_current
 from steerlab.environment.wind_fujiwara import (TABLE1, WindGeometry, fujiwara_coefficients,
                                                relative_wind, wind_force)
 from steerlab.errors import InputError
@@ -146,8 +145,7 @@ def test_rpm_and_schedule_together_is_an_error():
 
 def test_current_moves_the_track_not_the_heading():
     w = np.zeros(N_CHANNELS)
-    w[W_CURRENT_SPEED] = 0.2
-    w[W_CURRENT_DIR] = rad(90.0)     # flowing east
+    set_current(w, 0.2, rad(90.0))     # flowing east
     for x in ([0, 0, 0.4, U0, 0.02, 0.01], [1, 2, -2.0, 0.3, -0.01, -0.03]):
         calm, cur = _rhs(x, 0.1), _rhs(x, 0.1, w)
         np.testing.assert_allclose(cur[2:], calm[2:], atol=1e-15)

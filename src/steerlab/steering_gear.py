@@ -52,14 +52,16 @@ class SteeringGear(NamedTuple):
 @numba.njit(cache=True)
 def gear_rate(delta, delta_cmd, g):
     """Rudder rate [rad/s] of eq (15) for angle ``delta`` and order ``delta_cmd`` [rad]."""
+    # every parameter is read before the dead-zone test and the result is selected, not
+    # branched to, so that the batch engine can vectorise this kernel across runs
     dmax = g[G_DMAX]
+    rmax = g[G_RATE]
+    inv_tsg = g[G_INV_TSG]
+    dead = g[G_DEAD]
     cmd = min(max(delta_cmd, -dmax), dmax)
     err = cmd - delta
-    if abs(err) <= g[G_DEAD]:
-        return 0.0
-    rate = err * g[G_INV_TSG]
-    rmax = g[G_RATE]
-    return min(max(rate, -rmax), rmax)
+    rate = min(max(err * inv_tsg, -rmax), rmax)
+    return 0.0 if abs(err) <= dead else rate
 
 
 @numba.njit(cache=True)

@@ -14,6 +14,10 @@ ignores the others (a channel a model cannot represent is documented in its docs
 ``W_CURRENT_SPEED``, ``W_CURRENT_DIR``
     Current speed [m/s] and the direction it flows TOWARDS [rad], clockwise from north
     (it moves the track, not the heading: thesis 2.4.2).
+``W_CURRENT_N``, ``W_CURRENT_E``
+    The same current as north and east velocity components [m/s]
+    (``V_c cos beta_c``, ``V_c sin beta_c``), which the kinematics add without trigonometry.
+    :func:`set_current` writes all four current channels; write them only through it.
 ``W_YAW_RATE``
     Additive yaw-rate disturbance [rad/s] (the thesis' wave model adds filtered noise to r).
 ``W_YAW_MOMENT``
@@ -28,7 +32,31 @@ W_CURRENT_SPEED = 3
 W_CURRENT_DIR = 4
 W_YAW_RATE = 5
 W_YAW_MOMENT = 6
-N_CHANNELS = 7
+W_CURRENT_N = 7
+W_CURRENT_E = 8
+N_CHANNELS = 9
 CHANNEL_NAMES = ("d_rudder", "wind_speed", "wind_dir", "current_speed", "current_dir",
-                 "d_yaw_rate", "d_yaw_accel")
-CHANNEL_UNITS = ("rad", "m/s", "rad", "m/s", "rad", "rad/s", "rad/s^2")
+                 "d_yaw_rate", "d_yaw_accel", "current_north", "current_east")
+CHANNEL_UNITS = ("rad", "m/s", "rad", "m/s", "rad", "rad/s", "rad/s^2", "m/s", "m/s")
+
+
+def set_current(w, speed, direction):
+    """Write a current into the disturbance array ``w`` (rows ``(..., N_CHANNELS)``).
+
+    Parameters
+    ----------
+    w : ndarray
+        Disturbance array, modified in place.
+    speed : float or ndarray
+        Current speed [m/s] (per row, or one value).
+    direction : float or ndarray
+        Direction the current flows TOWARDS [rad], clockwise from north.
+    """
+    import numpy as np
+
+    speed = np.asarray(speed, dtype=float)
+    direction = np.asarray(direction, dtype=float)
+    w[..., W_CURRENT_SPEED] = speed
+    w[..., W_CURRENT_DIR] = direction
+    w[..., W_CURRENT_N] = speed * np.cos(direction)
+    w[..., W_CURRENT_E] = speed * np.sin(direction)

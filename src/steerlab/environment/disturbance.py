@@ -6,8 +6,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from steerlab.environment.channels import (N_CHANNELS, W_CURRENT_DIR, W_CURRENT_SPEED, W_RUDDER,
-                                           W_WIND_DIR, W_WIND_SPEED)
+from steerlab.environment.channels import (N_CHANNELS, W_RUDDER, W_WIND_DIR, W_WIND_SPEED,
+                                           set_current)
 from steerlab.environment.waves import coloured_noise
 from steerlab.errors import require_finite_range
 
@@ -73,8 +73,7 @@ def build_disturbance(dist: Disturbance, n_steps: int, dt: float, seed: int) -> 
     w[:, W_RUDDER] = np.where(t >= dist.constant_start, dist.constant_rudder, 0.0)
     w[:, W_WIND_SPEED] = dist.wind_speed
     w[:, W_WIND_DIR] = dist.wind_dir
-    w[:, W_CURRENT_SPEED] = dist.current_speed
-    w[:, W_CURRENT_DIR] = dist.current_dir
+    set_current(w, dist.current_speed, dist.current_dir)
     if dist.waves:
         rng = np.random.default_rng(seed)
         w[:, W_RUDDER] += coloured_noise(n_steps, dt, rng, dist.wave_sample_time, dist.wave_power)

@@ -35,8 +35,8 @@ from typing import Callable, Optional
 import numpy as np
 
 from steerlab.environment.channel_probe import reads_channel
-from steerlab.environment.channels import (W_CURRENT_DIR, W_CURRENT_SPEED, W_RUDDER, W_WIND_DIR,
-                                           W_WIND_SPEED, W_YAW_MOMENT, W_YAW_RATE)
+from steerlab.environment.channels import (W_RUDDER, W_WIND_DIR, W_WIND_SPEED, W_YAW_MOMENT,
+                                           W_YAW_RATE, set_current)
 from steerlab.environment.current_variation import current_series
 from steerlab.environment.gauss_markov import gauss_markov
 from steerlab.environment.random_streams import stream
@@ -186,8 +186,7 @@ def add_sea(w: np.ndarray, env, ctx: SeaContext, dt: float, seed: int) -> np.nda
         sp, di = current_series(c.kind, n_steps, dt, seed, env.current_speed, math.radians(env.current_dir_deg),
                                 c.speed_amplitude, math.radians(c.dir_amplitude_deg), c.time_scale,
                                 math.radians(c.phase_deg))
-        w[:, W_CURRENT_SPEED] = sp
-        w[:, W_CURRENT_DIR] = di
+        set_current(w, sp, di)
     if env.wind_rudder is not None and env.wind_rudder.amplitude_deg != 0.0:
         wr = env.wind_rudder
         if env.wind_speed <= 0.0:

@@ -7,26 +7,24 @@ Sec. 2.4.2: the current moves the track, not the heading)::
     y_e' = u sin psi + v cos psi + V_c sin beta_c
 
 ``u, v`` are the surge and sway speeds through the water [m/s] (``v = 0`` for models without
-sway), ``V_c = w[W_CURRENT_SPEED]`` [m/s] the current speed and ``beta_c = w[W_CURRENT_DIR]``
-[rad] the direction it flows towards, clockwise from north. The current terms are skipped
-when ``V_c == 0`` (no cost, and exactly the numbers without current).
-"""
+sway), ``V_c`` [m/s] the current speed and ``beta_c`` [rad] the direction it flows towards,
+clockwise from north; the kernel reads the current as its north and east components
+``w[W_CURRENT_N] = V_c cos beta_c``, ``w[W_CURRENT_E] = V_c sin beta_c`` (written with the
+speed and direction by :func:`steerlab.environment.channels.set_current`).
 
-import math
+``cos psi`` and ``sin psi`` come from :func:`steerlab.sincos.sincos` (plain arithmetic, no
+branches), so that the batch engine can vectorise this kernel across runs.
+"""
 
 import numba
 
-from steerlab.environment.channels import W_CURRENT_DIR, W_CURRENT_SPEED
+from steerlab.environment.channels import W_CURRENT_E, W_CURRENT_N
+from steerlab.sincos import sincos
 
 
 @numba.njit(cache=True, inline="always")
 def earth_velocity(psi, u, v, w, dx):
     """Write ``dx[0] = x_n'`` and ``dx[1] = y_e'`` [m/s] (see the module docstring)."""
-    c = math.cos(psi)
-    s = math.sin(psi)
-    dx[0] = u * c - v * s
-    dx[1] = u * s + v * c
-    vc = w[W_CURRENT_SPEED]
-    if vc != 0.0:
-        dx[0] += vc * math.cos(w[W_CURRENT_DIR])
-        dx[1] += vc * math.sin(w[W_CURRENT_DIR])
+    s, c = sincos(psi)
+    dx[0] = (u * c - v * s) + w[W_CURRENT_N]
+    dx[1] = (u * s + v * c) + w[W_CURRENT_E]

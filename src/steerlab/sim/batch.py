@@ -1,4 +1,7 @@
-"""Compiled batch engine: many runs of one (ship, controller) pair in parallel (numba prange).
+"""Compiled batch engine: many runs of one (ship, controller) pair in parallel.
+
+Groups of runs are advanced together, vectorised across the runs, on a pool of threads
+(:mod:`steerlab.sim.lanes`).
 
 Runs share ``dt``, the controller sample time and the number of steps; everything else
 (ship, gear, controller parameters, guidance, initial state, disturbance sequence) may vary
@@ -15,7 +18,7 @@ import numpy as np
 from steerlab.errors import InputError
 from steerlab.guidance.reference_vector import N_REF
 from steerlab.metrics_online import N_ACC
-from steerlab.sim.kernels import LANES, batch_loop
+from steerlab.sim.lanes import LANES, batch_loop
 from steerlab.sim.setup import SimSetup
 
 
@@ -49,7 +52,7 @@ def _stack(arrays, field):
 def simulate_batch(setups: list[SimSetup], record_every: int | None = None, lanes: int = LANES) -> BatchResult:
     """Run every setup with the compiled engine, in parallel over the available cores.
 
-    ``lanes`` runs are advanced together by each thread (see :func:`steerlab.sim.kernels.lane_loop`);
+    ``lanes`` runs are advanced together by each thread (see :func:`steerlab.sim.lanes.lane_loop`);
     the numbers do not depend on it.
     """
     if not setups:

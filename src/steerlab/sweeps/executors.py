@@ -1,7 +1,7 @@
 """Where packed batches run: this machine's cores (default) or a dask.distributed cluster.
 
-``LocalExecutor`` runs the whole batch in one compiled call (numba ``prange`` over the local
-cores). ``DaskExecutor`` cuts the batch into chunks of ``chunk_size`` runs
+``LocalExecutor`` runs the whole batch in one call of the compiled batch engine (vectorised
+groups of runs over a pool of threads on the local cores). ``DaskExecutor`` cuts the batch into chunks of ``chunk_size`` runs
 (:meth:`~steerlab.sweeps.packed.PackedBatch.take`: each chunk carries only the disturbance
 sequences it uses), sends them to the workers of a dask.distributed cluster, and
 concatenates the outputs in the original order. Runs are independent and deterministic, so

@@ -1,4 +1,4 @@
-"""Packed batches: the arrays of :func:`steerlab.sim.kernels.batch_loop`, built once, varied in place.
+"""Packed batches: the arrays of :func:`steerlab.sim.lanes.batch_loop`, built once, varied in place.
 
 Tuning, Monte-Carlo and robustness sweeps evaluate thousands of runs that differ only in a
 few numbers (controller parameters, seed, a model parameter). Building and validating a
@@ -140,10 +140,10 @@ class PackedBatch:
         return replace(self, PC=PC, Z=Z)
 
     def run(self, record_every: int | None = None) -> BatchOutput:
-        """Run every row with the compiled batch engine (numba ``prange`` over local cores)."""
+        """Run every row with the compiled batch engine (over the local cores)."""
         from steerlab.control.registry import get_controller
         from steerlab.ships.registry import get_ship
-        from steerlab.sim.kernels import LANES, batch_loop
+        from steerlab.sim.lanes import LANES, batch_loop
 
         ship = get_ship(self.ship_name)
         ctrl = get_controller(self.controller_name)
