@@ -38,6 +38,7 @@ from numba.core.registry import CPUDispatcher
 from steerlab.sim.batch import simulate_batch, vary_controller
 from steerlab.sim.engine import simulate_compiled, simulate_readable
 from steerlab.sim.kernels import plant_step
+from steerlab.sim.lanes import LANES
 from steerlab.sim.scenario import Scenario, scenario_from_dict
 from steerlab.sim.setup import SimSetup, build
 
@@ -236,6 +237,7 @@ def run_bench(n_batch: int = 1000, duration: float = 3000.0, repeats: int = 5,
         "batch_compile_s": batch_compile_s,
         "cores": os.cpu_count(),
         "numba_threads": numba.get_num_threads(),
+        "batch_lanes": LANES,
         "numba_version": numba.__version__,
         "numpy_version": np.__version__,
         "python_version": platform.python_version(),
