@@ -7,8 +7,14 @@ logs, state-dependent guidance, and ships whose kernels do not vectorise.
 
 from __future__ import annotations
 
+import re
+import struct
+
+import numba
 import numpy as np
 import pytest
+
+import steerlab.sincos as sincos_module
 
 from steerlab.bench import W1, w1_batch_setups
 from steerlab.errors import InputError
@@ -95,3 +101,43 @@ def test_ship_with_branches_and_its_own_current_handling():
 def test_bad_group_size_is_refused(sea_runs):
     with pytest.raises(InputError, match="lanes"):
         simulate_batch(sea_runs[:2], lanes=0)
+
+
+@pytest.mark.skipif(not numba.config.LOOP_VECTORIZE, reason="numba's loop vectoriser is switched off")
+def test_the_four_rk4_stages_of_the_esso_are_vectorised_across_runs():
+    """Structural guard for the batch speed: the compiled group holds the sin polynomial of
+    the kinematics as vector arithmetic (``<N x double>``) once per RK4 stage. A branch or a
+    library call added to the Esso, gear or kinematics kernels would make this fail."""
+    from steerlab.control.pid import pid_update
+    from steerlab.ships.esso_3dof import esso_rhs
+    from steerlab.sim.lanes import lane_loop
+
+    simulate_batch(w1_batch_setups(_w1(duration=1.0), 2))
+    group = lane_loop(esso_rhs, pid_update, 7, LANES)
+    ir = "\n".join(group.inspect_llvm().values())
+    s1 = "0x%016X" % struct.unpack("<Q", struct.pack("<d", sincos_module._S1))[0]
+    vector_lines = [ln for ln in ir.splitlines() if s1 in ln and "x double>" in ln]
+    assert len(vector_lines) >= 4, vector_lines
+    # and no library function was vectorised by calling it once per run (llvm.sin.v8f64 ...)
+    cheap = {"fabs", "floor", "ceil", "trunc", "rint", "round", "sqrt", "copysign", "minnum",
+             "maxnum", "minimum", "maximum", "smax", "smin", "umax", "umin", "masked"}
+    vector_calls = set(re.findall(r"@llvm\.(\w+)\.[\w.]*v\d+f64", ir))
+    assert vector_calls <= cheap, vector_calls - cheap
+
+
+def test_a_forked_child_runs_batches_too(sea_runs):
+    """The thread pool is per process: a child forked after a batch must not wait on the
+    parent's (threadless) pool."""
+    import multiprocessing as mp
+
+    if "fork" not in mp.get_all_start_methods():
+        pytest.skip("no fork on this platform")
+    want = simulate_batch(sea_runs[:5], lanes=2).final_states
+    ctx = mp.get_context("fork")
+    with ctx.Pool(1) as pool:
+        got = pool.apply_async(_child_batch, (sea_runs[:5],)).get(timeout=120)
+    np.testing.assert_array_equal(got, want)
+
+
+def _child_batch(runs):
+    return simulate_batch(runs, lanes=2).final_states

@@ -22,6 +22,7 @@ the metrics accumulator (branches, calls) run one run at a time, on the same col
 
 from __future__ import annotations
 
+import os
 from concurrent.futures import ThreadPoolExecutor
 from functools import lru_cache
 
@@ -303,13 +304,15 @@ def _run_groups(run_group, n: int, lanes: int) -> None:
         for i0 in starts[1:]:
             run_group(i0, min(lanes, n - i0))
         return
-    pool = _pool(threads)
+    pool = _pool(threads, os.getpid())
     for _ in pool.map(lambda i0: run_group(i0, min(lanes, n - i0)), starts[1:]):
         pass
 
 
 @lru_cache(maxsize=None)
-def _pool(threads: int) -> ThreadPoolExecutor:
+def _pool(threads: int, pid: int) -> ThreadPoolExecutor:
+    """A pool of ``threads`` workers for this process (``pid``: a forked child, whose copy of
+    the parent's pool has no threads, gets its own)."""
     return ThreadPoolExecutor(max_workers=threads, thread_name_prefix="steerlab-batch")
 
 
