@@ -208,3 +208,20 @@ def test_course_unstable_ship_needs_explicit_tau_star():
     with pytest.raises(InputError) as err:
         build(sc)
     assert err.value.field == "controller.tau_star0"
+
+
+def test_course_unstable_ship_needs_explicit_initial_model():
+    """Esso at 16 kn is course-unstable (Nomoto K, T < 0): the default initial K*, tau* would be
+    negative; the error says why and what to give, and giving them works."""
+    from steerlab.errors import InputError
+    from steerlab.sim.scenario import scenario_from_dict
+    from steerlab.sim.setup import build
+
+    with pytest.raises(InputError) as err:
+        build(scenario_from_dict({"ship": {"model": "esso"}, "controller": {"type": "asa"}}))
+    msg = str(err.value)
+    assert err.value.field == "controller.K_star0"
+    assert "course-unstable" in msg and "tau_star0" in msg and "T = -" in msg
+    s = build(scenario_from_dict({"ship": {"model": "esso"},
+                                  "controller": {"type": "asa", "K_star0": 2.0, "tau_star0": 3.0}}))
+    assert s.pc.size > 0

@@ -309,6 +309,15 @@ def build(cfg: ASAConfig, ctx):
         K, T = ctx.nomoto()
         ks0 = K * L / ctx.speed
         ts0 = T * ctx.speed / L
+        bad_k = cfg.K_star0 is None and not K > 0.0
+        bad_t = cfg.tau_star0 is None and not T > 0.0
+        if bad_k or bad_t:
+            name = "K_star0" if bad_k else "tau_star0"
+            raise InputError(f"controller.{name}", (
+                f"ship {ctx.ship.name!r} at {ctx.speed:.3g} m/s has the Nomoto model K = {K:.4g} 1/s, "
+                f"T = {T:.4g} s (course-unstable): ASA's initial K*, tau* come from a course-stable "
+                f"model (thesis 4.3.2); give K_star0 in [{cfg.K_star_min}, {cfg.K_star_max}] and "
+                f"tau_star0 in [{cfg.tau_star_min}, {cfg.tau_star_max}] explicitly"))
     ks0 = cfg.K_star0 if cfg.K_star0 is not None else ks0
     ts0 = cfg.tau_star0 if cfg.tau_star0 is not None else ts0
     uf = knots_to_ms(cfg.freeze_speed_kn) if cfg.freeze_speed_kn is not None else 0.2 * U0
