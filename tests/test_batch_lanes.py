@@ -104,16 +104,17 @@ def test_bad_group_size_is_refused(sea_runs):
 
 
 @pytest.mark.skipif(not numba.config.LOOP_VECTORIZE, reason="numba's loop vectoriser is switched off")
-def test_the_four_rk4_stages_of_the_esso_are_vectorised_across_runs():
+@pytest.mark.parametrize("ship", ["esso", "nomoto1"])
+def test_the_four_rk4_stages_are_vectorised_across_runs(ship):
     """Structural guard for the batch speed: the compiled group holds the sin polynomial of
-    the kinematics as vector arithmetic (``<N x double>``) once per RK4 stage. A branch or a
-    library call added to the Esso, gear or kinematics kernels would make this fail."""
-    from steerlab.control.pid import pid_update
-    from steerlab.ships.esso_3dof import esso_rhs
+    the kinematics as vector arithmetic (``<N x double>``) once per RK4 stage. A branch, a
+    raising division or a library call added to the ship (Esso; Nomoto 1, which divides by
+    T), gear or kinematics kernels would make this fail."""
     from steerlab.sim.lanes import lane_loop
 
-    simulate_batch(w1_batch_setups(_w1(duration=1.0), 2))
-    group = lane_loop(esso_rhs, pid_update, 7, LANES)
+    setup = _w1(duration=1.0, ship={"model": ship, "speed_kn": 16.0})
+    simulate_batch(w1_batch_setups(setup, 2))
+    group = lane_loop(setup.ship.rhs, setup.controller.update, setup.x0.size, LANES)
     ir = "\n".join(group.inspect_llvm().values())
     s1 = "0x%016X" % struct.unpack("<Q", struct.pack("<d", sincos_module._S1))[0]
     vector_lines = [ln for ln in ir.splitlines() if s1 in ln and "x double>" in ln]

@@ -55,9 +55,14 @@ def _fuse_options() -> dict:
 
     ``forceinline`` marks the function ``alwaysinline`` for LLVM; ``_nrt=False`` compiles it
     without reference counting (these kernels never allocate; the loop's scratch arrays are
-    allocated by the caller). Falls back to plain ``njit`` if this numba rejects the options.
+    allocated by the caller); ``error_model="numpy"`` lets a float division by zero give
+    IEEE inf/NaN instead of raising ``ZeroDivisionError``, so a division (``/ T`` in most
+    ship models) is one instruction and not a branch to an exception, which would stop the
+    batch engine from vectorising the kernel. The records the kernels divide by are validated
+    (T != 0 etc.), so no valid scenario divides by zero and the numbers are those of the
+    plain kernels. Falls back to plain ``njit`` if this numba rejects the options.
     """
-    opts = {"forceinline": True, "_nrt": False}
+    opts = {"forceinline": True, "_nrt": False, "error_model": "numpy"}
     try:
         probe = numba.njit(**opts)(_probe_kernel)
         probe(np.zeros(2))
