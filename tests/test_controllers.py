@@ -352,3 +352,26 @@ def test_printed_kd_rule_is_underdamped(scenario):
     # the plant is not the ideal double integrator (gear lag, ESO lag): some overshoot remains
     assert over_h < 3.0
     assert over_p > 3.0 * over_h and over_p > 8.0
+
+
+def test_adrc_observer_that_diverges_at_its_sample_time_is_refused():
+    """Forward-Euler ESO: a triple pole at -w has the discrete eigenvalue 1 - w h, so it
+    converges for w h < 2 only; faster observers are refused with the field and the limit."""
+    from steerlab.control.estimators import eso_discrete_radius, eso_gains_bandwidth
+    from steerlab.errors import InputError
+    from steerlab.sim.scenario import scenario_from_dict
+    from steerlab.sim.setup import build
+
+    assert eso_discrete_radius(eso_gains_bandwidth(5.0), 0.1) == pytest.approx(0.5, abs=1e-4)
+    assert eso_discrete_radius(eso_gains_bandwidth(25.0), 0.1) == pytest.approx(1.5, abs=1e-3)
+    ok = {"ship": {"model": "esso"}, "controller": {"type": "adrc", "observer": "bandwidth",
+                                                     "observer_bandwidth": 15.0}}
+    build(scenario_from_dict(ok))                                 # 15 * 0.1 = 1.5 < 2
+    with pytest.raises(InputError) as err:
+        build(scenario_from_dict({**ok, "controller": {**ok["controller"], "sample_time": 0.5}}))
+    assert err.value.field == "controller.observer_bandwidth"
+    assert "diverges" in str(err.value) and "below 4 rad/s" in str(err.value)
+    with pytest.raises(InputError) as err:
+        build(scenario_from_dict({"ship": {"model": "esso"},
+                                  "controller": {"type": "adrc", "L": [300.0, 3e4, 1e6]}}))
+    assert err.value.field == "controller.L"

@@ -37,7 +37,8 @@ from pydantic import Field, field_validator
 
 from steerlab.angles import wrap_to_pi
 from steerlab.config_base import FrozenConfig
-from steerlab.control.estimators import PAPER_L, eso_gains_bandwidth, eso_gains_lqr, eso_step
+from steerlab.control.estimators import (PAPER_L, check_discrete_eso, eso_gains_bandwidth, eso_gains_lqr,
+                                         eso_step)
 from steerlab.control.registry import ControllerSpec
 from steerlab.errors import InputError, require_finite_range
 from steerlab.units import rad
@@ -154,6 +155,9 @@ def build(cfg: ADRCConfig, ctx):
         L = eso_gains_bandwidth(cfg.observer_bandwidth)
     else:
         L = eso_gains_lqr(cfg.lqr_q, cfg.lqr_r)
+    field = "controller.L" if cfg.L is not None else (
+        "controller.observer_bandwidth" if cfg.observer == "bandwidth" else "controller.observer")
+    check_discrete_eso(L, ctx.sample_time, field)
     c = ADRC.from_settling_time(cfg.T_settle, c0, L=L, law=cfg.law, kd_rule=cfg.kd_rule,
                                 u_max=ctx.u_max(cfg.u_max_deg))
     return c, c.pack()

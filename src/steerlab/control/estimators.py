@@ -62,6 +62,33 @@ def eso_poles(L) -> np.ndarray:
     return np.roots([1.0, L[0], L[1], L[2]])
 
 
+def eso_discrete_radius(L, h: float) -> float:
+    """Spectral radius [-] of the forward-Euler ESO error dynamics ``I + h (A - L C)``.
+
+    The discrete observer (7a) at sample time ``h`` [s] converges only if this is < 1. For a
+    triple pole at ``-omega_o`` the eigenvalue is ``1 - omega_o h``: it converges for
+    ``omega_o h < 2`` (and without a sign-alternating error for ``omega_o h <= 1``).
+    """
+    A, _, C = eso_matrices()
+    Ad = np.eye(3) + h * (A - np.outer(np.asarray(L, dtype=float), C.ravel()))
+    return float(np.max(np.abs(np.linalg.eigvals(Ad))))
+
+
+def check_discrete_eso(L, h: float, field: str = "controller.L") -> None:
+    """Raise :class:`~steerlab.errors.InputError` if the ESO with gains ``L`` diverges when
+    integrated by forward Euler at the controller sample time ``h`` [s]."""
+    from steerlab.errors import InputError
+
+    rho = eso_discrete_radius(L, h)
+    if not rho < 1.0:
+        fastest = float(np.max(np.abs(eso_poles(L))))
+        raise InputError(field, (
+            f"the observer with gains {tuple(round(float(v), 6) for v in L)} (fastest pole "
+            f"{fastest:.3g} rad/s) diverges when sampled every {h:g} s (forward Euler: "
+            f"spectral radius {rho:.3g}, must be < 1); use slower observer poles (a bandwidth "
+            f"below {2.0 / h:.3g} rad/s, better {1.0 / h:.3g}) or a shorter sample_time"))
+
+
 @numba.njit(cache=True)
 def eso_step(xh, c0, l1, l2, l3, y, u, h):
     """Advance the ESO estimate ``xh = [x1, x2, x3]`` in place by one Euler step of (7a)."""
