@@ -70,8 +70,17 @@ def test_steering_inputs_heading_and_plotter_course():
     apb = nmea.render("APB", ["A", "A", "0.10", "R", "N", "V", "V", "45.0", "T", "WP1", "44.0", "T", "50.0", "T"])
     assert nmea.steering_inputs(apb.encode())["course"] == pytest.approx(math.radians(50.0))   # heading to steer
     apb = nmea.render("APB", ["A", "A", "0.10", "R", "N", "V", "V", "45.0", "T", "WP1", "44.0", "T", "", ""])
-    want = math.radians(44.0) + math.atan(0.1 * 1852 / 500.0)                # steer right: + correction
+    # the simulator's LOS law on the leg course (origin -> destination, 45 deg): steer right
+    # = the ship is to port of the track (e < 0) = + correction
+    want = math.radians(45.0) + math.atan(0.1 * 1852 / 500.0)
     assert nmea.steering_inputs(apb.encode(), 500.0)["course"] == pytest.approx(want)
+    from steerlab.guidance.los import los_heading
+    assert nmea.steering_inputs(apb.encode(), 500.0)["course"] == los_heading(math.radians(45.0), -185.2, 500.0)
+    no_leg = apb.split(",")
+    no_leg[8] = no_leg[9] = ""                                               # no origin bearing: bearing to dest
+    no_leg = nmea.render("APB", no_leg[1:-1] + [no_leg[-1].split("*")[0]])
+    assert nmea.steering_inputs(no_leg.encode(), 500.0)["course"] == pytest.approx(
+        math.radians(44.0) + math.atan(0.1 * 1852 / 500.0))
     rmb = nmea.render("RMB", ["A", "0.05", "L", "A", "B", "5430.00", "N", "01830.00", "E", "1.0", "90.0", "8.0", "V"])
     assert nmea.steering_inputs(rmb.encode(), 500.0)["course"] == pytest.approx(
         math.radians(90.0) - math.atan(0.05 * 1852 / 500.0))

@@ -119,6 +119,17 @@ def initial_los_state(g: np.ndarray) -> np.ndarray:
 
 
 @numba.njit(cache=True)
+def los_heading(alpha, e, lookahead):
+    """LOS heading [rad] of eq (2): ``wrap(alpha + atan2(-e, Delta))``.
+
+    ``alpha`` the leg course [rad], ``e`` the cross-track error [m] (> 0 to starboard of the
+    leg), ``lookahead`` the look-ahead distance ``Delta`` [m] (> 0). Used by the simulator's
+    kernel below and by the runtime for a chart plotter's APB/RMB sentences.
+    """
+    return wrap_to_pi(alpha + math.atan2(-e, lookahead))
+
+
+@numba.njit(cache=True)
 def los_guidance(t, x, g, z, ref, h):
     """Guidance kernel: LOS heading (eq 2) for the ship at ``x[0], x[1]``; advances the leg (eq 3).
 
@@ -149,7 +160,7 @@ def los_guidance(t, x, g, z, ref, h):
     ca = math.cos(alpha)
     sa = math.sin(alpha)
     e = -(px - xa) * sa + (py - ya) * ca
-    ref[0] = wrap_to_pi(alpha + math.atan2(-e, delta_la))
+    ref[0] = los_heading(alpha, e, delta_la)
     ref[1] = 0.0
     ref[2] = 0.0
     ref[4] = e

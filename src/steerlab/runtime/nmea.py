@@ -29,6 +29,7 @@ import pynmea2
 from pynmea2 import TalkerSentence
 
 from steerlab.units import KNOT, deg, rad
+from steerlab.guidance.los import los_heading
 
 EARTH_RADIUS = 6_371_000.0
 MAX_LINE = 96
@@ -167,12 +168,16 @@ def _xte_m(magnitude, unit: str | None) -> float | None:
 
 
 def _corrected(bearing_deg, xte_m, steer, lookahead: float):
+    """The simulator's LOS law (:func:`steerlab.guidance.los.los_heading`) on a plotter's leg
+    course (or bearing) and cross-track error: steer ``R`` means the ship is to port of the
+    track (``e < 0``), ``L`` to starboard."""
     b = _num(bearing_deg)
     if b is None:
         return None
     c = rad(b)
     if xte_m is not None and steer in ("L", "R") and lookahead > 0:
-        c += math.atan(xte_m / lookahead) * (1.0 if steer == "R" else -1.0)
+        e = abs(xte_m) if steer == "L" else -abs(xte_m)
+        return float(los_heading(c, e, lookahead))
     return c
 
 
@@ -183,10 +188,13 @@ def _course_from(s, lookahead: float):
             return None
         if getattr(s, "heading_to_dest_type", "") == "T" and _num(getattr(s, "heading_to_dest", None)) is not None:
             return rad(_num(s.heading_to_dest))
+        xte = _xte_m(s.cross_track_err_mag, s.cross_track_unit)
+        # the LOS law steers by the leg's course (origin -> destination), as the simulator does
+        if getattr(s, "bearing_type", "") == "T" and _num(getattr(s, "bearing_to_dest", None)) is not None:
+            return _corrected(s.bearing_to_dest, xte, s.dir_steer, lookahead)
         if getattr(s, "bearing_pres_dest_type", "") != "T":
             return None
-        return _corrected(s.bearing_pres_dest, _xte_m(s.cross_track_err_mag, s.cross_track_unit),
-                          s.dir_steer, lookahead)
+        return _corrected(s.bearing_pres_dest, xte, s.dir_steer, lookahead)
     if kind == "RMB":
         if getattr(s, "status", "A") != "A":
             return None
