@@ -229,3 +229,48 @@ def test_ship_and_autopilot_signalk_streams(controller):  # noqa: F811
 
     asyncio.run(_with_streams(controller, client))
     assert out.get("ok")
+
+
+def test_signalk_rest_api_serves_the_latest_values_to_a_real_http_client():
+    """GET the discovery document, the full model, a branch and a leaf with urllib (a real HTTP
+    client on loopback); unknown paths are 404; the values are the stream's last ones."""
+    import urllib.error
+    import urllib.request
+
+    from steerlab.runtime.signalk import iso_time
+
+    def get(url):
+        with urllib.request.urlopen(url, timeout=5) as resp:
+            return resp.status, resp.headers.get("Content-Type"), json.loads(resp.read())
+
+    async def go():
+        srv = await SignalKStreamServer().start()
+        try:
+            host, port = srv.address
+            srv.publish({"navigation.headingTrue": 1.25, "navigation.rateOfTurn": -0.01,
+                         "steering.rudderAngle": 0.1, "steering.rudderAngleTarget": None}, wall=1_700_000_000.5)
+            srv.publish({"steering.rudderAngle": 0.2}, wall=1_700_000_001.0)
+            _, _, disco = await asyncio.to_thread(get, f"http://{host}:{port}/signalk")
+            api = disco["endpoints"]["v1"]["signalk-http"]
+            assert api == f"http://{host}:{port}/signalk/v1/api/"
+            status, ctype, full = await asyncio.to_thread(get, api)
+            assert status == 200 and ctype == "application/json"
+            vessel = full["vessels"]["self"]
+            assert full["self"] == "vessels.self" and full["version"] == disco["endpoints"]["v1"]["version"]
+            assert vessel["navigation"]["headingTrue"]["value"] == 1.25
+            assert vessel["steering"]["rudderAngle"] == {
+                "value": 0.2, "timestamp": iso_time(1_700_000_001.0), "$source": "steerlab.steerlab-runtime"}
+            assert "rudderAngleTarget" not in vessel["steering"]            # None is not a value
+            _, _, leaf = await asyncio.to_thread(get, api + "vessels/self/navigation/rateOfTurn")
+            assert leaf["value"] == -0.01 and leaf["timestamp"] == iso_time(1_700_000_000.5)
+            _, _, branch = await asyncio.to_thread(get, api + "vessels/self/steering")
+            assert set(branch) == {"rudderAngle"}
+            for bad in ("vessels/self/navigation/nothing", "vessels/other", "sources",
+                        "vessels/self/navigation/headingTrue/value"):
+                with pytest.raises(urllib.error.HTTPError) as err:
+                    await asyncio.to_thread(get, api + bad)
+                assert err.value.code == 404, bad
+        finally:
+            await srv.close()
+
+    asyncio.run(go())

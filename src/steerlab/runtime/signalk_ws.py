@@ -4,8 +4,10 @@ The part of the Signal K specification (1.7, "Streaming API", "Subscription Prot
 "Request/Response") that an instrument display or a chart plotter needs:
 
 ``GET /signalk``
-    Discovery: ``{"endpoints": {"v1": {"version": "1.7.0", "signalk-ws": "ws://HOST:PORT/signalk/v1/stream"}},
-    "server": {"id": "steerlab", "version": ...}}``.
+    Discovery: ``{"endpoints": {"v1": {"version": "1.7.0", "signalk-ws": "ws://HOST:PORT/signalk/v1/stream",
+    "signalk-http": "http://HOST:PORT/signalk/v1/api/"}}, "server": {"id": "steerlab", "version": ...}}``.
+``GET /signalk/v1/api/...``
+    The read-only REST API over the latest values (:mod:`steerlab.runtime.signalk_rest`).
 ``WS /signalk/v1/stream[?subscribe=self|all|none][&sendCachedValues=true|false]``
     On connection a *hello* (``{"name", "version", "timestamp", "self": "vessels.self", "roles"}``),
     the cached values (unless ``sendCachedValues=false``), then every update as a delta message
@@ -43,6 +45,7 @@ from websockets.asyncio.server import broadcast, serve
 from steerlab.errors import InputError
 from steerlab.runtime.rate_limit import RateLimiter
 from steerlab.runtime.signalk import MAX_DELTA_BYTES, delta, iso_time
+from steerlab.runtime.signalk_rest import API_PATH, api_get
 from steerlab.runtime.web import _response, same_origin
 
 SIGNALK_VERSION = "1.7.0"
@@ -117,6 +120,7 @@ class SignalKStreamServer:
         self.max_buffer = max_buffer
         self.limiter = RateLimiter(msg_rate, 2 * msg_rate, max_sources=4 * max_clients)
         self.cache: dict = {}
+        self.cache_time: dict = {}       # path -> wall time of its last value [s]
         self.clients: dict = {}          # connection -> Subscriptions
         self.counts = {"clients": 0, "sent": 0, "skipped_slow": 0, "subscriptions": 0, "put_ok": 0,
                        "put_refused": 0, "rejected": 0, "rate_limited": 0}
@@ -127,9 +131,15 @@ class SignalKStreamServer:
         path, _, query = request.path.partition("?")
         if path in ("/signalk", "/signalk/"):
             host = request.headers.get("Host") or "%s:%d" % tuple(self.address)
-            body = {"endpoints": {"v1": {"version": SIGNALK_VERSION, "signalk-ws": f"ws://{host}{STREAM_PATH}"}},
+            body = {"endpoints": {"v1": {"version": SIGNALK_VERSION, "signalk-ws": f"ws://{host}{STREAM_PATH}",
+                                         "signalk-http": f"http://{host}{API_PATH}/"}},
                     "server": {"id": self.name, "version": _steerlab_version()}}
             return _response(HTTPStatus.OK, json.dumps(body).encode(), "application/json")
+        if path == API_PATH or path.startswith(API_PATH + "/"):
+            status, body = api_get(path, self.cache, self.cache_time, SIGNALK_VERSION)
+            if body is None:
+                return _response(status, b"no such Signal K path\n", "text/plain")
+            return _response(status, json.dumps(body).encode(), "application/json")
         if path != STREAM_PATH:
             return _response(HTTPStatus.NOT_FOUND, b"not found\n", "text/plain")
         if not same_origin(request):
@@ -221,6 +231,8 @@ class SignalKStreamServer:
         values = {p: v for p, v in values.items()
                   if v is not None and not (isinstance(v, float) and not math.isfinite(v))}
         self.cache.update(values)
+        now = time.time() if wall is None else wall
+        self.cache_time.update((p, now) for p in values)
         for ws, subs in list(self.clients.items()):
             self._send(ws, subs, values, wall)
 
