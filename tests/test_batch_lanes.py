@@ -142,3 +142,28 @@ def test_a_forked_child_runs_batches_too(sea_runs):
 
 def _child_batch(runs):
     return simulate_batch(runs, lanes=2).final_states
+
+
+def test_progress_reports_runs_done_in_order_and_ends_complete(sea_runs, monkeypatch):
+    from steerlab.sim import lanes
+
+    monkeypatch.setattr(lanes, "PROGRESS_PERIOD", 0.0)       # report after every group
+    calls = []
+    batch = simulate_batch(sea_runs, lanes=3, progress=lambda done, n: calls.append((done, n)))
+    assert {n for _, n in calls} == {19}
+    done = [d for d, _ in calls]
+    assert done == sorted(done) and done[-1] == 19 and len(done) >= 3
+    # whole groups (6 of 3 runs and one of 1), in the order they finish
+    assert set(np.diff([0] + done)) <= {1, 3, 4}
+    np.testing.assert_array_equal(batch.final_states, simulate_batch(sea_runs, lanes=3).final_states)
+
+
+def test_progress_bar_text():
+    from steerlab.progress import bar, runs_progress
+
+    assert bar(0, 10) == "[" + "." * 20 + "]"
+    assert bar(5, 10) == "[" + "#" * 10 + "." * 10 + "]"
+    assert bar(12, 10, width=4) == "[####]"
+    said = []
+    runs_progress(said.append)(250, 1000)
+    assert said == ["[#####...............] 250/1000 runs"]

@@ -110,8 +110,10 @@ def test_dask_and_local_give_identical_numbers():
         ex = DaskExecutor(client, chunk_size=4)
         remote = PopulationEvaluator(conds, pm, costs, executor=ex).per_condition_costs(X)
         a = batch.run(record_every=50)
-        b = ex.run(batch, record_every=50)
+        seen = []
+        b = ex.run(batch, record_every=50, progress=lambda done, n: seen.append((done, n)))
     assert np.array_equal(local, remote)
+    assert seen[-1] == (batch.n, batch.n) and [d for d, _ in seen] == sorted(d for d, _ in seen)
     assert np.array_equal(a.acc, b.acc) and np.array_equal(a.states, b.states)
 
 
@@ -150,7 +152,9 @@ def test_cli_tune_montecarlo_robustness(tmp_path, capsys):
     assert set(r["best"]["parameters"]) == {"kp", "kd"} and r["method"] == "de"
     assert (out / "convergence.png").exists() and (out / "history.csv").exists()
     assert r["n_simulations"] == 6 * 3 * 2  # (initial population + 2 generations) x 6 x 2 seeds
-    assert main(["montecarlo", str(s), "--runs", "3", "--out", str(tmp_path / "mc"), "--quiet"]) == 0
+    capsys.readouterr()
+    assert main(["montecarlo", str(s), "--runs", "3", "--out", str(tmp_path / "mc")]) == 0
+    assert "[####################] 3/3 runs" in capsys.readouterr().err     # progress, at the end
     assert (tmp_path / "mc" / "percentile_bands.png").exists()
     mc = json.loads((tmp_path / "mc" / "montecarlo.json").read_text())
     assert mc["metrics"]["itae_deg_s2"]["n"] == 3

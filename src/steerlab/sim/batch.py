@@ -49,11 +49,13 @@ def _stack(arrays, field):
     return np.ascontiguousarray(np.stack(arrays))
 
 
-def simulate_batch(setups: list[SimSetup], record_every: int | None = None, lanes: int = LANES) -> BatchResult:
+def simulate_batch(setups: list[SimSetup], record_every: int | None = None, lanes: int = LANES,
+                   progress=None) -> BatchResult:
     """Run every setup with the compiled engine, in parallel over the available cores.
 
     ``lanes`` runs are advanced together by each thread (see :func:`steerlab.sim.lanes.lane_loop`);
-    the numbers do not depend on it.
+    the numbers do not depend on it. ``progress(done, n)``, if given, is called with the number
+    of runs done (at most twice a second, and at the end).
     """
     if not setups:
         raise InputError("setups", "a batch needs at least one run")
@@ -97,12 +99,13 @@ def simulate_batch(setups: list[SimSetup], record_every: int | None = None, lane
     run_batch = batch_loop(s0.ship.rhs, s0.controller.update, nx, int(lanes), s0.guide)
     if s0.guide is None:
         out_ref = np.empty((n, n_rec, 2))
-        run_batch(X, Z, PS, PG, PC, GD, W, w_index, s0.dt, s0.nc, N, rec, out_x, out_cmd, out_ref, acc)
+        run_batch(X, Z, PS, PG, PC, GD, W, w_index, s0.dt, s0.nc, N, rec, out_x, out_cmd, out_ref, acc,
+                  progress=progress)
     else:   # state-dependent guidance: its own state per run; PS is this batch's copy
         out_ref = np.empty((n, n_rec, N_REF))
         GZ = _stack([s.gz0 for s in setups], "gz0").copy()
         run_batch(X, Z, PS, PG, PC, GD, GZ, W, w_index, s0.dt, s0.nc, N, rec, out_x, out_cmd, out_ref,
-                  acc, s0.rpm_slot)
+                  acc, s0.rpm_slot, progress=progress)
     time = np.arange(n_rec) * rec * s0.dt
     return BatchResult(acc, X, time, out_x, out_cmd, out_ref, s0.state_names)
 

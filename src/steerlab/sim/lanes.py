@@ -23,7 +23,8 @@ the metrics accumulator (branches, calls) run one run at a time, on the same col
 from __future__ import annotations
 
 import os
-from concurrent.futures import ThreadPoolExecutor
+import time
+from concurrent.futures import ThreadPoolExecutor, as_completed
 from functools import lru_cache
 
 import numba
@@ -289,24 +290,60 @@ def guided_lane_loop(ship_rhs, ctrl_update, guide, nx: int, lanes: int = LANES):
     return group
 
 
-def _run_groups(run_group, n: int, lanes: int) -> None:
+PROGRESS_PERIOD = 0.5
+"""Least time between two progress reports of a batch [s]."""
+
+
+def _run_groups(run_group, n: int, lanes: int, progress=None) -> None:
     """Call ``run_group(i0, n_act)`` for every group of ``lanes`` runs out of ``n``, spread over
     ``numba.get_num_threads()`` threads (the group kernels release the GIL).
 
     A pool of Python threads rather than numba's ``prange``: the groups are independent and
     few (one call each), and a ``parallel=True`` wrapper would re-optimise the whole inlined
     group loop once more at every compile (about 5 s per ship/controller pair).
+
+    ``progress(done, n)``, if given, is called from this thread with the number of runs done,
+    at most every :data:`PROGRESS_PERIOD` seconds and once at the end.
     """
     starts = list(range(0, n, lanes))
     threads = min(numba.get_num_threads(), len(starts))
+    report = _Reporter(progress, n)
     run_group(starts[0], min(lanes, n))       # the first group also compiles, in this thread
+    report.add(min(lanes, n))
     if threads <= 1:
         for i0 in starts[1:]:
             run_group(i0, min(lanes, n - i0))
-        return
-    pool = _pool(threads, os.getpid())
-    for _ in pool.map(lambda i0: run_group(i0, min(lanes, n - i0)), starts[1:]):
-        pass
+            report.add(min(lanes, n - i0))
+    else:
+        pool = _pool(threads, os.getpid())
+        runs = {pool.submit(run_group, i0, min(lanes, n - i0)): min(lanes, n - i0) for i0 in starts[1:]}
+        try:
+            for fut in as_completed(runs):
+                fut.result()
+                report.add(runs[fut])
+        finally:
+            for fut in runs:         # on an error (or Ctrl-C) drop the groups not yet started
+                fut.cancel()
+    report.done()
+
+
+class _Reporter:
+    """Throttled ``progress(done, total)`` calls (none when ``progress`` is None)."""
+
+    def __init__(self, progress, total: int):
+        self.progress, self.total, self.count = progress, total, 0
+        self.last = time.perf_counter()
+
+    def add(self, runs: int) -> None:
+        self.count += runs
+        now = time.perf_counter()
+        if self.progress is not None and self.count < self.total and now - self.last >= PROGRESS_PERIOD:
+            self.last = now
+            self.progress(self.count, self.total)
+
+    def done(self) -> None:
+        if self.progress is not None:
+            self.progress(self.total, self.total)
 
 
 @lru_cache(maxsize=None)
@@ -321,19 +358,19 @@ def guided_batch_loop(ship_rhs, ctrl_update, guide, nx: int, lanes: int = LANES)
     """:func:`batch_loop` with a state-dependent guidance kernel.
 
     ``run_batch(X, Z, PS, PG, PC, GD, GZ, W, w_index, dt, nc, n_steps, rec_every, out_x,
-    out_cmd, out_ref, ACC, rpm_slot)``; ``PS`` and ``GZ`` are modified in place.
+    out_cmd, out_ref, ACC, rpm_slot, progress=None)``; ``PS`` and ``GZ`` are modified in place.
     """
     group = guided_lane_loop(ship_rhs, ctrl_update, guide, int(nx), int(lanes))
     G = int(lanes)
     NX = int(nx)
 
     def run_batch(X, Z, PS, PG, PC, GD, GZ, W, w_index, dt, nc, n_steps, rec_every,
-                  out_x, out_cmd, out_ref, ACC, rpm_slot):
+                  out_x, out_cmd, out_ref, ACC, rpm_slot, progress=None):
         if X.shape[1] != NX:
             raise ValueError("plant state size differs from the one this loop was built for")
         _run_groups(lambda i0, n_act: group(X, Z, PS, PG, PC, GD, GZ, W, w_index, i0, n_act, dt, nc,
                                             n_steps, rec_every, out_x, out_cmd, out_ref, ACC, rpm_slot),
-                    X.shape[0], G)
+                    X.shape[0], G, progress)
 
     return run_batch
 
@@ -344,7 +381,7 @@ def batch_loop(ship_rhs, ctrl_update, nx: int, lanes: int = LANES, guide=None):
     cores (:func:`_run_groups`). With a ``guide`` kernel: :func:`guided_batch_loop`.
 
     ``run_batch(X, Z, PS, PG, PC, GD, W, w_index, dt, nc, n_steps, rec_every, out_x, out_cmd,
-    out_ref, ACC)``. Per-run 2-D inputs have a leading run axis; ``W`` is a stack of
+    out_ref, ACC, progress=None)``; ``progress(done, n)``: see :func:`_run_groups`. Per-run 2-D inputs have a leading run axis; ``W`` is a stack of
     disturbance sequences shared by index ``w_index[i]`` (so 1000 runs in the same sea store
     it once).
     """
@@ -355,11 +392,11 @@ def batch_loop(ship_rhs, ctrl_update, nx: int, lanes: int = LANES, guide=None):
     NX = int(nx)
 
     def run_batch(X, Z, PS, PG, PC, GD, W, w_index, dt, nc, n_steps, rec_every,
-                  out_x, out_cmd, out_ref, ACC):
+                  out_x, out_cmd, out_ref, ACC, progress=None):
         if X.shape[1] != NX:
             raise ValueError("plant state size differs from the one this loop was built for")
         _run_groups(lambda i0, n_act: group(X, Z, PS, PG, PC, GD, W, w_index, i0, n_act, dt, nc,
                                             n_steps, rec_every, out_x, out_cmd, out_ref, ACC),
-                    X.shape[0], G)
+                    X.shape[0], G, progress)
 
     return run_batch

@@ -30,8 +30,9 @@ class LocalExecutor:
 
     name = "local"
 
-    def run(self, batch: PackedBatch, record_every: int | None = None) -> BatchOutput:
-        return batch.run(record_every)
+    def run(self, batch: PackedBatch, record_every: int | None = None, progress=None) -> BatchOutput:
+        """``progress(done, n)``: runs done so far (see :meth:`PackedBatch.run`)."""
+        return batch.run(record_every, progress)
 
     def close(self) -> None:
         pass
@@ -48,11 +49,20 @@ class DaskExecutor:
         self._cluster = cluster
         self.name = f"dask ({client.scheduler.address})"
 
-    def run(self, batch: PackedBatch, record_every: int | None = None) -> BatchOutput:
+    def run(self, batch: PackedBatch, record_every: int | None = None, progress=None) -> BatchOutput:
+        """``progress(done, n)``: runs done so far, after each chunk that comes back."""
+        from distributed import as_completed
+
         n = batch.n
         bounds = list(range(0, n, self.chunk_size)) + [n]
         chunks = [batch.take(np.arange(a, b)) for a, b in zip(bounds[:-1], bounds[1:])]
         futures = self.client.map(_run_chunk, chunks, [record_every] * len(chunks), pure=False)
+        if progress is not None:
+            size = {f.key: c.n for f, c in zip(futures, chunks)}
+            done = 0
+            for f in as_completed(futures):
+                done += size[f.key]
+                progress(done, n)
         return BatchOutput.concatenate(self.client.gather(futures))
 
     def close(self) -> None:

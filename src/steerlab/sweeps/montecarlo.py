@@ -25,6 +25,7 @@ import numpy as np
 from steerlab.angles import wrap_to_pi_array
 from steerlab.errors import InputError
 from steerlab.metrics import METRIC_UNITS, R2D, integral_metrics, step_metrics
+from steerlab.progress import runs_progress
 from steerlab.sweeps.conditions import condition_set
 from steerlab.sweeps.executors import LocalExecutor
 from steerlab.sweeps.packed import PackedBatch
@@ -101,7 +102,7 @@ def run_montecarlo(scenario, n_runs: int, lam: float = 0.1, record_every: int | 
         raise InputError("--record-every", f"must be >= 1, got {record_every}")
     say(f"{batch.n} runs of {batch.n_steps} steps ({batch.ship_name} + {batch.controller_name}), "
         f"log every {record_every} step(s); first call compiles the loop")
-    out = (executor or LocalExecutor()).run(batch, record_every)
+    out = (executor or LocalExecutor()).run(batch, record_every, runs_progress(say))
     seeds = np.array([c.scenario.seed for c in conditions])
     per_run: dict = {}
     nd = batch.X.shape[1] - 1

@@ -139,8 +139,9 @@ class PackedBatch:
         Z = self.Z if Z is None else np.ascontiguousarray(Z, dtype=np.float64)
         return replace(self, PC=PC, Z=Z)
 
-    def run(self, record_every: int | None = None) -> BatchOutput:
-        """Run every row with the compiled batch engine (over the local cores)."""
+    def run(self, record_every: int | None = None, progress=None) -> BatchOutput:
+        """Run every row with the compiled batch engine (over the local cores);
+        ``progress(done, n)`` as for :func:`steerlab.sim.batch.simulate_batch`."""
         from steerlab.control.registry import get_controller
         from steerlab.ships.registry import get_ship
         from steerlab.sim.lanes import LANES, batch_loop
@@ -161,7 +162,7 @@ class PackedBatch:
         Z = self.Z.copy()
         run_batch = batch_loop(ship.rhs, ctrl.update, nx, LANES, None)  # same cache key as simulate_batch
         run_batch(X, Z, self.PS, self.PG, self.PC, self.GD, self.W, self.w_index, self.dt, self.nc,
-                  N, rec, out_x, out_cmd, out_ref, acc)
+                  N, rec, out_x, out_cmd, out_ref, acc, progress=progress)
         if record_every is None:
             return BatchOutput(acc, X)
         return BatchOutput(acc, X, np.arange(n_rec) * rec * self.dt, out_x, out_cmd, out_ref)

@@ -26,10 +26,11 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from steerlab.errors import InputError
+from steerlab.progress import runs_progress
+from steerlab.sim.scenario import scenario_from_dict
 from steerlab.sweeps.conditions import deep_merge, make_condition
 from steerlab.sweeps.executors import LocalExecutor
 from steerlab.sweeps.packed import PackedBatch
-from steerlab.sim.scenario import scenario_from_dict
 from steerlab.tuning.cost import ONLINE, metric_arrays, parse_cost
 
 MAX_POINTS = 100_000
@@ -140,7 +141,7 @@ def run_robustness(scenario, variations: list[Variation], metric: str = "itae", 
     say(f"{len(points)} grid points ({' x '.join(str(len(v.values)) for v in variations)}), controller "
         f"{'redesigned at every point' if redesign else 'designed for the nominal scenario'}")
     batch = PackedBatch.from_setups(setups + [nominal.setup])
-    out = (executor or LocalExecutor()).run(batch)
+    out = (executor or LocalExecutor()).run(batch, None, runs_progress(say))
     names = set(ONLINE)
     m = metric_arrays(out.acc, lam, names)
     values = expr(metric_arrays(out.acc, lam, expr.names))

@@ -38,6 +38,7 @@ from pathlib import Path
 import numpy as np
 
 from steerlab.errors import InputError
+from steerlab.progress import bar
 
 METHODS = ("de", "ga", "nsga2")
 CHECKPOINT_VERSION = 1
@@ -124,11 +125,9 @@ class _Progress:
         self.names = names
 
     def __call__(self, gen: int, n_sims: int, best_f, best_x) -> None:
-        width = 20
-        done = min(width, int(round(width * gen / max(1, self.n_gen))))
         params = ", ".join(f"{n}={v:.4g}" for n, v in zip(self.names, best_x))
         best = ", ".join(f"{v:.6g}" for v in np.atleast_1d(best_f))
-        self.say(f"[{'#' * done}{'.' * (width - done)}] gen {gen}/{self.n_gen}  sims {n_sims}  "
+        self.say(f"{bar(gen, self.n_gen)} gen {gen}/{self.n_gen}  sims {n_sims}  "
                  f"best {best}  ({params})")
 
 
