@@ -110,11 +110,12 @@ def test_the_four_rk4_stages_are_vectorised_across_runs(ship):
     the kinematics as vector arithmetic (``<N x double>``) once per RK4 stage. A branch, a
     raising division or a library call added to the ship (Esso; Nomoto 1, which divides by
     T), gear or kinematics kernels would make this fail."""
+    from steerlab.guidance.reference_models import course_guide
     from steerlab.sim.lanes import lane_loop
 
     setup = _w1(duration=1.0, ship={"model": ship, "speed_kn": 16.0})
     simulate_batch(w1_batch_setups(setup, 2))
-    group = lane_loop(setup.ship.rhs, setup.controller.update, setup.x0.size, LANES)
+    group = lane_loop(setup.ship.rhs, setup.controller.update, course_guide, setup.x0.size, LANES)
     ir = "\n".join(group.inspect_llvm().values())
     s1 = "0x%016X" % struct.unpack("<Q", struct.pack("<d", sincos_module._S1))[0]
     vector_lines = [ln for ln in ir.splitlines() if s1 in ln and "x double>" in ln]

@@ -18,9 +18,10 @@ Guidance kernel interface (all kinds but ``course``)::
 ``t`` [s], ``x`` the plant state (rudder last), ``gd`` the packed record, ``gz`` the
 guidance's own state (advanced in place), ``ref`` the reference vector
 (:mod:`steerlab.guidance.reference_vector`), ``h`` the controller sample [s]. It is called
-at every controller sample, before the controller, by every engine. ``course`` stays the
-time-only ``course_reference(t, gd, ref)`` so that the compiled loops can keep evaluating
-it ahead in blocks (``guide = None`` in :class:`GuidancePlan`).
+at every controller sample, before the controller, by every engine. ``course`` has
+``guide = None`` in :class:`GuidancePlan` (it has no state, and sweeps vary its record
+freely); the engines run it as the kernel
+:func:`~steerlab.guidance.reference_models.course_guide`.
 """
 
 from __future__ import annotations

@@ -64,3 +64,11 @@ def course_reference(t, g, ref):
                 r = math.copysign(rate, step)
     ref[0] = wrap_to_pi(psi)
     ref[1] = r
+
+
+@numba.njit(cache=True)
+def course_guide(t, x, g, z, ref, h):
+    """:func:`course_reference` in the shape of a guidance kernel ``guide(t, x, gd, gz, ref, h)``
+    (state, guidance state and sample time unused): the engines' loops take one kind of
+    guidance kernel, and a time-only course schedule is this one."""
+    course_reference(t, g, ref)

@@ -97,15 +97,12 @@ def simulate_batch(setups: list[SimSetup], record_every: int | None = None, lane
     if not 1 <= int(lanes) <= 64:
         raise InputError("lanes", f"must be in [1, 64], got {lanes}")
     run_batch = batch_loop(s0.ship.rhs, s0.controller.update, nx, int(lanes), s0.guide)
-    if s0.guide is None:
-        out_ref = np.empty((n, n_rec, 2))
-        run_batch(X, Z, PS, PG, PC, GD, W, w_index, s0.dt, s0.nc, N, rec, out_x, out_cmd, out_ref, acc,
-                  progress=progress)
-    else:   # state-dependent guidance: its own state per run; PS is this batch's copy
-        out_ref = np.empty((n, n_rec, N_REF))
-        GZ = _stack([s.gz0 for s in setups], "gz0").copy()
-        run_batch(X, Z, PS, PG, PC, GD, GZ, W, w_index, s0.dt, s0.nc, N, rec, out_x, out_cmd, out_ref,
-                  acc, s0.rpm_slot, progress=progress)
+    # reference columns: [psi_ref, r_ref] for the time-only course, else the whole vector
+    out_ref = np.empty((n, n_rec, 2 if s0.guide is None else N_REF))
+    GZ = _stack([s.gz0 for s in setups], "gz0").copy()
+    # PS is this batch's own stack: the guidance may order the propeller rate into it (rpm_slot)
+    run_batch(X, Z, PS, PG, PC, GD, GZ, W, w_index, s0.dt, s0.nc, N, rec, out_x, out_cmd, out_ref,
+              acc, s0.rpm_slot, progress=progress)
     time = np.arange(n_rec) * rec * s0.dt
     return BatchResult(acc, X, time, out_x, out_cmd, out_ref, s0.state_names)
 

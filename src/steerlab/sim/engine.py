@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from steerlab.angles import wrap_to_pi_array
-from steerlab.guidance.reference_models import course_reference
+from steerlab.guidance.reference_models import course_guide
 from steerlab.guidance.reference_vector import N_REF, REF_NAMES, REF_RPM, initial_reference
 from steerlab.metrics_online import accumulate, new_accumulator
 from steerlab.sim.kernels import closed_loop, plant_step
@@ -24,6 +24,11 @@ def _as_setup(scenario_or_setup) -> SimSetup:
     if isinstance(scenario_or_setup, SimSetup):
         return scenario_or_setup
     return build(scenario_or_setup)
+
+
+def _ref_columns(s: SimSetup) -> int:
+    """Reference entries logged: ``[psi_ref, r_ref]`` for a time-only course, else all N_REF."""
+    return 2 if s.guide is None else N_REF
 
 
 def _result(s: SimSetup, X, cmd, ref, engine: str) -> Result:
@@ -52,9 +57,9 @@ def simulate_readable(scenario_or_setup) -> Result:
     X = np.empty((N + 1, nx))
     cmd_log = np.empty(N + 1)
     work = np.empty((5, nx))
-    guide = s.guide
+    guide = course_guide if s.guide is None else s.guide   # time-only schedule, or LOS, models ...
     ref = initial_reference()
-    ref_log = np.empty((N + 1, N_REF if guide is not None else 2))
+    ref_log = np.empty((N + 1, _ref_columns(s)))
     gz = s.gz0.copy()
     ps = s.ps.copy()                              # the guidance may order the propeller rate
     slot = s.rpm_slot
@@ -63,12 +68,9 @@ def simulate_readable(scenario_or_setup) -> Result:
     for k in range(N + 1):
         t = k * s.dt
         if k % s.nc == 0:                         # controller sample: guidance, then control law
-            if guide is None:
-                course_reference(t, s.gd, ref)    # time-only course schedule
-            else:
-                guide(t, x, s.gd, gz, ref, h)     # state-dependent guidance (LOS, models ...)
-                if slot >= 0 and ref[REF_RPM] >= 0.0:
-                    ps[slot] = ref[REF_RPM]
+            guide(t, x, s.gd, gz, ref, h)
+            if slot >= 0 and ref[REF_RPM] >= 0.0:
+                ps[slot] = ref[REF_RPM]
             cmd = update(z, s.pc, t, x, ref, h)
         X[k] = x
         cmd_log[k] = cmd
@@ -89,13 +91,9 @@ def simulate_compiled(scenario_or_setup) -> Result:
     X = np.empty((N + 1, x.shape[0]))
     cmd = np.empty(N + 1)
     acc = new_accumulator()
-    if s.guide is None:
-        ref = np.empty((N + 1, 2))
-        run(x, z, s.ps, s.pg, s.pc, s.gd, s.w, s.dt, s.nc, N, 1, X, cmd, ref, acc)
-    else:
-        ref = np.empty((N + 1, N_REF))
-        run(x, z, s.ps.copy(), s.pg, s.pc, s.gd, s.gz0.copy(), s.w, s.dt, s.nc, N, 1, X, cmd, ref,
-            acc, s.rpm_slot)
+    ref = np.empty((N + 1, _ref_columns(s)))
+    run(x, z, s.ps.copy(), s.pg, s.pc, s.gd, s.gz0.copy(), s.w, s.dt, s.nc, N, 1, X, cmd, ref,
+        acc, s.rpm_slot)
     res = _result(s, X, cmd, ref, "compiled")
     res.meta["online_metrics"] = acc
     return res

@@ -2,9 +2,15 @@
 
 One definition, two speeds: :func:`plant_step` builds the RK4 step of ship + steering gear;
 :func:`closed_loop` builds the compiled loop used by the single fast run; the batch engine
-(:mod:`steerlab.sim.lanes`) calls the same fused ship + gear kernel, vectorised across runs. The readable engine (:mod:`steerlab.sim.engine`) calls the very same ``plant_step``
-and controller/guidance kernels from Python. Factories are memoised per combination, so
-each combination compiles once per process (numba cannot disk-cache closures).
+(:mod:`steerlab.sim.lanes`) calls the same fused ship + gear kernel, vectorised across runs.
+The readable engine (:mod:`steerlab.sim.engine`) calls the very same ``plant_step`` and
+controller/guidance kernels from Python. Factories are memoised per combination, so each
+combination compiles once per process (numba cannot disk-cache closures).
+
+Every loop takes one kind of guidance kernel, ``guide(t, x, gd, gz, ref, h)`` with a
+guidance state ``gz`` and the 6-entry reference vector (:mod:`steerlab.guidance.plan`),
+called at each controller sample: LOS, berthing, course-change models with a state, and
+the time-only course schedule (:func:`~steerlab.guidance.reference_models.course_guide`).
 
 How the fused loop is made fast (and why the numbers do not change)
 --------------------------------------------------------------------
@@ -17,17 +23,7 @@ How the fused loop is made fast (and why the numbers do not change)
   in the same order, so the fused loop and the readable loop give bit-identical results.
 * Factories may be specialised on the plant state size ``nx`` so that the short per-state
   loops of the RK4 step unroll instead of being vectorised with run-time alias checks.
-* The guidance (:func:`~steerlab.guidance.reference_models.course_reference`) is a pure
-  function of time, so the loop evaluates it for a block of upcoming controller samples at
-  a time (same ``t = k * dt``, same numbers) rather than interleaved with the RK4 step.
 * Sample and record decisions use counters instead of integer ``%`` per step.
-
-State-dependent guidance (LOS, berthing, course-change models with a state: see
-:mod:`steerlab.guidance.plan`) cannot be evaluated ahead: :func:`guided_closed_loop` (and
-the batch engine's guided loops, :mod:`steerlab.sim.lanes`) call the fused guidance kernel
-``guide(t, x, gd, gz, ref, h)`` at each controller sample instead, with the guidance state
-``gz`` and the 6-entry reference vector. ``closed_loop``/``batch_loop`` with ``guide=None``
-are the time-only loops above, unchanged.
 """
 
 from __future__ import annotations
@@ -40,14 +36,10 @@ import numpy as np
 from numba.core.registry import CPUDispatcher
 
 from steerlab.angles import wrap_to_pi
-from steerlab.guidance.reference_models import course_reference
+from steerlab.guidance.reference_models import course_guide
 from steerlab.guidance.reference_vector import N_REF, REF_LEG, REF_RPM, REF_XTE
 from steerlab.metrics_online import accumulate
 from steerlab.steering_gear import gear_clamp, gear_rate
-
-REF_BLOCK = 64
-"""Guidance samples evaluated ahead at a time by the compiled loop."""
-
 
 @lru_cache(maxsize=None)
 def _fuse_options() -> dict:
@@ -153,112 +145,34 @@ def plant_step(ship_rhs):
 
 @lru_cache(maxsize=None)
 def closed_loop(ship_rhs, ctrl_update, nx: int | None = None, guide=None):
-    """Compiled closed loop for one (ship, controller[, guidance]) combination.
+    """Compiled closed loop for one (ship, controller, guidance) combination.
 
-    ``guide = None``: the time-only course schedule (below). Otherwise ``guide`` is a
-    state-dependent guidance kernel ``guide(t, x, gd, gz, ref, h)`` (see
-    :mod:`steerlab.guidance.plan`) and the loop is :func:`guided_closed_loop`'s.
-
-    ``run(x, z, ps, pg, pc, gd, w, dt, nc, n_steps, rec_every, out_x, out_cmd, out_ref, acc)``
-    advances ``x`` (plant state) and ``z`` (controller state) in place over ``n_steps`` steps
-    of ``dt``; the controller and the guidance are sampled every ``nc`` steps and the order is
-    held in between. Rows ``0, rec_every, 2*rec_every, ...`` (and the final row, if it falls on
-    that grid) are written to the ``out_*`` arrays (pass ``rec_every > n_steps`` and 1-row
-    arrays to record only the start); the integral metrics accumulate into ``acc``.
-
-    ``nx`` (the plant state size, ship states + rudder), when given, specialises the loop on
-    it (faster); ``run`` then raises ``ValueError`` for a state of another size.
+    ``guide`` is a guidance kernel ``guide(t, x, gd, gz, ref, h)`` (see
+    :mod:`steerlab.guidance.plan`); ``None`` means the time-only course schedule
+    (:func:`~steerlab.guidance.reference_models.course_guide`). The loop is
+    :func:`guided_closed_loop`'s.
     """
-    if guide is not None:
-        return guided_closed_loop(ship_rhs, ctrl_update, guide, nx)
-    NX = 0 if nx is None else int(nx)
-    rk4 = _plant_kernels(ship_rhs, NX)[0]
-    update = _fused(ctrl_update)
-    reference = _fused(course_reference)
-    acc_step = _fused(accumulate)
-    wrap = _fused(wrap_to_pi)
-    RB = REF_BLOCK
-
-    @_jit_fused
-    def loop(x, z, ps, pg, pc, gd, w, dt, nc, n_steps, rec_every, out_x, out_cmd, out_ref, acc,
-             k1, k2, k3, k4, xt, ref, rbuf):
-        nx = x.shape[0] if NX == 0 else NX
-        cmd = 0.0
-        h = nc * dt
-        j = 0   # next output row
-        kc = 0  # steps since the last controller sample (sample when 0)
-        kr = 0  # steps since the last recorded row (record when 0)
-        nb = 0  # guidance samples held in rbuf
-        ib = 0  # next one to use
-        for k in range(n_steps + 1):
-            t = k * dt
-            sample = kc == 0
-            if sample:
-                if ib == nb:
-                    # the guidance is a pure function of time: evaluate the next block of
-                    # sample instants ahead (t computed exactly as below: kk * dt)
-                    nb = 0
-                    kk = k
-                    while nb < RB and kk <= n_steps:
-                        reference(kk * dt, gd, rbuf[nb])
-                        nb += 1
-                        kk += nc
-                    ib = 0
-                ref[0] = rbuf[ib, 0]
-                ref[1] = rbuf[ib, 1]
-                ib += 1
-            # heading error for the metrics, taken before the controller (which writes only
-            # its own state), so that the compiler can share it with the controller's own
-            e = wrap(ref[0] - x[2])
-            if sample:
-                cmd = update(z, pc, t, x, ref, h)
-            kc += 1
-            if kc == nc:
-                kc = 0
-            if kr == 0:
-                for i in range(nx):
-                    out_x[j, i] = x[i]
-                out_cmd[j] = cmd
-                out_ref[j, 0] = ref[0]
-                out_ref[j, 1] = ref[1]
-                j += 1
-            kr += 1
-            if kr == rec_every:
-                kr = 0
-            if k == n_steps:
-                break
-            delta = x[nx - 1]
-            rk4(t, x, cmd, w[k], ps, pg, dt, k1, k2, k3, k4, xt)
-            acc_step(acc, t, e, delta, x[nx - 1], dt)
-
-    @numba.njit
-    def run(x, z, ps, pg, pc, gd, w, dt, nc, n_steps, rec_every, out_x, out_cmd, out_ref, acc):
-        nx = x.shape[0]
-        if NX != 0 and nx != NX:
-            raise ValueError("plant state size differs from the one this loop was built for")
-        k1 = np.empty(nx)
-        k2 = np.empty(nx)
-        k3 = np.empty(nx)
-        k4 = np.empty(nx)
-        xt = np.empty(nx)
-        ref = np.zeros(2)
-        rbuf = np.empty((RB, 2))
-        loop(x, z, ps, pg, pc, gd, w, dt, nc, n_steps, rec_every, out_x, out_cmd, out_ref, acc,
-             k1, k2, k3, k4, xt, ref, rbuf)
-
-    return run
+    return guided_closed_loop(ship_rhs, ctrl_update, course_guide if guide is None else guide, nx)
 
 
 @lru_cache(maxsize=None)
 def guided_closed_loop(ship_rhs, ctrl_update, guide, nx: int | None = None):
-    """Compiled closed loop with a state-dependent guidance kernel, evaluated at every sample.
+    """Compiled closed loop with a guidance kernel ``guide(t, x, gd, gz, ref, h)``.
 
     ``run(x, z, ps, pg, pc, gd, gz, w, dt, nc, n_steps, rec_every, out_x, out_cmd, out_ref,
-    acc, rpm_slot)``: as :func:`closed_loop`'s ``run``, plus the guidance state ``gz``
-    (advanced in place) and ``rpm_slot``: when >= 0, a propeller-rate order of the guidance
-    (``ref[REF_RPM] >= 0``) is written to ``ps[rpm_slot]`` at the sample, so ``ps`` must be
-    the run's own copy. ``out_ref`` has up to ``N_REF`` columns
-    (:mod:`steerlab.guidance.reference_vector`); as many as it has are recorded.
+    acc, rpm_slot)`` advances ``x`` (plant state) and ``z`` (controller state) in place over
+    ``n_steps`` steps of ``dt``; the guidance and the controller are sampled every ``nc``
+    steps and the order is held in between. The guidance state ``gz`` is advanced in place;
+    ``rpm_slot``: when >= 0, a propeller-rate order of the guidance (``ref[REF_RPM] >= 0``)
+    is written to ``ps[rpm_slot]`` at the sample, so ``ps`` must be the run's own copy. Rows
+    ``0, rec_every, 2*rec_every, ...`` (and the final row, if it falls on that grid) are
+    written to the ``out_*`` arrays (pass ``rec_every > n_steps`` and 1-row arrays to record
+    only the start); ``out_ref`` has up to ``N_REF`` columns
+    (:mod:`steerlab.guidance.reference_vector`), as many as it has are recorded. The integral
+    metrics accumulate into ``acc``.
+
+    ``nx`` (the plant state size, ship states + rudder), when given, specialises the loop on
+    it (faster); ``run`` then raises ``ValueError`` for a state of another size.
     """
     NX = 0 if nx is None else int(nx)
     rk4 = _plant_kernels(ship_rhs, NX)[0]

@@ -31,10 +31,10 @@ import numba
 import numpy as np
 
 from steerlab.angles import wrap_to_pi
-from steerlab.guidance.reference_models import course_reference
+from steerlab.guidance.reference_models import course_guide
 from steerlab.guidance.reference_vector import N_REF, REF_LEG, REF_RPM, REF_XTE
 from steerlab.metrics_online import accumulate
-from steerlab.sim.kernels import REF_BLOCK, _fused, _jit_fused, _plant_kernels
+from steerlab.sim.kernels import _fused, _jit_fused, _plant_kernels
 
 LANES = 16
 """Runs advanced together by one thread of the batch engine (two AVX-512 vectors of float64;
@@ -143,92 +143,19 @@ def _scratch(nx: int, lanes: int):
 
 
 @lru_cache(maxsize=None)
-def lane_loop(ship_rhs, ctrl_update, nx: int, lanes: int = LANES):
+def lane_loop(ship_rhs, ctrl_update, guide, nx: int, lanes: int = LANES):
     """Compiled loop advancing a group of up to ``lanes`` independent runs in lock step.
 
     Same kernels and the same operations, in the same order, per run as
-    :func:`~steerlab.sim.kernels.closed_loop` (so each run's numbers are bit-identical to
-    its single run); only the schedule and the memory layout differ (module docstring).
+    :func:`~steerlab.sim.kernels.guided_closed_loop` (so each run's numbers are bit-identical
+    to its single run); only the schedule and the memory layout differ (module docstring).
 
-    ``group(X, Z, PS, PG, PC, GD, W, w_index, i0, n_act, dt, nc, n_steps, rec_every, out_x,
-    out_cmd, out_ref, ACC)`` advances runs ``i0 .. i0 + n_act - 1`` of the batch arrays in place.
-    It is compiled as a function of its own, called once per group: its scratch arrays are
-    allocated inside it, with shapes the compiler sees (which the vectoriser needs).
-    """
-    NX = int(nx)
-    G = int(lanes)
-    load, store, rk4_lanes, record_lanes = _group_kernels(ship_rhs, NX)
-    scratch = _scratch(NX, G)
-    update = _fused(ctrl_update)
-    reference = _fused(course_reference)
-    wrap = _fused(wrap_to_pi)
-    RB = REF_BLOCK
-
-    @numba.njit(nogil=True)
-    def group(X, Z, PS, PG, PC, GD, W, w_index, i0, n_act, dt, nc, n_steps, rec_every,
-              out_x, out_cmd, out_ref, ACC):
-        XL, PL, PGL, WL, K1, K2, K3, K4, XT, CMD, E, DPREV = scratch(PS.shape[1], PG.shape[1], W.shape[2])
-        REF = np.zeros((G, 2))
-        RBUF = np.empty((G, RB, 2))
-        load(X, PS, PG, i0, n_act, XL, PL, PGL)
-        h = nc * dt
-        h2 = 0.5 * dt
-        s6 = dt / 6.0
-        j = 0
-        kc = 0
-        kr = 0
-        nb = 0
-        ib = 0
-        for g in range(n_act):
-            CMD[g] = 0.0
-        for k in range(n_steps + 1):
-            t = k * dt
-            sample = kc == 0
-            if sample and ib == nb:
-                for g in range(n_act):
-                    kk = k
-                    m = 0
-                    while m < RB and kk <= n_steps:
-                        reference(kk * dt, GD[i0 + g], RBUF[g, m])
-                        m += 1
-                        kk += nc
-                    nb = m
-                ib = 0
-            for g in range(n_act):
-                i = i0 + g
-                if sample:
-                    REF[g, 0] = RBUF[g, ib, 0]
-                    REF[g, 1] = RBUF[g, ib, 1]
-                E[g] = wrap(REF[g, 0] - XL[2, g])
-                if sample:
-                    CMD[g] = update(Z[i], PC[i], t, XL[:, g], REF[g], h)
-            if sample:
-                ib += 1
-            kc += 1
-            if kc == nc:
-                kc = 0
-            if kr == 0:
-                record_lanes(XL, CMD, REF, i0, n_act, j, 2, out_x, out_cmd, out_ref)
-                j += 1
-            kr += 1
-            if kr == rec_every:
-                kr = 0
-            if k == n_steps:
-                break
-            rk4_lanes(t, k, i0, n_act, CMD, W, w_index, dt, h2, s6, ACC, E, DPREV,
-                      XL, PL, PGL, WL, K1, K2, K3, K4, XT)
-        store(X, i0, n_act, XL)
-
-    return group
-
-
-@lru_cache(maxsize=None)
-def guided_lane_loop(ship_rhs, ctrl_update, guide, nx: int, lanes: int = LANES):
-    """:func:`lane_loop` with a state-dependent guidance kernel
-    (see :func:`~steerlab.sim.kernels.guided_closed_loop`).
-
-    ``PS`` rows are overwritten at ``rpm_slot`` (when >= 0) by the guidance's propeller order,
-    as is the group's copy the ship kernel reads.
+    ``group(X, Z, PS, PG, PC, GD, GZ, W, w_index, i0, n_act, dt, nc, n_steps, rec_every,
+    out_x, out_cmd, out_ref, ACC, rpm_slot)`` advances runs ``i0 .. i0 + n_act - 1`` of the
+    batch arrays in place. ``PS`` rows are overwritten at ``rpm_slot`` (when >= 0) by the
+    guidance's propeller order, as is the group's copy the ship kernel reads. It is compiled
+    as a function of its own, called once per group: its scratch arrays are allocated inside
+    it, with shapes the compiler sees (which the vectoriser needs).
     """
     NX = int(nx)
     G = int(lanes)
@@ -354,13 +281,18 @@ def _pool(threads: int, pid: int) -> ThreadPoolExecutor:
 
 
 @lru_cache(maxsize=None)
-def guided_batch_loop(ship_rhs, ctrl_update, guide, nx: int, lanes: int = LANES):
-    """:func:`batch_loop` with a state-dependent guidance kernel.
+def batch_loop(ship_rhs, ctrl_update, nx: int, lanes: int = LANES, guide=None):
+    """Batch over scenarios: groups of ``lanes`` runs (:func:`lane_loop`) spread over the
+    cores (:func:`_run_groups`). ``guide``: a guidance kernel; ``None`` is the time-only
+    course schedule (:func:`~steerlab.guidance.reference_models.course_guide`).
 
     ``run_batch(X, Z, PS, PG, PC, GD, GZ, W, w_index, dt, nc, n_steps, rec_every, out_x,
-    out_cmd, out_ref, ACC, rpm_slot, progress=None)``; ``PS`` and ``GZ`` are modified in place.
+    out_cmd, out_ref, ACC, rpm_slot, progress=None)``: per-run 2-D inputs have a leading run
+    axis; ``W`` is a stack of disturbance sequences shared by index ``w_index[i]`` (so 1000
+    runs in the same sea store it once); ``PS`` (at ``rpm_slot``, when >= 0) and ``GZ`` are
+    modified in place; ``progress(done, n)``: see :func:`_run_groups`.
     """
-    group = guided_lane_loop(ship_rhs, ctrl_update, guide, int(nx), int(lanes))
+    group = lane_loop(ship_rhs, ctrl_update, course_guide if guide is None else guide, int(nx), int(lanes))
     G = int(lanes)
     NX = int(nx)
 
@@ -370,33 +302,6 @@ def guided_batch_loop(ship_rhs, ctrl_update, guide, nx: int, lanes: int = LANES)
             raise ValueError("plant state size differs from the one this loop was built for")
         _run_groups(lambda i0, n_act: group(X, Z, PS, PG, PC, GD, GZ, W, w_index, i0, n_act, dt, nc,
                                             n_steps, rec_every, out_x, out_cmd, out_ref, ACC, rpm_slot),
-                    X.shape[0], G, progress)
-
-    return run_batch
-
-
-@lru_cache(maxsize=None)
-def batch_loop(ship_rhs, ctrl_update, nx: int, lanes: int = LANES, guide=None):
-    """Batch over scenarios: groups of ``lanes`` runs (:func:`lane_loop`) spread over the
-    cores (:func:`_run_groups`). With a ``guide`` kernel: :func:`guided_batch_loop`.
-
-    ``run_batch(X, Z, PS, PG, PC, GD, W, w_index, dt, nc, n_steps, rec_every, out_x, out_cmd,
-    out_ref, ACC, progress=None)``; ``progress(done, n)``: see :func:`_run_groups`. Per-run 2-D inputs have a leading run axis; ``W`` is a stack of
-    disturbance sequences shared by index ``w_index[i]`` (so 1000 runs in the same sea store
-    it once).
-    """
-    if guide is not None:
-        return guided_batch_loop(ship_rhs, ctrl_update, guide, int(nx), int(lanes))
-    group = lane_loop(ship_rhs, ctrl_update, int(nx), int(lanes))
-    G = int(lanes)
-    NX = int(nx)
-
-    def run_batch(X, Z, PS, PG, PC, GD, W, w_index, dt, nc, n_steps, rec_every,
-                  out_x, out_cmd, out_ref, ACC, progress=None):
-        if X.shape[1] != NX:
-            raise ValueError("plant state size differs from the one this loop was built for")
-        _run_groups(lambda i0, n_act: group(X, Z, PS, PG, PC, GD, W, w_index, i0, n_act, dt, nc,
-                                            n_steps, rec_every, out_x, out_cmd, out_ref, ACC),
                     X.shape[0], G, progress)
 
     return run_batch

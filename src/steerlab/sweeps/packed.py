@@ -161,8 +161,9 @@ class PackedBatch:
         X = self.X.copy()
         Z = self.Z.copy()
         run_batch = batch_loop(ship.rhs, ctrl.update, nx, LANES, None)  # same cache key as simulate_batch
-        run_batch(X, Z, self.PS, self.PG, self.PC, self.GD, self.W, self.w_index, self.dt, self.nc,
-                  N, rec, out_x, out_cmd, out_ref, acc, progress=progress)
+        GZ = np.zeros((n, 0))         # time-only course schedules: no guidance state
+        run_batch(X, Z, self.PS, self.PG, self.PC, self.GD, GZ, self.W, self.w_index, self.dt, self.nc,
+                  N, rec, out_x, out_cmd, out_ref, acc, -1, progress=progress)
         if record_every is None:
             return BatchOutput(acc, X)
         return BatchOutput(acc, X, np.arange(n_rec) * rec * self.dt, out_x, out_cmd, out_ref)
