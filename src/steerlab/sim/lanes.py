@@ -7,17 +7,22 @@ arrays**: one row per state, one column per run (``XL[q, g]`` is state ``q`` of 
 in scratch arrays of a shape fixed at compile time. Each RK4 stage is then one loop over
 the runs of the group that calls the very same ship + gear kernel
 (:func:`steerlab.sim.kernels._plant_kernels`) on column views ``XL[:, g]``; after inlining,
-the compiler vectorises that loop (8 runs per AVX-512 instruction, 4 with AVX2), because the kernels
-are straight-line arithmetic and selects: the kinematics take ``sin``/``cos`` from
-:func:`steerlab.sincos.sincos` instead of the C library, and the steering gear selects its
-dead zone rather than branching.
+the compiler vectorises that loop (8 runs per AVX-512 instruction, 4 with AVX2), because
+the kernels are straight-line arithmetic and selects: the kinematics take ``sin``/``cos``
+from :func:`steerlab.sincos.sincos` instead of the C library, the steering gear selects its
+dead zone rather than branching, and divisions do not branch to ``ZeroDivisionError``
+(numba's numpy error model, :func:`steerlab.sim.kernels._fuse_options`). A ship kernel with
+branches, loops or library calls (MMG, de Keizer's rpm schedule) still runs, one run at a
+time. ``tests/test_batch_lanes.py`` checks in the compiled code that the Esso and Nomoto 1
+stages stay vectorised.
 
 The numbers do not change: per run, every operation and its order are those of the single
 run's ``rk4`` (IEEE arithmetic has no lanes; no fused multiply-add, no ``fastmath``), so run
 ``i`` of a batch is bit-identical to the same run alone. The controller, the guidance and
 the metrics accumulator (branches, calls) run one run at a time, on the same column views.
 
-``batch_loop`` spreads the groups over the cores (a pool of threads; the kernels release the GIL).
+``batch_loop`` spreads the groups over the cores (a pool of threads; the kernels release
+the GIL).
 """
 
 from __future__ import annotations
