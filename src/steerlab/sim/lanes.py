@@ -310,3 +310,35 @@ def batch_loop(ship_rhs, ctrl_update, nx: int, lanes: int = LANES, guide=None):
                     X.shape[0], G, progress)
 
     return run_batch
+
+
+# library functions a vectorised loop may still call per lane element: cheap, exact intrinsics
+_CHEAP_VECTOR_INTRINSICS = frozenset({
+    "fabs", "floor", "ceil", "trunc", "rint", "round", "sqrt", "copysign", "minnum", "maxnum",
+    "minimum", "maximum", "smax", "smin", "umax", "umin", "masked"})
+
+
+def vectorisation_report(ship_rhs, ctrl_update, nx: int, guide=None, lanes: int = LANES) -> dict:
+    """How the compiled group of a (ship, controller, guidance) combination was vectorised.
+
+    Reads the LLVM IR of :func:`lane_loop`'s group (compiled by a batch run first; raises
+    ``RuntimeError`` if it was not) and returns ``{"vectorised_stages": n,
+    "per_run_library_calls": [...]}``: ``n`` counts the ship-kernel calls whose sine
+    polynomial (:mod:`steerlab.sincos`, used by every ship's kinematics) became vector
+    arithmetic, 4 when all RK4 stages are vectorised; the list names library functions the
+    vectoriser could only call once per run (``sin``, ``exp`` ...: such a kernel is vectorised
+    in name only). A kernel with branches, loops or library calls gives 0 stages.
+    """
+    import re
+    import struct
+
+    from steerlab import sincos as sincos_module
+
+    group = lane_loop(ship_rhs, ctrl_update, course_guide if guide is None else guide, int(nx), int(lanes))
+    if not group.signatures:
+        raise RuntimeError("the group has not been compiled yet: run a batch of this combination first")
+    ir = "\n".join(group.inspect_llvm().values())
+    s1 = "0x%016X" % struct.unpack("<Q", struct.pack("<d", sincos_module._S1))[0]
+    stages = sum(1 for line in ir.splitlines() if s1 in line and "x double>" in line)
+    calls = set(re.findall(r"@llvm\.(\w+)\.[\w.]*v\d+f64", ir)) - _CHEAP_VECTOR_INTRINSICS
+    return {"vectorised_stages": stages, "per_run_library_calls": sorted(calls)}
