@@ -162,3 +162,22 @@ def test_progress_bar_text():
     said = []
     runs_progress(said.append)(250, 1000)
     assert said == ["[#####...............] 250/1000 runs"]
+
+
+def test_bench_ships_script_reports_a_vectorised_esso(capsys):
+    """benchmarks/bench_ships.py, run as its own main on a tiny workload."""
+    import importlib.util
+    import json
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parents[1] / "benchmarks" / "bench_ships.py"
+    spec = importlib.util.spec_from_file_location("bench_ships", path)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    assert mod.main(["--ships", "esso", "--runs", "4", "--duration", "5", "--repeats", "1", "--json"]) == 0
+    (row,) = json.loads(capsys.readouterr().out)
+    assert row["ship"] == "esso" and row["kernel"] == "esso_rhs"
+    assert row["batch_ship_steps_per_s"] > 0 and row["single_steps_per_s"] > 0
+    assert row["vectorised_stages"] >= 4 and row["per_run_library_calls"] == []
+    assert mod.main(["--ships", "no-such-ship"]) == 2
+    assert "unknown ship" in capsys.readouterr().err
