@@ -96,6 +96,14 @@ def test_sensors_compiled_readable_parity_and_effect():
     late = b.time > 100.0                                                 # after the course change
     assert np.std(np.diff(b.delta_cmd[late])) > 10 * np.std(np.diff(clean.delta_cmd[late]))
     np.testing.assert_array_equal(simulate(_sc(SENSORS), "readable").delta_cmd, b.delta_cmd)
+    # the batch engine: each run (its own sensor noise stream, by seed) as alone
+    from steerlab.sim.batch import simulate_batch
+
+    other = build(_sc(SENSORS, seed=4))
+    batch = simulate_batch([build(s), other], record_every=10)
+    np.testing.assert_array_equal(batch.delta_cmd[0], a.delta_cmd[::10])
+    np.testing.assert_array_equal(batch.final_states[1], simulate(other, "compiled").states[-1])
+    assert not np.array_equal(batch.delta_cmd[1], batch.delta_cmd[0])
 
 
 def test_sensors_off_by_default_is_unchanged():
