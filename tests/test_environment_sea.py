@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from scipy.signal import welch
 
-from steerlab.environment.channels import (W_CURRENT_DIR, W_CURRENT_SPEED, W_RUDDER, W_WIND_DIR, W_WIND_SPEED,
+from steerlab.environment.channels import (W_CURRENT_E, W_CURRENT_N, W_RUDDER, W_WIND_DIR, W_WIND_SPEED,
                                            W_YAW_MOMENT, W_YAW_RATE)
 from steerlab.environment.encounter import encounter_frequency
 from steerlab.environment.gauss_markov import gauss_markov
@@ -212,7 +212,7 @@ SEA = {"wind_speed": 10.0, "current_speed": 0.5, "current_dir_deg": 90.0,
 def test_same_seed_same_sea_different_seed_different_sea():
     a, b, c = (build(_sc(SEA, seed=s)).w for s in (4, 4, 5))
     assert np.array_equal(a, b)
-    for ch in (W_RUDDER, W_WIND_SPEED, W_WIND_DIR, W_CURRENT_SPEED, W_CURRENT_DIR):
+    for ch in (W_RUDDER, W_WIND_SPEED, W_WIND_DIR, W_CURRENT_N, W_CURRENT_E):
         assert not np.array_equal(a[:, ch], c[:, ch])
 
 

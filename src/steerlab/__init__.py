@@ -10,5 +10,7 @@ Conventions (everywhere inside the library)
 
 __version__ = "0.1.0"
 
+# before any kernel is defined: cached kernels are keyed on the whole package, not one file
+from steerlab import numba_cache  # noqa: F401,E402  (isort: skip)
 from steerlab.angles import wrap_to_pi  # noqa: F401
 from steerlab.errors import InputError  # noqa: F401

@@ -11,13 +11,13 @@ ignores the others (a channel a model cannot represent is documented in its docs
     both their constant (wind/current) and their coloured-noise (waves) disturbances this way.
 ``W_WIND_SPEED``, ``W_WIND_DIR``
     True wind speed [m/s] and the direction it comes FROM [rad], clockwise from north.
-``W_CURRENT_SPEED``, ``W_CURRENT_DIR``
-    Current speed [m/s] and the direction it flows TOWARDS [rad], clockwise from north
-    (it moves the track, not the heading: thesis 2.4.2).
 ``W_CURRENT_N``, ``W_CURRENT_E``
-    The same current as north and east velocity components [m/s]
-    (``V_c cos beta_c``, ``V_c sin beta_c``), which the kinematics add without trigonometry.
-    :func:`set_current` writes all four current channels; write them only through it.
+    The current's velocity [m/s], north and east components: ``V_c cos beta_c``,
+    ``V_c sin beta_c`` for a current of speed ``V_c`` flowing TOWARDS ``beta_c`` (clockwise
+    from north). It moves the track, not the heading (thesis 2.4.2). Components rather than
+    speed and direction, so that the kinematics add it without trigonometry (which keeps the
+    batch engine's kernels vectorisable); :func:`set_current` writes them from a speed and a
+    direction.
 ``W_YAW_RATE``
     Additive yaw-rate disturbance [rad/s] (the thesis' wave model adds filtered noise to r).
 ``W_YAW_MOMENT``
@@ -28,16 +28,14 @@ ignores the others (a channel a model cannot represent is documented in its docs
 W_RUDDER = 0
 W_WIND_SPEED = 1
 W_WIND_DIR = 2
-W_CURRENT_SPEED = 3
-W_CURRENT_DIR = 4
+W_CURRENT_N = 3
+W_CURRENT_E = 4
 W_YAW_RATE = 5
 W_YAW_MOMENT = 6
-W_CURRENT_N = 7
-W_CURRENT_E = 8
-N_CHANNELS = 9
-CHANNEL_NAMES = ("d_rudder", "wind_speed", "wind_dir", "current_speed", "current_dir",
-                 "d_yaw_rate", "d_yaw_accel", "current_north", "current_east")
-CHANNEL_UNITS = ("rad", "m/s", "rad", "m/s", "rad", "rad/s", "rad/s^2", "m/s", "m/s")
+N_CHANNELS = 7
+CHANNEL_NAMES = ("d_rudder", "wind_speed", "wind_dir", "current_north", "current_east",
+                 "d_yaw_rate", "d_yaw_accel")
+CHANNEL_UNITS = ("rad", "m/s", "rad", "m/s", "m/s", "rad/s", "rad/s^2")
 
 
 def set_current(w, speed, direction):
@@ -56,7 +54,5 @@ def set_current(w, speed, direction):
 
     speed = np.asarray(speed, dtype=float)
     direction = np.asarray(direction, dtype=float)
-    w[..., W_CURRENT_SPEED] = speed
-    w[..., W_CURRENT_DIR] = direction
     w[..., W_CURRENT_N] = speed * np.cos(direction)
     w[..., W_CURRENT_E] = speed * np.sin(direction)

@@ -1,8 +1,9 @@
 r"""Slowly varying current: a mean-reverting random walk or a sinusoid (tide) about the mean.
 
 Current moves the track, not the heading (van Amerongen 1982, Section 2.4.2): it enters the
-ships' kinematics (``x_n' = ... + V_c cos beta_c``) through channels ``W_CURRENT_SPEED`` and
-``W_CURRENT_DIR`` (direction it flows TOWARDS, clockwise from north).
+ships' kinematics (``x_n' = ... + V_c cos beta_c``) through channels ``W_CURRENT_N`` and
+``W_CURRENT_E`` (its north and east velocity; ``beta_c`` is the direction it flows TOWARDS,
+clockwise from north), written by :func:`steerlab.environment.channels.set_current`.
 
 * ``random_walk``: speed ``V + u(t)`` and direction ``beta + b(t)`` with ``u``, ``b``
   first-order Gauss-Markov processes (:mod:`steerlab.environment.gauss_markov`) of std

@@ -34,9 +34,9 @@ class Disturbance:
     wind_dir : float
         Direction the wind comes FROM [rad], clockwise from north (``W_WIND_DIR``).
     current_speed : float
-        Constant current speed [m/s] (``W_CURRENT_SPEED``).
+        Constant current speed [m/s] (channels ``W_CURRENT_N``, ``W_CURRENT_E``).
     current_dir : float
-        Direction the current flows TOWARDS [rad], clockwise from north (``W_CURRENT_DIR``).
+        Direction the current flows TOWARDS [rad], clockwise from north.
     """
 
     constant_rudder: float = 0.0

@@ -22,7 +22,7 @@ import math
 import numpy as np
 from scipy.signal import welch
 
-from steerlab.environment.channels import (W_CURRENT_DIR, W_CURRENT_SPEED, W_RUDDER, W_WIND_DIR, W_WIND_SPEED,
+from steerlab.environment.channels import (W_CURRENT_E, W_CURRENT_N, W_RUDDER, W_WIND_DIR, W_WIND_SPEED,
                                            W_YAW_MOMENT, W_YAW_RATE)
 from steerlab.environment.encounter import encounter_frequency
 from steerlab.environment.sea import spectrum_components, target_spectrum_fn, thesis_omega_n, yaw_gain
@@ -137,9 +137,12 @@ def wind_current_summary(w: np.ndarray) -> dict:
         return math.degrees(math.atan2(s, c)) % 360.0, math.degrees(math.sqrt(max(-2.0 * math.log(R), 0.0))) if R > 0 else float("nan")
 
     out = {}
-    for name, cs, cd in (("wind", W_WIND_SPEED, W_WIND_DIR), ("current", W_CURRENT_SPEED, W_CURRENT_DIR)):
-        m, sd = circ(w[:, cd])
-        out[name] = {"speed_mean_m_s": float(np.mean(w[:, cs])), "speed_std_m_s": float(np.std(w[:, cs])),
+    current_speed = np.hypot(w[:, W_CURRENT_N], w[:, W_CURRENT_E])
+    current_dir = np.arctan2(w[:, W_CURRENT_E], w[:, W_CURRENT_N])     # towards, from north
+    for name, speed, direction in (("wind", w[:, W_WIND_SPEED], w[:, W_WIND_DIR]),
+                                   ("current", current_speed, current_dir)):
+        m, sd = circ(direction)
+        out[name] = {"speed_mean_m_s": float(np.mean(speed)), "speed_std_m_s": float(np.std(speed)),
                      "dir_mean_deg": m, "dir_std_deg": sd}
     out["yaw_rate_disturbance_std_rad_s"] = float(np.std(w[:, W_YAW_RATE]))
     out["yaw_accel_disturbance_std_rad_s2"] = float(np.std(w[:, W_YAW_MOMENT]))

@@ -20,6 +20,7 @@ Output level: for ideal white noise of PSD ``P`` the stationary standard deviati
 from __future__ import annotations
 
 import math
+from functools import lru_cache
 
 import control
 import numpy as np
@@ -46,14 +47,21 @@ def held_white_noise(n_steps: int, dt: float, rng: np.random.Generator,
     return np.repeat(samples, hold)[: n_steps + 1]
 
 
+@lru_cache(maxsize=64)
 def band_pass_eq39(dt: float, num=EQ39_NUM, den=EQ39_DEN):
-    """ZOH discretisation of eq (39) at step ``dt``: returns ``(b, a)`` for ``lfilter``."""
+    """ZOH discretisation of eq (39) at step ``dt``: returns ``(b, a)`` for ``lfilter``.
+
+    Memoised (a Monte-Carlo builds thousands of seas with the same filter); the arrays are
+    read-only.
+    """
     sysd = control.c2d(control.tf(list(num), list(den)), dt, method="zoh")
     b = np.asarray(sysd.num[0][0], dtype=float)
     a = np.asarray(sysd.den[0][0], dtype=float)
     # python-control drops the leading zero of a strictly proper numerator; lfilter needs it
     # (otherwise output k would see input k: the sequence would run one step early)
     b = np.concatenate([np.zeros(len(a) - len(b)), b])
+    b.flags.writeable = False
+    a.flags.writeable = False
     return b, a
 
 

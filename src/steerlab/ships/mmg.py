@@ -33,8 +33,8 @@ RELATIVE TO THE WATER; ``U = sqrt(u^2 + v^2)``)::
   gives eq 8's ``V^2``).
 * Wind (eqs 12-16) on the RELATIVE wind (true wind from channels ``W_WIND_SPEED``,
   ``W_WIND_DIR``; ship velocity over ground including the current).
-* Current (channels ``W_CURRENT_SPEED``, ``W_CURRENT_DIR``: speed and the direction it flows
-  TOWARDS): the hydrodynamics use water-relative ``u, v``; the current only adds to the
+* Current (channels ``W_CURRENT_N``, ``W_CURRENT_E``: its north and east velocity; turned
+  into body axes with the heading for the relative wind): the hydrodynamics use water-relative ``u, v``; the current only adds to the
   track. For a uniform, constant current this is exact and leaves the heading unaffected
   (thesis 2.4.2); a slowly varying current's inertial term ``dV_c/dt`` is neglected.
 * Also read: ``W_RUDDER`` (equivalent rudder angle, added to delta) and ``W_YAW_MOMENT``
@@ -61,7 +61,7 @@ import numpy as np
 from pydantic import Field, ValidationError, field_validator
 
 from steerlab.config_base import FrozenConfig
-from steerlab.environment.channels import (W_CURRENT_DIR, W_CURRENT_SPEED, W_RUDDER, W_WIND_DIR,
+from steerlab.environment.channels import (W_CURRENT_E, W_CURRENT_N, W_RUDDER, W_WIND_DIR,
                                            W_WIND_SPEED, W_YAW_MOMENT)
 from steerlab.environment.wind_fujiwara import (RHO_AIR, WindGeometry, fujiwara_coefficients,
                                                 relative_wind, wind_force)
@@ -70,6 +70,7 @@ from steerlab.ships.clarke import (ClarkeDerivatives, PrimeMass, clarke_derivati
                                    prime_mass, state_space_eq10)
 from steerlab.ships.rpm_schedule import check_rpm_schedule, pack_rate, scheduled_rate
 from steerlab.ships.kinematics import earth_velocity
+from steerlab.sincos import sincos
 
 # ---------------------------------------------------------------------------------------------
 # ship data (from a TOML file)
@@ -301,11 +302,10 @@ def mmg_rhs(t, x, delta, w, p, dx):
     v = x[4]
     r = x[5]
     d = delta + w[W_RUDDER]
-    # current (flowing towards beta_c) in body axes
-    vc = w[W_CURRENT_SPEED]
-    bc = w[W_CURRENT_DIR] - psi
-    uc = vc * math.cos(bc)
-    vcb = vc * math.sin(bc)
+    # current (north, east components) in body axes
+    sp, cp = sincos(psi)
+    uc = w[W_CURRENT_N] * cp + w[W_CURRENT_E] * sp
+    vcb = w[W_CURRENT_E] * cp - w[W_CURRENT_N] * sp
     earth_velocity(psi, u, v, w, dx)
     dx[2] = r
     U = math.sqrt(u * u + v * v)

@@ -14,7 +14,7 @@ form with the extra state ``z = r' + a r - b T3 delta`` [rad/s^2], where
 
 so that eliminating ``z`` gives the equation above exactly. ``psi' = r``; constant surge
 ``u`` (the approach speed), no sway; ``x_n' = u cos psi``, ``y_e' = u sin psi`` plus the
-current (``W_CURRENT_SPEED``, ``W_CURRENT_DIR``, direction it flows towards). State:
+current (``W_CURRENT_N``, ``W_CURRENT_E``: its north and east velocity). State:
 ``[x_n, y_e, psi, u, v, r, z]``.
 
 Parameters (packed ``[K, T1, T2, T3]``): ``K`` [1/s], ``T1``, ``T2`` [s] (> 0 for a

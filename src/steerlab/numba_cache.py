@@ -1,0 +1,104 @@
+"""Numba's on-disk cache for steerlab's kernels, invalidated by any change to steerlab.
+
+Numba keys a cached kernel on the modification time and size of the file that defines it,
+and nothing else. A steerlab kernel also bakes in constants and kernels of *other* modules
+(the disturbance channel indices of ``environment/channels.py``, ``sincos``, ...): after
+such a module changes (a ``git pull`` on an editable install, an upgrade in place) numba
+would load the old machine code, which then reads the wrong channels, silently. This
+module adds the fingerprint of the whole steerlab package (every ``.py`` file's path, size
+and modification time) to the stamp of every steerlab kernel, so any change to steerlab
+recompiles its cached kernels once. Functions outside steerlab are left to numba as they are.
+
+It plugs into numba's cache locators (``numba.core.caching.CacheImpl._locator_classes``, an
+internal list): if a future numba changes that, :func:`install` does nothing and says so
+with a warning, and the cache behaves as numba's own.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import os
+import warnings
+from functools import lru_cache
+from pathlib import Path
+
+PACKAGE_ROOT = Path(__file__).resolve().parent
+
+
+def package_fingerprint(root: Path = PACKAGE_ROOT) -> str:
+    """SHA-1 of every ``.py`` file's relative path, size and modification time under ``root``."""
+    h = hashlib.sha1()
+    for path in sorted(Path(root).rglob("*.py")):
+        st = path.stat()
+        h.update(f"{path.relative_to(root).as_posix()}:{st.st_size}:{st.st_mtime_ns};".encode())
+    return h.hexdigest()
+
+
+@lru_cache(maxsize=None)
+def _fingerprint() -> str:
+    return package_fingerprint()
+
+
+def _inside(py_file: str, root: Path = PACKAGE_ROOT) -> bool:
+    try:
+        Path(py_file).resolve().relative_to(root)
+    except (ValueError, OSError):
+        return False
+    return True
+
+
+def install() -> bool:
+    """Put the package-fingerprint locator first among numba's cache locators (idempotent).
+
+    Returns whether it is installed.
+    """
+    try:
+        from numba.core import caching
+
+        classes = caching.CacheImpl._locator_classes
+        base = caching._CacheLocator
+    except (ImportError, AttributeError):   # pragma: no cover - depends on the numba version
+        warnings.warn("steerlab: numba's cache locators have moved; cached kernels are keyed "
+                      "on their own file only (clear __pycache__ after updating steerlab)",
+                      RuntimeWarning, stacklevel=2)
+        return False
+    if any(getattr(c, "_steerlab", False) for c in classes):
+        return True
+    standard = list(classes)
+
+    class PackageStampLocator(base):
+        """numba's own locator for the file, with the steerlab fingerprint in its stamp."""
+
+        _steerlab = True
+
+        def __init__(self, inner):
+            self._inner = inner
+
+        def ensure_cache_path(self):
+            self._inner.ensure_cache_path()
+
+        def get_cache_path(self):
+            return self._inner.get_cache_path()
+
+        def get_source_stamp(self):
+            return (self._inner.get_source_stamp(), "steerlab", _fingerprint())
+
+        def get_disambiguator(self):
+            return self._inner.get_disambiguator()
+
+        @classmethod
+        def from_function(cls, py_func, py_file):
+            if not _inside(py_file):
+                return None
+            for locator_class in standard:
+                inner = locator_class.from_function(py_func, py_file)
+                if inner is not None:
+                    return cls(inner)
+            return None
+
+    classes.insert(0, PackageStampLocator)
+    return True
+
+
+INSTALLED = install() if os.environ.get("STEERLAB_NUMBA_CACHE_STAMP", "1") != "0" else False
+"""Installed at import of steerlab (``STEERLAB_NUMBA_CACHE_STAMP=0`` leaves numba's own)."""
