@@ -44,6 +44,26 @@ def test_montecarlo_ci_shrinks_with_n():
     assert np.all(large.error_bands_deg[50] <= large.error_bands_deg[95])
 
 
+def test_montecarlo_in_chunks_gives_the_same_numbers(monkeypatch):
+    """Chunks of 3 seeds (the last one short) against one chunk: every per-run metric, every
+    statistic and every percentile band equal, and the progress runs to the end."""
+    from steerlab.sweeps import montecarlo
+
+    sc = scenario_from_dict({**SEA, "duration": 60.0})
+    whole = run_montecarlo(sc, 8, record_every=10)
+    monkeypatch.setattr(montecarlo, "CHUNK_RUNS", 3)
+    said = []
+    parts = run_montecarlo(sc, 8, record_every=10, progress=said.append)
+    assert np.array_equal(parts.seeds, whole.seeds) and np.array_equal(parts.time, whole.time)
+    for k, v in whole.per_run.items():
+        np.testing.assert_array_equal(parts.per_run[k], v, err_msg=k)
+    assert parts.stats == whole.stats
+    for p in whole.error_bands_deg:
+        np.testing.assert_array_equal(parts.error_bands_deg[p], whole.error_bands_deg[p])
+        np.testing.assert_array_equal(parts.rudder_bands_deg[p], whole.rudder_bands_deg[p])
+    assert any("in chunks of up to 3" in m for m in said) and said[-1].endswith("8/8 runs")
+
+
 def test_montecarlo_run_equals_single_run():
     sc = scenario_from_dict(SEA)
     mc = run_montecarlo(sc, 2, record_every=1)
