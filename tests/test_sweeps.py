@@ -92,6 +92,24 @@ def test_robustness_map_varies_the_plant_only():
     assert res.metric_values[0] < res.metric_values[1] < res.metric_values[2]
 
 
+def test_robustness_grid_stores_a_sea_once_unless_it_varies(monkeypatch):
+    from steerlab.sweeps import robustness
+
+    seen = []
+    real = robustness.PackedBatch.from_setups
+
+    def spy(setups):
+        seen.append(len({id(s.w) for s in setups}))
+        return real(setups)
+
+    monkeypatch.setattr(robustness.PackedBatch, "from_setups", staticmethod(spy))
+    sc = scenario_from_dict({**SEA, "duration": 30.0})
+    a = run_robustness(sc, [parse_vary("T=30:70:20", sc)], "itae")
+    b = run_robustness(sc, [parse_vary("environment.wave_power=0.0001:0.0003:0.0001", sc)], "itae")
+    assert seen == [1, 4]             # 3 plants + nominal in one sea; 3 other seas + the nominal (1e-2)
+    assert len(set(a.metric_values)) == 3 and len(set(b.metric_values)) == 3
+
+
 @pytest.mark.parametrize("text, fragment", [
     ("T", "NAME=lo:hi:step"), ("T=1:2", "lo:hi:step"), ("T=2:1:1", "lo <= hi"),
     ("T=1:2:0", "step > 0"), ("Q=1:2:1", "unknown quantity 'Q'"), ("ship.nope=1:2:1", "unknown scenario path"),

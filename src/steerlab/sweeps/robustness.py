@@ -137,6 +137,8 @@ def run_robustness(scenario, variations: list[Variation], metric: str = "itae", 
             if s.pc.shape != nominal.setup.pc.shape:
                 raise InputError("--vary", "the controller record changes shape over the grid")
             s = replace(s, pc=nominal.setup.pc, z0=nominal.setup.z0)
+        if s.w.shape == nominal.setup.w.shape and np.array_equal(s.w, nominal.setup.w):
+            s = replace(s, w=nominal.setup.w)   # the same sea: the batch stores it once
         setups.append(s)
     say(f"{len(points)} grid points ({' x '.join(str(len(v.values)) for v in variations)}), controller "
         f"{'redesigned at every point' if redesign else 'designed for the nominal scenario'}")
