@@ -32,7 +32,7 @@ from pathlib import Path
 from steerlab.control.design_context import DesignContext
 from steerlab.errors import InputError
 from steerlab.sim.scenario import Scenario, scenario_from_dict
-from steerlab.sim.setup import SimSetup, build
+from steerlab.sim.setup import SimSetup, build, build_seeds
 from steerlab.steering_gear import SteeringGear
 from steerlab.units import knots_to_ms, rad
 
@@ -114,7 +114,8 @@ def condition_set(base: Scenario, n_seeds: int = 1, speeds_kn=(), wave_powers=()
         raise InputError("--seeds", f"{total} conditions; allowed at most {MAX_CONDITIONS}")
     base_d = base.model_dump()
     out = []
-    for (vlabel, vd), sp, wp, k in itertools.product(variants, speeds, powers, range(int(n_seeds))):
+    seeds = [base.seed + k for k in range(int(n_seeds))]
+    for (vlabel, vd), sp, wp in itertools.product(variants, speeds, powers):
         d = deep_merge(base_d, vd)
         parts = [vlabel] if vlabel else []
         if sp is not None:
@@ -124,8 +125,10 @@ def condition_set(base: Scenario, n_seeds: int = 1, speeds_kn=(), wave_powers=()
             d["environment"]["wave_power"] = float(wp)
             d["environment"]["waves"] = wp > 0
             parts.append(f"waves {wp:g}")
-        d["seed"] = base.seed + k
-        if n_seeds > 1:
-            parts.append(f"seed {base.seed + k}")
-        out.append(make_condition(", ".join(parts) or "nominal", scenario_from_dict(d)))
+        scenario = scenario_from_dict(d)
+        ctx = design_context(scenario)
+        # the seeds share everything but their seas: designed once, realised per seed
+        for seed, setup in zip(seeds, build_seeds(scenario, seeds)):
+            label = ", ".join(parts + ([f"seed {seed}"] if n_seeds > 1 else [])) or "nominal"
+            out.append(Condition(label, scenario.model_copy(update={"seed": seed}), setup, ctx))
     return out
