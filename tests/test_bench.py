@@ -39,6 +39,8 @@ def test_bench_dict_has_keys_with_positive_finite_values(bench):
     assert bench["n_batch"] == 8
     assert bench["n_steps"] == 2000
     assert bench["cores"] >= 1 and bench["numba_threads"] >= 1 and bench["batch_lanes"] >= 1
+    assert bench["batch_vectorisation"]["vectorised_stages"] >= 4       # the Esso's RK4 stages, all
+    assert bench["batch_vectorisation"]["per_run_library_calls"] == []
     assert bench["c_reference_steps_per_s"] == C_REFERENCE_STEPS_PER_S == 13.8e6
     assert "not measured" in bench["c_reference_note"]
     assert isinstance(bench["numba_version"], str) and bench["numba_version"]

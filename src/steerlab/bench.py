@@ -39,7 +39,7 @@ from numba.core.registry import CPUDispatcher
 from steerlab.sim.batch import simulate_batch, vary_controller
 from steerlab.sim.engine import simulate_compiled, simulate_readable
 from steerlab.sim.kernels import plant_step
-from steerlab.sim.lanes import LANES
+from steerlab.sim.lanes import LANES, vectorisation_report
 from steerlab.sim.scenario import Scenario, scenario_from_dict
 from steerlab.sim.setup import SimSetup, build
 
@@ -244,6 +244,7 @@ def run_bench(n_batch: int = 1000, duration: float = 3000.0, repeats: int = 5,
         "cores": os.cpu_count(),
         "numba_threads": numba.get_num_threads(),
         "batch_lanes": LANES,
+        "batch_vectorisation": vectorisation_report(setup.ship.rhs, setup.controller.update, setup.x0.size),
         "numba_version": numba.__version__,
         "numpy_version": np.__version__,
         "python_version": platform.python_version(),
