@@ -160,8 +160,11 @@ def test_progress_bar_text():
     assert bar(5, 10) == "[" + "#" * 10 + "." * 10 + "]"
     assert bar(12, 10, width=4) == "[####]"
     said = []
-    runs_progress(said.append)(250, 1000)
-    assert said == ["[#####...............] 250/1000 runs"]
+    report = runs_progress(said.append, period=60.0)
+    report(250, 1000)
+    report(500, 1000)                      # within the period: not printed
+    report(1000, 1000)                     # the end: always printed
+    assert said == ["[#####...............] 250/1000 runs", "[####################] 1000/1000 runs"]
 
 
 def test_bench_ships_script_reports_a_vectorised_esso(capsys):
