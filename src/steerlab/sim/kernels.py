@@ -91,6 +91,22 @@ def _fused(kernel):
     return _jit_fused(py)
 
 
+@numba.njit(inline="always")
+def rk4_stage(x, c, k):
+    """Classic RK4 (Runge-Kutta 1901/Kutta): a stage's input state ``x + c k``, ``c`` = h/2 or h."""
+    return x + c * k
+
+
+@numba.njit(inline="always")
+def rk4_update(x, s6, k1, k2, k3, k4):
+    """Classic RK4: the step ``x + (h/6) (k1 + 2 k2 + 2 k3 + k4)``, ``s6 = h/6``.
+
+    These two helpers are the RK4 formula for every engine (the single run's :func:`_plant_kernels`
+    and the batch's :mod:`steerlab.sim.lanes`), element by element, so both give the same bits.
+    """
+    return x + s6 * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
+
+
 @lru_cache(maxsize=None)
 def _plant_kernels(ship_rhs, nx: int = 0):
     """``(rk4, rk4_step)`` for a ship model; ``nx > 0`` specialises on the plant state size."""
@@ -113,17 +129,17 @@ def _plant_kernels(ship_rhs, nx: int = 0):
         h2 = 0.5 * dt
         plant_rhs(t, x, delta_cmd, w, ps, pg, k1)
         for i in range(nx):
-            xt[i] = x[i] + h2 * k1[i]
+            xt[i] = rk4_stage(x[i], h2, k1[i])
         plant_rhs(t + h2, xt, delta_cmd, w, ps, pg, k2)
         for i in range(nx):
-            xt[i] = x[i] + h2 * k2[i]
+            xt[i] = rk4_stage(x[i], h2, k2[i])
         plant_rhs(t + h2, xt, delta_cmd, w, ps, pg, k3)
         for i in range(nx):
-            xt[i] = x[i] + dt * k3[i]
+            xt[i] = rk4_stage(x[i], dt, k3[i])
         plant_rhs(t + dt, xt, delta_cmd, w, ps, pg, k4)
         s = dt / 6.0
         for i in range(nx):
-            x[i] += s * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
+            x[i] = rk4_update(x[i], s, k1[i], k2[i], k3[i], k4[i])
         x[nx - 1] = clamp(x[nx - 1], pg)
 
     @numba.njit

@@ -39,7 +39,7 @@ from steerlab.angles import wrap_to_pi
 from steerlab.guidance.reference_models import course_guide
 from steerlab.guidance.reference_vector import N_REF, REF_LEG, REF_RPM, REF_XTE
 from steerlab.metrics_online import accumulate
-from steerlab.sim.kernels import _fused, _jit_fused, _plant_kernels
+from steerlab.sim.kernels import _fused, _jit_fused, _plant_kernels, rk4_stage, rk4_update
 
 LANES = 16
 """Runs advanced together by one thread of the batch engine (two AVX-512 vectors of float64;
@@ -94,22 +94,22 @@ def _group_kernels(ship_rhs, nx: int):
             plant_rhs(t, XL[:, g], CMD[g], WL[:, g], PL[:, g], PGL[:, g], K1[:, g])
         for q in range(NX):
             for g in range(n_act):
-                XT[q, g] = XL[q, g] + h2 * K1[q, g]
+                XT[q, g] = rk4_stage(XL[q, g], h2, K1[q, g])
         for g in range(n_act):
             plant_rhs(t2, XT[:, g], CMD[g], WL[:, g], PL[:, g], PGL[:, g], K2[:, g])
         for q in range(NX):
             for g in range(n_act):
-                XT[q, g] = XL[q, g] + h2 * K2[q, g]
+                XT[q, g] = rk4_stage(XL[q, g], h2, K2[q, g])
         for g in range(n_act):
             plant_rhs(t2, XT[:, g], CMD[g], WL[:, g], PL[:, g], PGL[:, g], K3[:, g])
         for q in range(NX):
             for g in range(n_act):
-                XT[q, g] = XL[q, g] + dt * K3[q, g]
+                XT[q, g] = rk4_stage(XL[q, g], dt, K3[q, g])
         for g in range(n_act):
             plant_rhs(t + dt, XT[:, g], CMD[g], WL[:, g], PL[:, g], PGL[:, g], K4[:, g])
         for q in range(NX):
             for g in range(n_act):
-                XL[q, g] += s6 * (K1[q, g] + 2.0 * K2[q, g] + 2.0 * K3[q, g] + K4[q, g])
+                XL[q, g] = rk4_update(XL[q, g], s6, K1[q, g], K2[q, g], K3[q, g], K4[q, g])
         for g in range(n_act):
             XL[NX - 1, g] = clamp(XL[NX - 1, g], PGL[:, g])
         for g in range(n_act):
