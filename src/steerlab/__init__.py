@@ -6,7 +6,15 @@ Conventions (everywhere inside the library)
 * Heading ``psi`` clockwise from north, yaw rate ``r > 0`` turning to starboard,
   rudder angle ``delta > 0`` turns the ship to starboard.
 * Every heading error goes through :func:`steerlab.angles.wrap_to_pi`.
+
+The public API (``import steerlab as sl``) is loaded lazily: ``import steerlab`` imports
+numpy and numba only; ``sl.simulate`` and friends import their module on first use
+(PEP 562 module ``__getattr__``), so a command pays only for what it uses.
 """
+
+from __future__ import annotations
+
+import importlib
 
 __version__ = "0.1.0"
 
@@ -14,3 +22,28 @@ __version__ = "0.1.0"
 from steerlab import numba_cache  # noqa: F401,E402  (isort: skip)
 from steerlab.angles import wrap_to_pi  # noqa: F401
 from steerlab.errors import InputError  # noqa: F401
+
+_LAZY = {
+    # name: "module:attribute" (one line each; keep sorted within a block)
+    "default_scenario": "steerlab.sim.scenario:default_scenario",
+    "load_scenario": "steerlab.sim.scenario:load_scenario",
+    "simulate": "steerlab.sim.engine:simulate",
+    "simulate_batch": "steerlab.sim.batch:simulate_batch",
+}
+
+
+def __getattr__(name: str):
+    target = _LAZY.get(name)
+    if target is None:
+        raise AttributeError(f"module 'steerlab' has no attribute {name!r}")
+    module, _, attr = target.partition(":")
+    value = getattr(importlib.import_module(module), attr)
+    globals()[name] = value
+    return value
+
+
+def __dir__():
+    return sorted(set(globals()) | set(_LAZY))
+
+
+__all__ = ["InputError", "wrap_to_pi", *_LAZY]
