@@ -7,7 +7,9 @@ such a module changes (a ``git pull`` on an editable install, an upgrade in plac
 would load the old machine code, which then reads the wrong channels, silently. This
 module adds the fingerprint of the whole steerlab package (every ``.py`` file's path, size
 and modification time) to the stamp of every steerlab kernel, so any change to steerlab
-recompiles its cached kernels once. Functions outside steerlab are left to numba as they are.
+recompiles its cached kernels once. Functions outside steerlab are left to numba as they are,
+except the generated drivers (:mod:`steerlab.sim.drivers`), whose stamp is their file name:
+the hash of their text, in a directory named after the fingerprint.
 
 It plugs into numba's cache locators (``numba.core.caching.CacheImpl._locator_classes``, an
 internal list): if a future numba changes that, :func:`install` does nothing and says so
@@ -18,6 +20,7 @@ from __future__ import annotations
 
 import hashlib
 import os
+import re
 import warnings
 from functools import lru_cache
 from pathlib import Path
@@ -47,6 +50,15 @@ def _inside(py_file: str, root: Path = PACKAGE_ROOT) -> bool:
     return True
 
 
+_DRIVER_NAME = re.compile(r"d_[0-9a-f]{20}\.py")
+
+
+def _is_driver(py_file: str) -> bool:
+    """A generated driver module (:mod:`steerlab.sim.drivers`): ``.../drivers/<fp>/d_<hash>.py``."""
+    p = Path(py_file)
+    return bool(_DRIVER_NAME.fullmatch(p.name)) and p.parent.parent.name == "drivers"
+
+
 def install() -> bool:
     """Put the package-fingerprint locator first among numba's cache locators (idempotent).
 
@@ -71,8 +83,9 @@ def install() -> bool:
 
         _steerlab = True
 
-        def __init__(self, inner):
+        def __init__(self, inner, driver=""):
             self._inner = inner
+            self._driver = driver
 
         def ensure_cache_path(self):
             self._inner.ensure_cache_path()
@@ -81,6 +94,8 @@ def install() -> bool:
             return self._inner.get_cache_path()
 
         def get_source_stamp(self):
+            if self._driver:   # its name is its text's hash, its directory steerlab's fingerprint
+                return ("steerlab-driver", self._driver)
             return (self._inner.get_source_stamp(), "steerlab", _fingerprint())
 
         def get_disambiguator(self):
@@ -88,12 +103,13 @@ def install() -> bool:
 
         @classmethod
         def from_function(cls, py_func, py_file):
-            if not _inside(py_file):
+            driver = _is_driver(py_file)
+            if not driver and not _inside(py_file):
                 return None
             for locator_class in standard:
                 inner = locator_class.from_function(py_func, py_file)
                 if inner is not None:
-                    return cls(inner)
+                    return cls(inner, str(Path(py_file).relative_to(Path(py_file).parent.parent)) if driver else "")
             return None
 
     classes.insert(0, PackageStampLocator)

@@ -17,7 +17,6 @@ weights, Section 5), or computed here by python-control: LQR on the dual system
 
 from __future__ import annotations
 
-import control
 import numba
 import numpy as np
 
@@ -41,6 +40,8 @@ def eso_gains_lqr(q=(1.0, 1.0, 1.0), r: float = 1.0) -> np.ndarray:
     ``q`` are the diagonal state weights, ``r`` the output weight.
     """
     A, _, C = eso_matrices()
+    import control
+
     K, _, _ = control.lqr(A.T, C.T, np.diag(q), np.array([[r]]))
     return np.asarray(K, dtype=float).ravel()
 
@@ -48,6 +49,8 @@ def eso_gains_lqr(q=(1.0, 1.0, 1.0), r: float = 1.0) -> np.ndarray:
 def eso_gains_poles(poles) -> np.ndarray:
     """Observer gains placing the ESO poles (python-control ``acker``; repeated poles allowed)."""
     A, _, C = eso_matrices()
+    import control
+
     K = control.acker(A.T, C.T, list(poles))
     return np.asarray(K, dtype=float).ravel()
 

@@ -35,7 +35,6 @@ from __future__ import annotations
 
 from typing import Literal, NamedTuple, Optional
 
-import control
 import numba
 import numpy as np
 from pydantic import Field, field_validator
@@ -56,6 +55,8 @@ def sliding_surface_design(A, b, poles):
     """``(k, h)``: ``k`` places ``A - b k^T`` at ``{0, *poles}``; ``h`` its left null vector, h1 = 1."""
     A = np.asarray(A, dtype=float)
     b = np.asarray(b, dtype=float).reshape(-1, 1)
+    import control
+
     k = np.asarray(control.acker(A, b, [0.0, *poles]), dtype=float).ravel()
     Ac = A - b @ k.reshape(1, -1)
     w, V = np.linalg.eig(Ac.T)

@@ -18,9 +18,10 @@ Layouts: ``z = [filter (N_WF) | x copy (NX_MAX) | inner z]``,
 ``p = [filter params (N_WF_PARAMS) | K [1/s] | T [s] | inner p]``. Nothing is allocated
 (the copy lives in ``z``; slices are views), so the kernel obeys the engine's rules. The
 kernel is a copy of one template function whose module globals bind ``_inner`` to the inner
-kernel, so the engine's fusing (``sim/kernels.py: _fused``, which follows kernels called
-through module globals) inlines the filter and the inner controller like any other kernel.
-It is not disk-cached (all wrappers share one code object), so it compiles once per process.
+kernel (:func:`steerlab.kernel_refs.bound_kernel`), so the engine's fusing (which follows
+kernels called through module globals) inlines the filter and the inner controller like any
+other kernel, and a generated driver can name it (its machine code is cached on disk with the
+driver, :mod:`steerlab.sim.drivers`).
 
 The filter's K, T come from ``ctx.nomoto()`` (the ship's first-order Nomoto model at the
 design speed) unless ``filter_K``, ``filter_T`` are given; ASA itself uses the same filter
@@ -41,11 +42,9 @@ from __future__ import annotations
 
 import importlib
 import pkgutil
-import types
 from functools import lru_cache
 from typing import Literal, NamedTuple, Optional
 
-import numba
 import numpy as np
 from pydantic import Field, create_model
 
@@ -53,6 +52,7 @@ from steerlab.control.registry import ControllerSpec
 from steerlab.control.wave_filter import (F_PSI, F_R, N_WF, N_WF_PARAMS, WaveFilterConfig, WaveFilterParams,
                                           wave_filter_init, wave_filter_step)
 from steerlab.errors import InputError, require_finite_range
+from steerlab.kernel_refs import bound_kernel
 
 NX_MAX = 32
 """Largest plant state (ship states + rudder) the wrapper can copy."""
@@ -115,11 +115,7 @@ class WaveFiltered(NamedTuple):
 def wave_filtered(spec: ControllerSpec) -> ControllerSpec:
     """``spec`` behind the wave filter, registered as ``spec.name + "+wf"`` (memoised)."""
     name = spec.name + SUFFIX
-    g = dict(_wf_update_template.__globals__)
-    g["_inner"] = spec.update
-    fn = types.FunctionType(_wf_update_template.__code__, g, name.replace("+", "_") + "_update")
-    fn.__doc__ = f"{spec.name} behind the noise-adaptive wave filter (steerlab.control.wave_filtered)."
-    kernel = numba.njit(fn)
+    kernel = bound_kernel(_wf_update_template, name.replace("+", "_") + "_update", _inner=spec.update)
     cfg_cls = create_model(
         spec.config.__name__ + "WaveFiltered", __base__=spec.config,
         type=(Literal[name], ...),

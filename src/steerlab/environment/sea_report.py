@@ -20,7 +20,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy.signal import welch
 
 from steerlab.environment.channels import (W_CURRENT_E, W_CURRENT_N, W_RUDDER, W_WIND_DIR, W_WIND_SPEED,
                                            W_YAW_MOMENT, W_YAW_RATE)
@@ -39,6 +38,8 @@ def estimate_psd(x, dt: float, nperseg: int = 1024):
     """``(w [rad/s], S [unit^2 s/rad])``: smoothed one-sided Welch estimate."""
     x = np.asarray(x, dtype=float)
     nperseg = int(min(nperseg, max(16, x.shape[0] // 4)))
+    from scipy.signal import welch
+
     f, P = welch(x - x.mean(), fs=1.0 / dt, nperseg=nperseg)
     P = np.convolve(P, np.ones(SMOOTH) / SMOOTH, mode="same") / (2.0 * math.pi)
     return 2.0 * math.pi * f, P

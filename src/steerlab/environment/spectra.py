@@ -40,7 +40,6 @@ import math
 from functools import lru_cache
 
 import numpy as np
-from scipy.integrate import quad
 
 from steerlab.errors import InputError, require_finite_range
 
@@ -109,6 +108,8 @@ def _jonswap_shape(w, wp, gamma):
 @lru_cache(maxsize=64)
 def jonswap_normaliser(gamma: float) -> float:
     """``c(gamma)`` making ``m0 = H^2/16`` (independent of ``Tp``; computed at ``w_p = 1``)."""
+    from scipy.integrate import quad
+
     val = sum(quad(lambda x: float(_jonswap_shape(np.array([x]), 1.0, gamma)[0]), lo, hi, limit=200)[0]
               for lo, hi in ((0.0, 1.0), (1.0, 3.0), (3.0, np.inf)))
     return (1.0 / 16.0) / val

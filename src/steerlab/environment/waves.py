@@ -22,9 +22,7 @@ from __future__ import annotations
 import math
 from functools import lru_cache
 
-import control
 import numpy as np
-from scipy.signal import lfilter
 
 from steerlab.errors import InputError, require_finite_range
 
@@ -54,6 +52,8 @@ def band_pass_eq39(dt: float, num=EQ39_NUM, den=EQ39_DEN):
     Memoised (a Monte-Carlo builds thousands of seas with the same filter); the arrays are
     read-only.
     """
+    import control
+
     sysd = control.c2d(control.tf(list(num), list(den)), dt, method="zoh")
     b = np.asarray(sysd.num[0][0], dtype=float)
     a = np.asarray(sysd.den[0][0], dtype=float)
@@ -71,6 +71,8 @@ def coloured_noise(n_steps: int, dt: float, rng: np.random.Generator,
     white = held_white_noise(n_steps, dt, rng, sample_time, power)
     b, a = band_pass_eq39(dt)
     # ZOH discretisation: output k depends on inputs up to k-1 (b[0] == 0)
+    from scipy.signal import lfilter
+
     return lfilter(b, a, white)
 
 
@@ -100,6 +102,8 @@ def held_noise_std_eq39(sample_time: float = 0.5, power: float = 1e-4, num=EQ39_
         return g2 * s * s
 
     peak = math.sqrt(a0)
+    from scipy.integrate import quad
+
     val = sum(quad(integrand, lo, hi, limit=200)[0]
               for lo, hi in ((0.0, peak), (peak, 20 * peak), (20 * peak, math.inf)))
     return math.sqrt(power * val / math.pi)

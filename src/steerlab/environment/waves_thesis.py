@@ -27,7 +27,6 @@ import math
 
 import numba
 import numpy as np
-from scipy.linalg import expm, solve_continuous_lyapunov
 
 from steerlab.errors import require_finite_range
 
@@ -56,6 +55,8 @@ def theoretical_psd(w, sigma: float, wn: float, zeta: float = ZETA_THESIS) -> np
 
 def discretise(wn: float, zeta: float, q: float, dt: float):
     """``(Phi, Qd, P)``: exact transition, discrete noise covariance and stationary covariance."""
+    from scipy.linalg import expm, solve_continuous_lyapunov
+
     A, B = _system(wn, zeta)
     Qc = q * (B @ B.T)
     M = np.zeros((4, 4))

@@ -25,7 +25,6 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.optimize import least_squares
 
 from steerlab.errors import InputError
 from steerlab.identification.record import Record
@@ -182,6 +181,8 @@ def identify(rec: Record, model: str, use_spiral: bool | None = None, settle: fl
     ``use_spiral``: None = use the steady turns when there are enough (>= 4), True = require
     them (InputError otherwise), False = fit everything dynamically.
     """
+    from scipy.optimize import least_squares
+
     if model not in MODELS:
         raise InputError("--model", f"must be one of {list(MODELS)}, got {model!r}")
     spiral = None

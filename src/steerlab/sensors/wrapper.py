@@ -27,7 +27,6 @@ Sample 0 (at the first controller call) is never dropped.
 from __future__ import annotations
 
 import math
-import types
 from functools import lru_cache
 from typing import NamedTuple
 
@@ -36,6 +35,7 @@ import numpy as np
 
 from steerlab.control.registry import ControllerSpec
 from steerlab.errors import InputError
+from steerlab.kernel_refs import bound_kernel
 from steerlab.sensors.counter_rng import make_key, normal, split_seed, uniform
 
 Z_CALLS, Z_PSI, Z_R, OFF_X = 0, 1, 2, 3
@@ -93,12 +93,9 @@ def _sensed_update_template(z, p, t, x, ref, h):
 def sensed_spec(spec: ControllerSpec) -> ControllerSpec:
     """``spec`` behind the sensors (memoised: one compiled kernel per inner controller)."""
     name = spec.name + SUFFIX
-    g = dict(_sensed_update_template.__globals__)
-    g["_inner"] = spec.update
-    fn = types.FunctionType(_sensed_update_template.__code__, g, name.replace("+", "_") + "_update")
-    fn.__doc__ = f"{spec.name} behind the sensor models (steerlab.sensors.wrapper)."
+    kernel = bound_kernel(_sensed_update_template, name.replace("+", "_") + "_update", _inner=spec.update)
     return ControllerSpec(name=name, description=f"{spec.description}, measured through sensor models",
-                          update=numba.njit(fn), n_state=spec.n_state, config=spec.config, build=spec.build,
+                          update=kernel, n_state=spec.n_state, config=spec.config, build=spec.build,
                           source=spec.source)
 
 

@@ -12,7 +12,6 @@ zero-dynamics pole ``a0 = a11 - a21 b1/b2`` of eq (36).
 
 from __future__ import annotations
 
-import control
 import numpy as np
 
 from steerlab.errors import InputError, require_finite_range
@@ -21,6 +20,8 @@ from steerlab.ships.registry import get_ship
 
 def nomoto_from_linear(A1, B1) -> dict:
     """Nomoto K [1/s], T1, T2, T3 and first-order T [s] of ``r/delta`` for ``(A1, B1)``."""
+    import control
+
     sys = control.ss(np.asarray(A1), np.asarray(B1).reshape(2, 1), np.array([[0.0, 1.0]]), np.zeros((1, 1)))
     tf = control.ss2tf(sys)
     num = np.atleast_1d(np.squeeze(tf.num[0][0]))

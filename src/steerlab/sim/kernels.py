@@ -1,11 +1,13 @@
 """Fused closed-loop kernels built from the model, gear, controller and guidance kernels.
 
-One definition, two speeds: :func:`plant_step` builds the RK4 step of ship + steering gear;
-:func:`closed_loop` builds the compiled loop used by the single fast run; the batch engine
+One definition, two speeds: :func:`plant_step` is the RK4 step of ship + steering gear;
+:func:`closed_loop` is the compiled loop used by the single fast run; the batch engine
 (:mod:`steerlab.sim.lanes`) calls the same fused ship + gear kernel, vectorised across runs.
 The readable engine (:mod:`steerlab.sim.engine`) calls the very same ``plant_step`` and
-controller/guidance kernels from Python. Factories are memoised per combination, so each
-combination compiles once per process (numba cannot disk-cache closures).
+controller/guidance kernels from Python. The loops themselves are written once, in
+:mod:`steerlab.sim.driver_template`; each combination's copy (its *driver*) is generated as a
+module and its machine code cached on disk (:mod:`steerlab.sim.drivers`), so a combination
+compiles once, ever, not once per process.
 
 Every loop takes one kind of guidance kernel, ``guide(t, x, gd, gz, ref, h)`` with a
 guidance state ``gz`` and the 6-entry reference vector (:mod:`steerlab.guidance.plan`),
@@ -32,14 +34,9 @@ import types
 from functools import lru_cache
 
 import numba
-import numpy as np
 from numba.core.registry import CPUDispatcher
 
-from steerlab.angles import wrap_to_pi
 from steerlab.guidance.reference_models import course_guide
-from steerlab.guidance.reference_vector import N_REF, REF_LEG, REF_RPM, REF_XTE
-from steerlab.metrics_online import accumulate
-from steerlab.steering_gear import gear_clamp, gear_rate
 
 @lru_cache(maxsize=None)
 def _fuse_options() -> dict:
@@ -52,19 +49,16 @@ def _fuse_options() -> dict:
     ship models) is one instruction and not a branch to an exception, which would stop the
     batch engine from vectorising the kernel. The records the kernels divide by are validated
     (T != 0 etc.), so no valid scenario divides by zero and the numbers are those of the
-    plain kernels. Falls back to plain ``njit`` if this numba rejects the options.
+    plain kernels. The options are checked (without compiling anything: a compile per
+    process would cost start-up time) against numba's target options; plain ``njit`` if
+    this numba lacks one.
     """
     opts = {"forceinline": True, "_nrt": False, "error_model": "numpy"}
     try:
-        probe = numba.njit(**opts)(_probe_kernel)
-        probe(np.zeros(2))
-    except Exception:  # pragma: no cover - depends on the numba version
+        from numba.core.cpu import CPUTargetOptions
+    except ImportError:  # pragma: no cover - depends on the numba version
         return {}
-    return opts
-
-
-def _probe_kernel(a):
-    a[1] = a[0] + 1.0
+    return {k: v for k, v in opts.items() if hasattr(CPUTargetOptions, k)}
 
 
 def _jit_fused(fn):
@@ -107,47 +101,13 @@ def rk4_update(x, s6, k1, k2, k3, k4):
     return x + s6 * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
 
 
-@lru_cache(maxsize=None)
 def _plant_kernels(ship_rhs, nx: int = 0):
-    """``(rk4, rk4_step)`` for a ship model; ``nx > 0`` specialises on the plant state size."""
-    ship = _fused(ship_rhs)
-    rate = _fused(gear_rate)
-    clamp = _fused(gear_clamp)
-    NX = nx
+    """``(rk4, rk4_step, plant_rhs, clamp)`` for a ship model (its plant-only driver);
+    ``nx > 0`` specialises on the plant state size."""
+    from steerlab.sim.drivers import driver
 
-    @_jit_fused
-    def plant_rhs(t, x, delta_cmd, w, ps, pg, dx):
-        nd = (x.shape[0] if NX == 0 else NX) - 1
-        delta = x[nd]
-        ship(t, x, delta, w, ps, dx)
-        dx[nd] = rate(delta, delta_cmd, pg)
-
-    @_jit_fused
-    def rk4(t, x, delta_cmd, w, ps, pg, dt, k1, k2, k3, k4, xt):
-        """Advance ``x`` in place by one RK4 step; ``k1..k4``, ``xt`` are (nx,) scratch."""
-        nx = x.shape[0] if NX == 0 else NX
-        h2 = 0.5 * dt
-        plant_rhs(t, x, delta_cmd, w, ps, pg, k1)
-        for i in range(nx):
-            xt[i] = rk4_stage(x[i], h2, k1[i])
-        plant_rhs(t + h2, xt, delta_cmd, w, ps, pg, k2)
-        for i in range(nx):
-            xt[i] = rk4_stage(x[i], h2, k2[i])
-        plant_rhs(t + h2, xt, delta_cmd, w, ps, pg, k3)
-        for i in range(nx):
-            xt[i] = rk4_stage(x[i], dt, k3[i])
-        plant_rhs(t + dt, xt, delta_cmd, w, ps, pg, k4)
-        s = dt / 6.0
-        for i in range(nx):
-            x[i] = rk4_update(x[i], s, k1[i], k2[i], k3[i], k4[i])
-        x[nx - 1] = clamp(x[nx - 1], pg)
-
-    @numba.njit
-    def rk4_step(t, x, delta_cmd, w, ps, pg, dt, work):
-        """Advance ``x`` in place by one RK4 step; ``work`` is a (5, nx) scratch array."""
-        rk4(t, x, delta_cmd, w, ps, pg, dt, work[0], work[1], work[2], work[3], work[4])
-
-    return rk4, rk4_step, plant_rhs, clamp
+    d = driver(ship_rhs, None, None, int(nx))
+    return d.rk4, d.rk4_step, d.plant_rhs, d.clamp
 
 
 def plant_step(ship_rhs):
@@ -190,70 +150,30 @@ def guided_closed_loop(ship_rhs, ctrl_update, guide, nx: int | None = None):
     ``nx`` (the plant state size, ship states + rudder), when given, specialises the loop on
     it (faster); ``run`` then raises ``ValueError`` for a state of another size.
     """
-    NX = 0 if nx is None else int(nx)
-    rk4 = _plant_kernels(ship_rhs, NX)[0]
-    update = _fused(ctrl_update)
-    reference = _fused(guide)
-    acc_step = _fused(accumulate)
-    wrap = _fused(wrap_to_pi)
-    NR = N_REF
-    RPM = REF_RPM
+    from steerlab.sim.drivers import driver
 
-    @_jit_fused
-    def loop(x, z, ps, pg, pc, gd, gz, w, dt, nc, n_steps, rec_every, out_x, out_cmd, out_ref,
-             acc, rpm_slot, k1, k2, k3, k4, xt, ref):
-        nx = x.shape[0] if NX == 0 else NX
-        nr = min(out_ref.shape[1], NR)
-        cmd = 0.0
-        h = nc * dt
-        j = 0
-        kc = 0
-        kr = 0
-        for k in range(n_steps + 1):
-            t = k * dt
-            sample = kc == 0
-            if sample:
-                reference(t, x, gd, gz, ref, h)
-                if rpm_slot >= 0 and ref[RPM] >= 0.0:
-                    ps[rpm_slot] = ref[RPM]
-            e = wrap(ref[0] - x[2])
-            if sample:
-                cmd = update(z, pc, t, x, ref, h)
-            kc += 1
-            if kc == nc:
-                kc = 0
-            if kr == 0:
-                for i in range(nx):
-                    out_x[j, i] = x[i]
-                out_cmd[j] = cmd
-                for q in range(nr):
-                    out_ref[j, q] = ref[q]
-                j += 1
-            kr += 1
-            if kr == rec_every:
-                kr = 0
-            if k == n_steps:
-                break
-            delta = x[nx - 1]
-            rk4(t, x, cmd, w[k], ps, pg, dt, k1, k2, k3, k4, xt)
-            acc_step(acc, t, e, delta, x[nx - 1], dt)
+    d = driver(ship_rhs, ctrl_update, guide, 0 if nx is None else int(nx))
+    return _Announced(d, "run")
 
-    @numba.njit
-    def run(x, z, ps, pg, pc, gd, gz, w, dt, nc, n_steps, rec_every, out_x, out_cmd, out_ref, acc,
-            rpm_slot):
-        nx = x.shape[0]
-        if NX != 0 and nx != NX:
-            raise ValueError("plant state size differs from the one this loop was built for")
-        k1 = np.empty(nx)
-        k2 = np.empty(nx)
-        k3 = np.empty(nx)
-        k4 = np.empty(nx)
-        xt = np.empty(nx)
-        ref = np.zeros(NR)
-        ref[RPM] = -1.0
-        ref[REF_XTE] = np.nan
-        ref[REF_LEG] = -1.0
-        loop(x, z, ps, pg, pc, gd, gz, w, dt, nc, n_steps, rec_every, out_x, out_cmd, out_ref, acc,
-             rpm_slot, k1, k2, k3, k4, xt, ref)
 
-    return run
+class _Announced:
+    """A driver's entry point that says (through :data:`steerlab.sim.drivers.on_compile`)
+    when its first call compiles, then calls the compiled kernel directly."""
+
+    __slots__ = ("_mod", "_name", "_fn")
+
+    def __init__(self, mod, name):
+        self._mod, self._name, self._fn = mod, name, None
+
+    def __call__(self, *args):
+        fn = self._fn
+        if fn is None:
+            from steerlab.sim.drivers import entry
+
+            fn = self._fn = entry(self._mod, self._name)
+        return fn(*args)
+
+    @property
+    def dispatcher(self):
+        """The numba dispatcher (for inspection: signatures, LLVM IR)."""
+        return getattr(self._mod, self._name)

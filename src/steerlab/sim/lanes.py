@@ -33,127 +33,22 @@ from concurrent.futures import ThreadPoolExecutor, as_completed
 from functools import lru_cache
 
 import numba
-import numpy as np
 
-from steerlab.angles import wrap_to_pi
 from steerlab.guidance.reference_models import course_guide
-from steerlab.guidance.reference_vector import N_REF, REF_LEG, REF_RPM, REF_XTE
-from steerlab.metrics_online import accumulate
-from steerlab.sim.kernels import _fused, _jit_fused, _plant_kernels, rk4_stage, rk4_update
 
 LANES = 16
 """Runs advanced together by one thread of the batch engine (two AVX-512 vectors of float64;
 measured on W1: 8 lanes 0.78x, 32 lanes 0.99x the speed of 16)."""
 
 
-@lru_cache(maxsize=None)
-def _group_kernels(ship_rhs, nx: int):
-    """``(load, store, rk4_lanes, record_lanes)`` for a ship model with plant state size ``nx``.
-
-    * ``load(X, PS, PG, i0, n_act, XL, PL, PGL)``: copy the group's states and ship and gear
-      records into the structure-of-arrays scratch (columns = runs).
-    * ``store(X, i0, n_act, XL)``: copy the states back.
-    * ``rk4_lanes(...)``: one RK4 step of every run of the group, stage by stage, then the
-      metrics accumulator; the same operations per run as ``rk4`` of
-      :func:`~steerlab.sim.kernels._plant_kernels`.
-    * ``record_lanes(...)``: write one logged row of every run of the group.
-    """
-    NX = int(nx)
-    _, _, plant_rhs, clamp = _plant_kernels(ship_rhs, NX)
-    acc_step = _fused(accumulate)
-
-    @_jit_fused
-    def load(X, PS, PG, i0, n_act, XL, PL, PGL):
-        for g in range(n_act):
-            i = i0 + g
-            for q in range(NX):
-                XL[q, g] = X[i, q]
-            for q in range(PS.shape[1]):
-                PL[q, g] = PS[i, q]
-            for q in range(PG.shape[1]):
-                PGL[q, g] = PG[i, q]
-
-    @_jit_fused
-    def store(X, i0, n_act, XL):
-        for g in range(n_act):
-            for q in range(NX):
-                X[i0 + g, q] = XL[q, g]
-
-    @_jit_fused
-    def rk4_lanes(t, k, i0, n_act, CMD, W, w_index, dt, h2, s6, ACC, E, DPREV,
-                  XL, PL, PGL, WL, K1, K2, K3, K4, XT):
-        # this step's disturbance row of every run, as columns
-        for g in range(n_act):
-            row = W[w_index[i0 + g], k]
-            for c in range(row.shape[0]):
-                WL[c, g] = row[c]
-            DPREV[g] = XL[NX - 1, g]
-        t2 = t + h2
-        # the loops over g below are the vectorised ones: keep their bodies free of calls
-        for g in range(n_act):
-            plant_rhs(t, XL[:, g], CMD[g], WL[:, g], PL[:, g], PGL[:, g], K1[:, g])
-        for q in range(NX):
-            for g in range(n_act):
-                XT[q, g] = rk4_stage(XL[q, g], h2, K1[q, g])
-        for g in range(n_act):
-            plant_rhs(t2, XT[:, g], CMD[g], WL[:, g], PL[:, g], PGL[:, g], K2[:, g])
-        for q in range(NX):
-            for g in range(n_act):
-                XT[q, g] = rk4_stage(XL[q, g], h2, K2[q, g])
-        for g in range(n_act):
-            plant_rhs(t2, XT[:, g], CMD[g], WL[:, g], PL[:, g], PGL[:, g], K3[:, g])
-        for q in range(NX):
-            for g in range(n_act):
-                XT[q, g] = rk4_stage(XL[q, g], dt, K3[q, g])
-        for g in range(n_act):
-            plant_rhs(t + dt, XT[:, g], CMD[g], WL[:, g], PL[:, g], PGL[:, g], K4[:, g])
-        for q in range(NX):
-            for g in range(n_act):
-                XL[q, g] = rk4_update(XL[q, g], s6, K1[q, g], K2[q, g], K3[q, g], K4[q, g])
-        for g in range(n_act):
-            XL[NX - 1, g] = clamp(XL[NX - 1, g], PGL[:, g])
-        for g in range(n_act):
-            acc_step(ACC[i0 + g], t, E[g], DPREV[g], XL[NX - 1, g], dt)
-
-    @_jit_fused
-    def record_lanes(XL, CMD, REF, i0, n_act, j, nr, out_x, out_cmd, out_ref):
-        """Write row ``j`` of the logs of runs ``i0 .. i0 + n_act - 1`` (first ``nr`` reference entries)."""
-        for g in range(n_act):
-            i = i0 + g
-            for q in range(NX):
-                out_x[i, j, q] = XL[q, g]
-            out_cmd[i, j] = CMD[g]
-            for q in range(nr):
-                out_ref[i, j, q] = REF[g, q]
-
-    return load, store, rk4_lanes, record_lanes
-
-
-@lru_cache(maxsize=None)
-def _scratch(nx: int, lanes: int):
-    """``scratch(n_ps, n_pg, n_w)``: a group's structure-of-arrays scratch (a column per run),
-    inlined into its caller so that the compiler sees the shapes and that the arrays are
-    distinct: ``XL, PL, PGL, WL, K1, K2, K3, K4, XT`` (rows: state, ship record, gear record,
-    disturbance channel) and ``CMD, E, DPREV`` (one entry per run)."""
-    NX = int(nx)
-    G = int(lanes)
-
-    @numba.njit(inline="always")
-    def scratch(n_ps, n_pg, n_w):
-        return (np.empty((NX, G)), np.empty((n_ps, G)), np.empty((n_pg, G)), np.empty((n_w, G)),
-                np.empty((NX, G)), np.empty((NX, G)), np.empty((NX, G)), np.empty((NX, G)),
-                np.empty((NX, G)), np.empty(G), np.empty(G), np.empty(G))
-
-    return scratch
-
-
-@lru_cache(maxsize=None)
 def lane_loop(ship_rhs, ctrl_update, guide, nx: int, lanes: int = LANES):
     """Compiled loop advancing a group of up to ``lanes`` independent runs in lock step.
 
     Same kernels and the same operations, in the same order, per run as
     :func:`~steerlab.sim.kernels.guided_closed_loop` (so each run's numbers are bit-identical
     to its single run); only the schedule and the memory layout differ (module docstring).
+    It is the ``group`` entry point of the combination's driver
+    (:mod:`steerlab.sim.driver_template`, cached on disk by :mod:`steerlab.sim.drivers`).
 
     ``group(X, Z, PS, PG, PC, GD, GZ, W, w_index, i0, n_act, dt, nc, n_steps, rec_every,
     out_x, out_cmd, out_ref, ACC, rpm_slot)`` advances runs ``i0 .. i0 + n_act - 1`` of the
@@ -162,64 +57,9 @@ def lane_loop(ship_rhs, ctrl_update, guide, nx: int, lanes: int = LANES):
     as a function of its own, called once per group: its scratch arrays are allocated inside
     it, with shapes the compiler sees (which the vectoriser needs).
     """
-    NX = int(nx)
-    G = int(lanes)
-    load, store, rk4_lanes, record_lanes = _group_kernels(ship_rhs, NX)
-    scratch = _scratch(NX, G)
-    update = _fused(ctrl_update)
-    reference = _fused(guide)
-    wrap = _fused(wrap_to_pi)
-    NR = N_REF
-    RPM = REF_RPM
+    from steerlab.sim.drivers import driver
 
-    @numba.njit(nogil=True)
-    def group(X, Z, PS, PG, PC, GD, GZ, W, w_index, i0, n_act, dt, nc, n_steps, rec_every,
-              out_x, out_cmd, out_ref, ACC, rpm_slot):
-        XL, PL, PGL, WL, K1, K2, K3, K4, XT, CMD, E, DPREV = scratch(PS.shape[1], PG.shape[1], W.shape[2])
-        REF = np.zeros((G, NR))
-        for g in range(G):
-            REF[g, REF_RPM] = -1.0
-            REF[g, REF_XTE] = np.nan
-            REF[g, REF_LEG] = -1.0
-        load(X, PS, PG, i0, n_act, XL, PL, PGL)
-        h = nc * dt
-        h2 = 0.5 * dt
-        s6 = dt / 6.0
-        nr = min(out_ref.shape[2], NR)
-        j = 0
-        kc = 0
-        kr = 0
-        for g in range(n_act):
-            CMD[g] = 0.0
-        for k in range(n_steps + 1):
-            t = k * dt
-            sample = kc == 0
-            for g in range(n_act):
-                i = i0 + g
-                if sample:
-                    reference(t, XL[:, g], GD[i], GZ[i], REF[g], h)
-                    if rpm_slot >= 0 and REF[g, RPM] >= 0.0:
-                        PS[i, rpm_slot] = REF[g, RPM]
-                        PL[rpm_slot, g] = REF[g, RPM]
-                E[g] = wrap(REF[g, 0] - XL[2, g])
-                if sample:
-                    CMD[g] = update(Z[i], PC[i], t, XL[:, g], REF[g], h)
-            kc += 1
-            if kc == nc:
-                kc = 0
-            if kr == 0:
-                record_lanes(XL, CMD, REF, i0, n_act, j, nr, out_x, out_cmd, out_ref)
-                j += 1
-            kr += 1
-            if kr == rec_every:
-                kr = 0
-            if k == n_steps:
-                break
-            rk4_lanes(t, k, i0, n_act, CMD, W, w_index, dt, h2, s6, ACC, E, DPREV,
-                      XL, PL, PGL, WL, K1, K2, K3, K4, XT)
-        store(X, i0, n_act, XL)
-
-    return group
+    return driver(ship_rhs, ctrl_update, guide, int(nx), int(lanes)).group
 
 
 PROGRESS_PERIOD = 0.5
@@ -297,7 +137,9 @@ def batch_loop(ship_rhs, ctrl_update, nx: int, lanes: int = LANES, guide=None):
     runs in the same sea store it once); ``PS`` (at ``rpm_slot``, when >= 0) and ``GZ`` are
     modified in place; ``progress(done, n)``: see :func:`_run_groups`.
     """
-    group = lane_loop(ship_rhs, ctrl_update, course_guide if guide is None else guide, int(nx), int(lanes))
+    from steerlab.sim.drivers import driver, entry
+
+    mod = driver(ship_rhs, ctrl_update, course_guide if guide is None else guide, int(nx), int(lanes))
     G = int(lanes)
     NX = int(nx)
 
@@ -305,6 +147,7 @@ def batch_loop(ship_rhs, ctrl_update, nx: int, lanes: int = LANES, guide=None):
                   out_x, out_cmd, out_ref, ACC, rpm_slot, progress=None):
         if X.shape[1] != NX:
             raise ValueError("plant state size differs from the one this loop was built for")
+        group = entry(mod, "group")
         _run_groups(lambda i0, n_act: group(X, Z, PS, PG, PC, GD, GZ, W, w_index, i0, n_act, dt, nc,
                                             n_steps, rec_every, out_x, out_cmd, out_ref, ACC, rpm_slot),
                     X.shape[0], G, progress)

@@ -1,0 +1,294 @@
+"""The compiled driver of one (ship, controller, guidance) combination: template source.
+
+:mod:`steerlab.sim.drivers` turns this file into a small module per combination, in the
+driver cache directory, by replacing the *bindings* block below with the combination's
+kernels (named by :mod:`steerlab.kernel_refs`) and sizes. Every kernel of the driver is then
+a module global, so numba's disk cache (``cache=True`` on the entry points) keeps the fused
+machine code across processes: a fresh process loads it instead of compiling for seconds.
+The package fingerprint is part of the cache directory, so a changed steerlab never serves
+stale code.
+
+What is in a driver (one definition of each loop, for every engine):
+
+* the plant: ship + steering gear right-hand side (``plant_rhs``), one RK4 step (``rk4``),
+  and ``rk4_step`` (the step the readable engine, the runtime's ship server and the trials
+  call from Python);
+* ``run``: the single run's closed loop (:func:`steerlab.sim.kernels.guided_closed_loop`
+  documents its arguments);
+* ``group``: the batch engine's loop over a group of ``LANES`` runs in lock step,
+  structure of arrays, vectorised across the runs (:mod:`steerlab.sim.lanes` documents it).
+
+Per run, both loops perform the same operations in the same order, so a batch run is
+bit-identical to the same run alone; the readable engine calls the same ``rk4_step``.
+Only what is called is compiled: a process that runs one scenario compiles (or loads) only
+``run``.
+
+This file is importable as it is (the placeholder bindings bind nothing): the package
+fingerprint covers it like any other source file.
+"""
+
+# flake8: noqa: E402
+from __future__ import annotations
+
+import numba
+import numpy as np
+
+from steerlab.angles import wrap_to_pi
+from steerlab.guidance.reference_vector import N_REF, REF_LEG, REF_RPM, REF_XTE
+from steerlab.metrics_online import accumulate
+from steerlab.sim.kernels import _fused, _jit_fused, rk4_stage, rk4_update
+from steerlab.steering_gear import gear_clamp, gear_rate
+
+# ---- bindings: replaced in every generated driver ----
+SHIP_RHS = None       # ship kernel rhs(t, x, delta, w, ps, dx)
+CTRL_UPDATE = None    # controller kernel update(z, p, t, x, ref, h) -> delta_cmd
+GUIDE = None          # guidance kernel guide(t, x, gd, gz, ref, h)
+NX = 0                # plant state size (ship states + rudder); 0 = any (read from x)
+LANES = 16            # runs per batch group
+CACHE = False         # numba disk cache for the entry points
+# ---- end of bindings ----
+
+ship = _fused(SHIP_RHS)
+rate = _fused(gear_rate)
+clamp = _fused(gear_clamp)
+update = _fused(CTRL_UPDATE)
+reference = _fused(GUIDE)
+acc_step = _fused(accumulate)
+wrap = _fused(wrap_to_pi)
+NR = N_REF
+RPM = REF_RPM
+G = LANES
+
+
+# ---------------------------------------------------------------- plant: ship + gear, RK4
+
+@_jit_fused
+def plant_rhs(t, x, delta_cmd, w, ps, pg, dx):
+    """Plant derivative: the ship's ``dx`` and the gear's rudder rate (last state)."""
+    nd = (x.shape[0] if NX == 0 else NX) - 1
+    delta = x[nd]
+    ship(t, x, delta, w, ps, dx)
+    dx[nd] = rate(delta, delta_cmd, pg)
+
+
+@_jit_fused
+def rk4(t, x, delta_cmd, w, ps, pg, dt, k1, k2, k3, k4, xt):
+    """Advance ``x`` in place by one RK4 step; ``k1..k4``, ``xt`` are (nx,) scratch."""
+    nx = x.shape[0] if NX == 0 else NX
+    h2 = 0.5 * dt
+    plant_rhs(t, x, delta_cmd, w, ps, pg, k1)
+    for i in range(nx):
+        xt[i] = rk4_stage(x[i], h2, k1[i])
+    plant_rhs(t + h2, xt, delta_cmd, w, ps, pg, k2)
+    for i in range(nx):
+        xt[i] = rk4_stage(x[i], h2, k2[i])
+    plant_rhs(t + h2, xt, delta_cmd, w, ps, pg, k3)
+    for i in range(nx):
+        xt[i] = rk4_stage(x[i], dt, k3[i])
+    plant_rhs(t + dt, xt, delta_cmd, w, ps, pg, k4)
+    s = dt / 6.0
+    for i in range(nx):
+        x[i] = rk4_update(x[i], s, k1[i], k2[i], k3[i], k4[i])
+    x[nx - 1] = clamp(x[nx - 1], pg)
+
+
+@numba.njit(cache=CACHE)
+def rk4_step(t, x, delta_cmd, w, ps, pg, dt, work):
+    """Advance ``x`` in place by one RK4 step; ``work`` is a (5, nx) scratch array."""
+    rk4(t, x, delta_cmd, w, ps, pg, dt, work[0], work[1], work[2], work[3], work[4])
+
+
+# ---------------------------------------------------------------- the single run
+
+@_jit_fused
+def loop(x, z, ps, pg, pc, gd, gz, w, dt, nc, n_steps, rec_every, out_x, out_cmd, out_ref,
+         acc, rpm_slot, k1, k2, k3, k4, xt, ref):
+    nx = x.shape[0] if NX == 0 else NX
+    nr = min(out_ref.shape[1], NR)
+    cmd = 0.0
+    h = nc * dt
+    j = 0
+    kc = 0
+    kr = 0
+    for k in range(n_steps + 1):
+        t = k * dt
+        sample = kc == 0
+        if sample:
+            reference(t, x, gd, gz, ref, h)
+            if rpm_slot >= 0 and ref[RPM] >= 0.0:
+                ps[rpm_slot] = ref[RPM]
+        e = wrap(ref[0] - x[2])
+        if sample:
+            cmd = update(z, pc, t, x, ref, h)
+        kc += 1
+        if kc == nc:
+            kc = 0
+        if kr == 0:
+            for i in range(nx):
+                out_x[j, i] = x[i]
+            out_cmd[j] = cmd
+            for q in range(nr):
+                out_ref[j, q] = ref[q]
+            j += 1
+        kr += 1
+        if kr == rec_every:
+            kr = 0
+        if k == n_steps:
+            break
+        delta = x[nx - 1]
+        rk4(t, x, cmd, w[k], ps, pg, dt, k1, k2, k3, k4, xt)
+        acc_step(acc, t, e, delta, x[nx - 1], dt)
+
+
+@numba.njit(cache=CACHE)
+def run(x, z, ps, pg, pc, gd, gz, w, dt, nc, n_steps, rec_every, out_x, out_cmd, out_ref, acc,
+        rpm_slot):
+    """The single run's closed loop (arguments: :func:`steerlab.sim.kernels.guided_closed_loop`)."""
+    nx = x.shape[0]
+    if NX != 0 and nx != NX:
+        raise ValueError("plant state size differs from the one this loop was built for")
+    k1 = np.empty(nx)
+    k2 = np.empty(nx)
+    k3 = np.empty(nx)
+    k4 = np.empty(nx)
+    xt = np.empty(nx)
+    ref = np.zeros(NR)
+    ref[RPM] = -1.0
+    ref[REF_XTE] = np.nan
+    ref[REF_LEG] = -1.0
+    loop(x, z, ps, pg, pc, gd, gz, w, dt, nc, n_steps, rec_every, out_x, out_cmd, out_ref, acc,
+         rpm_slot, k1, k2, k3, k4, xt, ref)
+
+
+# ---------------------------------------------------------------- the batch: groups of LANES runs
+
+@_jit_fused
+def load(X, PS, PG, i0, n_act, XL, PL, PGL):
+    """Copy the group's states and ship and gear records into the scratch (columns = runs)."""
+    for g in range(n_act):
+        i = i0 + g
+        for q in range(NX):
+            XL[q, g] = X[i, q]
+        for q in range(PS.shape[1]):
+            PL[q, g] = PS[i, q]
+        for q in range(PG.shape[1]):
+            PGL[q, g] = PG[i, q]
+
+
+@_jit_fused
+def store(X, i0, n_act, XL):
+    """Copy the group's states back."""
+    for g in range(n_act):
+        for q in range(NX):
+            X[i0 + g, q] = XL[q, g]
+
+
+@_jit_fused
+def rk4_lanes(t, k, i0, n_act, CMD, W, w_index, dt, h2, s6, ACC, E, DPREV,
+              XL, PL, PGL, WL, K1, K2, K3, K4, XT):
+    """One RK4 step of every run of the group, stage by stage, then the metrics accumulator;
+    per run the same operations as :func:`rk4`."""
+    # this step's disturbance row of every run, as columns
+    for g in range(n_act):
+        row = W[w_index[i0 + g], k]
+        for c in range(row.shape[0]):
+            WL[c, g] = row[c]
+        DPREV[g] = XL[NX - 1, g]
+    t2 = t + h2
+    # the loops over g below are the vectorised ones: keep their bodies free of calls
+    for g in range(n_act):
+        plant_rhs(t, XL[:, g], CMD[g], WL[:, g], PL[:, g], PGL[:, g], K1[:, g])
+    for q in range(NX):
+        for g in range(n_act):
+            XT[q, g] = rk4_stage(XL[q, g], h2, K1[q, g])
+    for g in range(n_act):
+        plant_rhs(t2, XT[:, g], CMD[g], WL[:, g], PL[:, g], PGL[:, g], K2[:, g])
+    for q in range(NX):
+        for g in range(n_act):
+            XT[q, g] = rk4_stage(XL[q, g], h2, K2[q, g])
+    for g in range(n_act):
+        plant_rhs(t2, XT[:, g], CMD[g], WL[:, g], PL[:, g], PGL[:, g], K3[:, g])
+    for q in range(NX):
+        for g in range(n_act):
+            XT[q, g] = rk4_stage(XL[q, g], dt, K3[q, g])
+    for g in range(n_act):
+        plant_rhs(t + dt, XT[:, g], CMD[g], WL[:, g], PL[:, g], PGL[:, g], K4[:, g])
+    for q in range(NX):
+        for g in range(n_act):
+            XL[q, g] = rk4_update(XL[q, g], s6, K1[q, g], K2[q, g], K3[q, g], K4[q, g])
+    for g in range(n_act):
+        XL[NX - 1, g] = clamp(XL[NX - 1, g], PGL[:, g])
+    for g in range(n_act):
+        acc_step(ACC[i0 + g], t, E[g], DPREV[g], XL[NX - 1, g], dt)
+
+
+@_jit_fused
+def record_lanes(XL, CMD, REF, i0, n_act, j, nr, out_x, out_cmd, out_ref):
+    """Write row ``j`` of the logs of runs ``i0 .. i0 + n_act - 1`` (first ``nr`` reference entries)."""
+    for g in range(n_act):
+        i = i0 + g
+        for q in range(NX):
+            out_x[i, j, q] = XL[q, g]
+        out_cmd[i, j] = CMD[g]
+        for q in range(nr):
+            out_ref[i, j, q] = REF[g, q]
+
+
+@numba.njit(inline="always")
+def scratch(n_ps, n_pg, n_w):
+    """A group's structure-of-arrays scratch, inlined into its caller so that the compiler sees
+    the shapes and that the arrays are distinct: ``XL, PL, PGL, WL, K1, K2, K3, K4, XT`` (rows:
+    state, ship record, gear record, disturbance channel) and ``CMD, E, DPREV`` (one per run)."""
+    return (np.empty((NX, G)), np.empty((n_ps, G)), np.empty((n_pg, G)), np.empty((n_w, G)),
+            np.empty((NX, G)), np.empty((NX, G)), np.empty((NX, G)), np.empty((NX, G)),
+            np.empty((NX, G)), np.empty(G), np.empty(G), np.empty(G))
+
+
+@numba.njit(nogil=True, cache=CACHE)
+def group(X, Z, PS, PG, PC, GD, GZ, W, w_index, i0, n_act, dt, nc, n_steps, rec_every,
+          out_x, out_cmd, out_ref, ACC, rpm_slot):
+    """Advance runs ``i0 .. i0 + n_act - 1`` of the batch arrays in place
+    (arguments: :func:`steerlab.sim.lanes.lane_loop`)."""
+    XL, PL, PGL, WL, K1, K2, K3, K4, XT, CMD, E, DPREV = scratch(PS.shape[1], PG.shape[1], W.shape[2])
+    REF = np.zeros((G, NR))
+    for g in range(G):
+        REF[g, REF_RPM] = -1.0
+        REF[g, REF_XTE] = np.nan
+        REF[g, REF_LEG] = -1.0
+    load(X, PS, PG, i0, n_act, XL, PL, PGL)
+    h = nc * dt
+    h2 = 0.5 * dt
+    s6 = dt / 6.0
+    nr = min(out_ref.shape[2], NR)
+    j = 0
+    kc = 0
+    kr = 0
+    for g in range(n_act):
+        CMD[g] = 0.0
+    for k in range(n_steps + 1):
+        t = k * dt
+        sample = kc == 0
+        for g in range(n_act):
+            i = i0 + g
+            if sample:
+                reference(t, XL[:, g], GD[i], GZ[i], REF[g], h)
+                if rpm_slot >= 0 and REF[g, RPM] >= 0.0:
+                    PS[i, rpm_slot] = REF[g, RPM]
+                    PL[rpm_slot, g] = REF[g, RPM]
+            E[g] = wrap(REF[g, 0] - XL[2, g])
+            if sample:
+                CMD[g] = update(Z[i], PC[i], t, XL[:, g], REF[g], h)
+        kc += 1
+        if kc == nc:
+            kc = 0
+        if kr == 0:
+            record_lanes(XL, CMD, REF, i0, n_act, j, nr, out_x, out_cmd, out_ref)
+            j += 1
+        kr += 1
+        if kr == rec_every:
+            kr = 0
+        if k == n_steps:
+            break
+        rk4_lanes(t, k, i0, n_act, CMD, W, w_index, dt, h2, s6, ACC, E, DPREV,
+                  XL, PL, PGL, WL, K1, K2, K3, K4, XT)
+    store(X, i0, n_act, XL)

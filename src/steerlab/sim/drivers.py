@@ -1,0 +1,298 @@
+"""Compiled drivers, compiled once ever: one generated module per combination, cached on disk.
+
+A *driver* is the compiled closed loop of one (ship, controller, guidance, plant size,
+lanes) combination: the single run, the batch group and the plant step
+(:mod:`steerlab.sim.driver_template`). Numba cannot cache closures across processes, so
+instead of building the loops as closures this module writes each combination's driver as
+a small Python module in the driver cache directory, whose kernels are module globals, and
+compiles its entry points with numba's disk cache. A fresh process imports the module and
+loads the machine code (tens of milliseconds) instead of compiling it (seconds).
+
+Cache layout and guarantees
+---------------------------
+``<cache root>/drivers/<steerlab fingerprint>/d_<hash>.py`` (+ numba's ``__pycache__``):
+
+* **Never stale.** The directory is named after the fingerprint of the whole steerlab
+  package (:func:`steerlab.numba_cache.package_fingerprint`): any change to steerlab's source
+  uses a new directory. Inside it the file name is the hash of the module's text, and numba's
+  stamp of a driver is that name (not the file's modification time), so rewriting a file
+  with the same text never invalidates its machine code.
+* **Safe under concurrent writers** (two CLI runs, pytest workers, Dask workers): a module is
+  created by writing a temporary file and linking it into place only if absent; numba
+  writes its cache files by atomic rename. Two processes compiling the same combination at
+  once both succeed (each compiles; the last rename wins; both results are identical).
+* **Corrupt entries are rebuilt.** Before the first use in a process, the driver's module
+  text and numba's index and data files are read back; a truncated or unreadable file is
+  deleted and the driver recompiled, never a crash.
+
+Kernels that cannot be named by :mod:`steerlab.kernel_refs` (defined in ``__main__``, a
+notebook, a closure) get the same driver built in memory and compiled in the process, as
+before. ``STEERLAB_DRIVER_CACHE=0`` forces that for everything.
+
+The cache root is ``$STEERLAB_CACHE_DIR``, else ``$XDG_CACHE_HOME/steerlab``, else
+``~/.cache/steerlab``. ``steerlab cache info|clear|warm`` manages it.
+"""
+
+from __future__ import annotations
+
+import glob
+import hashlib
+import importlib.util
+import os
+import pickle
+import shutil
+import sys
+import threading
+import types
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Callable, Optional
+
+from steerlab.kernel_refs import describe, kernel_ref
+from steerlab.numba_cache import _fingerprint
+
+TEMPLATE = Path(__file__).with_name("driver_template.py")
+BEGIN = "# ---- bindings: replaced in every generated driver ----"
+END = "# ---- end of bindings ----"
+ENTRY_POINTS = ("run", "group", "rk4_step")
+MODULE_PREFIX = "steerlab_driver_"
+
+_LOCK = threading.RLock()
+_LOADED: dict = {}
+
+on_compile: Optional[Callable[[str], None]] = None
+"""Called with a one-line message when a driver is about to be compiled (not loaded from the
+disk cache). The library leaves it ``None`` (silent); the CLI sets it to print to stderr."""
+
+
+def cache_root() -> Path:
+    """Root of steerlab's caches (see the module docstring)."""
+    env = os.environ.get("STEERLAB_CACHE_DIR")
+    if env:
+        return Path(env)
+    xdg = os.environ.get("XDG_CACHE_HOME")
+    return (Path(xdg) if xdg else Path.home() / ".cache") / "steerlab"
+
+
+def drivers_dir() -> Path:
+    """This steerlab's driver directory (named after the package fingerprint)."""
+    return cache_root() / "drivers" / _fingerprint()[:20]
+
+
+def enabled() -> bool:
+    return os.environ.get("STEERLAB_DRIVER_CACHE", "1") != "0"
+
+
+@dataclass(frozen=True)
+class _Key:
+    ship: object
+    ctrl: object
+    guide: object
+    nx: int
+    lanes: int
+
+
+def driver(ship_rhs, ctrl_update=None, guide=None, nx: int = 0, lanes: int = 16) -> types.ModuleType:
+    """The driver module of a combination (loaded, generated or built in memory; memoised).
+
+    ``ctrl_update``/``guide`` may be None for a plant-only driver (``rk4_step``). The module
+    has the kernels of :mod:`steerlab.sim.driver_template` as attributes.
+    """
+    key = _Key(ship_rhs, ctrl_update, guide, int(nx), int(lanes))
+    mod = _LOADED.get(key)
+    if mod is not None:
+        return mod
+    with _LOCK:
+        mod = _LOADED.get(key)
+        if mod is None:
+            mod = _make(key)
+            _LOADED[key] = mod
+        return mod
+
+
+def _bindings(refs: dict, nx: int, lanes: int, cache: bool) -> str:
+    lines = [BEGIN, "from steerlab.kernel_refs import resolve as _resolve"]
+    for name in ("SHIP_RHS", "CTRL_UPDATE", "GUIDE"):
+        lines.append(f"{name} = _resolve({refs[name]!r})")
+    lines += [f"NX = {int(nx)}", f"LANES = {int(lanes)}", f"CACHE = {bool(cache)}", END]
+    return "\n".join(lines)
+
+
+def _source(bindings: str) -> str:
+    text = TEMPLATE.read_text(encoding="utf-8")
+    head, _, rest = text.partition(BEGIN)
+    _, _, tail = rest.partition(END)
+    if not tail:
+        raise RuntimeError(f"{TEMPLATE}: bindings markers missing")
+    return head + bindings + tail
+
+
+def describe_key(ship_rhs, ctrl_update, guide) -> str:
+    parts = [describe(kernel_ref(ship_rhs)) if kernel_ref(ship_rhs) else getattr(ship_rhs, "__name__", "?")]
+    for k in (ctrl_update, guide):
+        if k is not None:
+            r = kernel_ref(k)
+            parts.append(describe(r) if r else getattr(k, "__name__", "?"))
+    return " + ".join(parts)
+
+
+def _make(key: _Key) -> types.ModuleType:
+    refs = {"SHIP_RHS": kernel_ref(key.ship), "CTRL_UPDATE": kernel_ref(key.ctrl),
+            "GUIDE": kernel_ref(key.guide)}
+    nameable = all(refs[n] is not None or k is None
+                   for n, k in (("SHIP_RHS", key.ship), ("CTRL_UPDATE", key.ctrl), ("GUIDE", key.guide)))
+    if enabled() and nameable:
+        try:
+            return _from_disk(key, _source(_bindings(refs, key.nx, key.lanes, True)))
+        except OSError:          # read-only or full disk: compile in memory instead
+            pass
+    return _in_memory(key)
+
+
+def _in_memory(key: _Key) -> types.ModuleType:
+    """The driver built in this process only (kernels passed as objects, no disk cache)."""
+    text = _source("\n".join([BEGIN, "SHIP_RHS = CTRL_UPDATE = GUIDE = None",
+                              f"NX = {key.nx}", f"LANES = {key.lanes}", "CACHE = False", END]))
+    # bind the kernels as objects: replace the placeholder line before executing
+    mod = types.ModuleType(f"{MODULE_PREFIX}mem_{id(key):x}")
+    mod.__file__ = str(TEMPLATE)
+    code = compile(text.replace("SHIP_RHS = CTRL_UPDATE = GUIDE = None",
+                                "SHIP_RHS, CTRL_UPDATE, GUIDE = _KERNELS"), str(TEMPLATE), "exec")
+    mod.__dict__["_KERNELS"] = (key.ship, key.ctrl, key.guide)
+    sys.modules[mod.__name__] = mod
+    exec(code, mod.__dict__)
+    mod._steerlab_cached = False
+    mod._steerlab_label = describe_key(key.ship, key.ctrl, key.guide)
+    return mod
+
+
+def _write_once(path: Path, text: str) -> None:
+    """Create ``path`` with ``text`` unless it already holds exactly that (atomic, race-free)."""
+    data = text.encode("utf-8")
+    try:
+        if path.read_bytes() == data:
+            return
+    except OSError:
+        pass
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_name(f".{path.name}.{os.getpid()}.{threading.get_ident()}.tmp")
+    tmp.write_bytes(data)
+    try:
+        os.replace(tmp, path)   # same text from every writer: the last rename wins, harmlessly
+    finally:
+        if tmp.exists():
+            tmp.unlink()
+
+
+def _from_disk(key: _Key, text: str) -> types.ModuleType:
+    digest = hashlib.sha1(text.encode("utf-8")).hexdigest()[:20]
+    name = f"{MODULE_PREFIX}{digest}"
+    path = drivers_dir() / f"d_{digest}.py"
+    _write_once(path, text)
+    mod = sys.modules.get(name)
+    if mod is None:
+        spec = importlib.util.spec_from_file_location(name, path)
+        mod = importlib.util.module_from_spec(spec)
+        sys.modules[name] = mod
+        try:
+            spec.loader.exec_module(mod)
+        except BaseException:
+            sys.modules.pop(name, None)
+            raise
+    for entry in ENTRY_POINTS:
+        _check_cache_files(getattr(mod, entry))
+    mod._steerlab_cached = True
+    mod._steerlab_label = describe_key(key.ship, key.ctrl, key.guide)
+    return mod
+
+
+def _cache_files(dispatcher) -> tuple[Optional[str], list[str]]:
+    """numba's index file of a cached dispatcher and its data files (numba internals, guarded)."""
+    try:
+        cf = dispatcher._cache._cache_file
+        index = cf._index_path
+        pattern = glob.escape(cf._data_name_pattern.replace("{number:d}", "@")).replace("@", "*")
+        return index, glob.glob(os.path.join(glob.escape(cf._cache_path), pattern))
+    except AttributeError:
+        return None, []
+
+
+def _check_cache_files(dispatcher) -> bool:
+    """Read back the dispatcher's cache files; delete them all if one is unreadable.
+
+    Returns whether they were fine (or absent)."""
+    index, data = _cache_files(dispatcher)
+    if index is None or not os.path.exists(index):
+        return True
+    try:
+        with open(index, "rb") as f:
+            pickle.load(f)
+            pickle.loads(f.read())
+        for path in data:
+            with open(path, "rb") as f:
+                pickle.loads(f.read())
+        return True
+    except Exception:  # noqa: BLE001 - any unreadable entry: rebuild it
+        for path in [index, *data]:
+            try:
+                os.unlink(path)
+            except OSError:
+                pass
+        return False
+
+
+def is_compiled_on_disk(mod: types.ModuleType, entry: str) -> bool:
+    """Whether ``mod.entry`` has machine code in the disk cache (or in this process)."""
+    disp = getattr(mod, entry)
+    if disp.signatures:
+        return True
+    if not getattr(mod, "_steerlab_cached", False):
+        return False
+    index, data = _cache_files(disp)
+    return index is not None and os.path.exists(index) and bool(data)
+
+
+def entry(mod: types.ModuleType, name: str):
+    """``mod.name``, after telling :data:`on_compile` if calling it will compile."""
+    disp = getattr(mod, name)
+    if on_compile is not None and not disp.signatures and not is_compiled_on_disk(mod, name):
+        what = {"run": "closed loop", "group": "batch loop", "rk4_step": "plant step"}[name]
+        on_compile(f"steerlab: compiling the {what} for {mod._steerlab_label} "
+                   f"(first use{'; cached for next time' if mod._steerlab_cached else ''}) ...")
+    return disp
+
+
+# ---------------------------------------------------------------- cache management
+
+def cache_info() -> dict:
+    """What the cache holds: root, this steerlab's directory, drivers, files and bytes."""
+    root = cache_root()
+    here = drivers_dir()
+    dirs = sorted(p for p in (root / "drivers").glob("*") if p.is_dir()) if (root / "drivers").exists() else []
+
+    def size(p: Path) -> int:
+        return sum(f.stat().st_size for f in p.rglob("*") if f.is_file())
+
+    return {"root": str(root), "current": str(here),
+            "drivers": len(list(here.glob("d_*.py"))) if here.exists() else 0,
+            "compiled_files": len(list((here / "__pycache__").glob("*.nbc"))) if here.exists() else 0,
+            "bytes": size(here) if here.exists() else 0,
+            "stale_versions": [p.name for p in dirs if p != here],
+            "stale_bytes": sum(size(p) for p in dirs if p != here)}
+
+
+def cache_clear(stale_only: bool = False) -> int:
+    """Delete the driver cache (or only other steerlab versions'); returns bytes freed."""
+    root = cache_root() / "drivers"
+    if not root.exists():
+        return 0
+    here = drivers_dir()
+    freed = 0
+    for p in root.iterdir():
+        if stale_only and p == here:
+            continue
+        freed += sum(f.stat().st_size for f in p.rglob("*") if f.is_file())
+        shutil.rmtree(p, ignore_errors=True)
+    with _LOCK:
+        _LOADED.clear()
+    return freed
