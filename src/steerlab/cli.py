@@ -114,7 +114,7 @@ def cmd_run(args) -> int:
     say(f"scenario {scenario.name!r} from {path}")
     setup = build(scenario)
     say(f"simulating {setup.n_steps} steps of {setup.dt} s with the {args.engine} engine "
-        f"({setup.ship.name} + {setup.controller.name}; first call compiles, a few seconds)")
+        f"({setup.ship.name} + {setup.controller.name})")
     result = simulate(setup, engine=args.engine)
     metrics = compute_metrics(result, lam=args.lam)
     say("writing time series, metrics, figures and report")
@@ -283,6 +283,10 @@ def _version() -> str:
 def main(argv=None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
+    if not getattr(args, "quiet", False):
+        from steerlab.sim import drivers
+
+        drivers.on_compile = lambda msg: print(msg, file=sys.stderr, flush=True)
     try:
         return args.func(args)
     except InputError as err:

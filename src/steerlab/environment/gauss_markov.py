@@ -16,6 +16,7 @@ import math
 
 import numpy as np
 
+from steerlab.environment.iir_filter import lfilter
 from steerlab.errors import require_finite_range
 
 
@@ -29,6 +30,4 @@ def gauss_markov(n_steps: int, dt: float, rng: np.random.Generator, sigma: float
     drive = n * sigma * math.sqrt(max(1.0 - a * a, 0.0))
     drive[0] = n[0] * sigma
     # x[0] = sigma n0; x[k] = a x[k-1] + drive[k]
-    from scipy.signal import lfilter
-
     return lfilter([1.0], [1.0, -a], drive)

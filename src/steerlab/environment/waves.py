@@ -7,7 +7,8 @@ i.e. a two-sided PSD of ``P``) drives the band-pass filter::
     G(s) = 10.8 s / (s^2 + 0.672 s + 2.6729)          (eq 39; peak at 1.635 rad/s)
 
 The output is an equivalent rudder angle [rad]. The filter is discretised exactly with a
-zero-order hold at the simulation step ``dt`` (python-control ``c2d``), which is exact here
+zero-order hold at the simulation step ``dt`` (python-control ``c2d``, computed once and
+kept in steerlab's cache), which is exact here
 because the input is constant over each step (``Ts`` is a multiple of ``dt``).
 
 Output level: for ideal white noise of PSD ``P`` the stationary standard deviation would be
@@ -24,6 +25,8 @@ from functools import lru_cache
 
 import numpy as np
 
+from steerlab.disk_memo import disk_memo
+from steerlab.environment.iir_filter import lfilter
 from steerlab.errors import InputError, require_finite_range
 
 EQ39_NUM = (10.8, 0.0)
@@ -49,9 +52,19 @@ def held_white_noise(n_steps: int, dt: float, rng: np.random.Generator,
 def band_pass_eq39(dt: float, num=EQ39_NUM, den=EQ39_DEN):
     """ZOH discretisation of eq (39) at step ``dt``: returns ``(b, a)`` for ``lfilter``.
 
-    Memoised (a Monte-Carlo builds thousands of seas with the same filter); the arrays are
-    read-only.
+    Computed by python-control's ``c2d`` once and kept in steerlab's cache across processes
+    (:func:`steerlab.disk_memo.disk_memo`: the same bits, without importing python-control in
+    every run); memoised in the process too (a Monte-Carlo builds thousands of seas with the
+    same filter). The arrays are read-only.
     """
+    b, a = disk_memo("eq39_zoh", (float(dt), list(map(float, num)), list(map(float, den))),
+                     lambda: _c2d_zoh(dt, num, den), packages=("control", "scipy", "numpy"))
+    b.flags.writeable = False
+    a.flags.writeable = False
+    return b, a
+
+
+def _c2d_zoh(dt: float, num, den):
     import control
 
     sysd = control.c2d(control.tf(list(num), list(den)), dt, method="zoh")
@@ -60,8 +73,6 @@ def band_pass_eq39(dt: float, num=EQ39_NUM, den=EQ39_DEN):
     # python-control drops the leading zero of a strictly proper numerator; lfilter needs it
     # (otherwise output k would see input k: the sequence would run one step early)
     b = np.concatenate([np.zeros(len(a) - len(b)), b])
-    b.flags.writeable = False
-    a.flags.writeable = False
     return b, a
 
 
@@ -71,8 +82,6 @@ def coloured_noise(n_steps: int, dt: float, rng: np.random.Generator,
     white = held_white_noise(n_steps, dt, rng, sample_time, power)
     b, a = band_pass_eq39(dt)
     # ZOH discretisation: output k depends on inputs up to k-1 (b[0] == 0)
-    from scipy.signal import lfilter
-
     return lfilter(b, a, white)
 
 

@@ -1,0 +1,92 @@
+"""``steerlab cache info|clear|warm``: the on-disk cache of compiled drivers.
+
+Each (ship, controller, guidance) combination's closed loop is compiled once and kept in
+the cache (:mod:`steerlab.sim.drivers`), so later processes load it in milliseconds.
+``warm`` compiles the common catalogue combinations ahead of time (e.g. once per CI run,
+or after installing steerlab); ``clear`` deletes the cache (``--stale`` only the entries of
+other steerlab versions).
+"""
+
+from __future__ import annotations
+
+import sys
+
+EXAMPLES = """examples:
+  steerlab cache info                 # where the cache is, how many drivers, how big
+  steerlab cache warm                 # compile the common catalogue pairs (progress bar)
+  steerlab cache warm --ships esso --controllers pid adrc --batch
+  steerlab cache clear --stale        # drop the entries of other steerlab versions
+  STEERLAB_CACHE_DIR=/tmp/slc steerlab cache info"""
+
+COMMON_SHIPS = ("esso", "nomoto1", "de-keizer", "kosoko")
+COMMON_CONTROLLERS = ("pid", "adrc")
+
+
+def register(sub, formatter_class):
+    p = sub.add_parser("cache", help="the cache of compiled loops: info, clear, warm",
+                       description=__doc__.split("\n\n", 1)[1], epilog=EXAMPLES,
+                       formatter_class=formatter_class)
+    p.add_argument("action", choices=("info", "clear", "warm"))
+    p.add_argument("--stale", action="store_true", help="clear: only other steerlab versions' entries")
+    p.add_argument("--ships", nargs="+", default=list(COMMON_SHIPS), metavar="ID",
+                   help=f"warm: ship ids (default: {' '.join(COMMON_SHIPS)})")
+    p.add_argument("--controllers", nargs="+", default=list(COMMON_CONTROLLERS), metavar="TYPE",
+                   help=f"warm: controller types (default: {' '.join(COMMON_CONTROLLERS)})")
+    p.add_argument("--batch", action="store_true", help="warm: also the batch engine's loop")
+    p.add_argument("--json", action="store_true", help="info: print JSON")
+    p.add_argument("--quiet", action="store_true")
+    p.set_defaults(func=run)
+
+
+def _mb(n: int) -> str:
+    return f"{n / 1e6:.1f} MB"
+
+
+def run(args) -> int:
+    from steerlab.sim import drivers
+
+    if args.action == "info":
+        info = drivers.cache_info()
+        if args.json:
+            from steerlab.cli import dump_json
+
+            print(dump_json(info))
+        else:
+            print(f"cache root       {info['root']}")
+            print(f"this steerlab    {info['current']}")
+            print(f"drivers          {info['drivers']} ({info['compiled_files']} compiled entry points, "
+                  f"{_mb(info['bytes'])})")
+            print(f"other versions   {len(info['stale_versions'])} ({_mb(info['stale_bytes'])}; "
+                  "'steerlab cache clear --stale' removes them)")
+        return 0
+    if args.action == "clear":
+        freed = drivers.cache_clear(stale_only=args.stale)
+        print(f"freed {_mb(freed)}")
+        return 0
+    return _warm(args)
+
+
+def _warm(args) -> int:
+    from steerlab.control.registry import get_controller
+    from steerlab.ships.registry import get_ship
+    from steerlab.sim import drivers
+    from steerlab.sim.warm import warm_pair
+
+    pairs = [(s, c) for s in args.ships for c in args.controllers]
+    for s, c in pairs:            # validate every name before compiling anything
+        get_ship(s)
+        get_controller(c)
+    from steerlab.cli import _progress
+    from steerlab.progress import runs_progress
+
+    say = _progress(args.quiet)
+    report = runs_progress(say, "combinations", period=0.0)
+    for i, (s, c) in enumerate(pairs):
+        status = warm_pair(s, c, batch=args.batch)
+        if status != "ok":
+            say(f"{s} + {c}: {status}")
+        report(i + 1, len(pairs))
+    if not args.quiet:
+        print(f"warm: {len(pairs)} combination(s) compiled or already cached in "
+              f"{drivers.drivers_dir()}", file=sys.stderr)
+    return 0

@@ -1,0 +1,44 @@
+"""Compile (or load) the drivers of a (ship, controller) pair ahead of use: ``steerlab cache warm``."""
+
+from __future__ import annotations
+
+import math
+
+from steerlab.errors import InputError
+
+WARM_DURATION = 2.0
+"""Simulated time of a warming run [s]: a few steps, enough to compile every entry point."""
+
+
+def warm_scenario(ship_id: str, controller: str):
+    """A short scenario of the pair at a speed inside the ship's validity range."""
+    from steerlab.ships.registry import get_ship
+    from steerlab.sim.scenario import scenario_from_dict
+    from steerlab.units import ms_to_knots
+
+    spec = get_ship(ship_id)
+    lo, hi = spec.speed_range
+    speed_kn = 16.0 if not math.isfinite(hi) else ms_to_knots(0.5 * (lo + hi))
+    if speed_kn < ms_to_knots(lo):
+        speed_kn = ms_to_knots(lo)
+    return scenario_from_dict({
+        "name": f"warm-{ship_id}-{controller}", "seed": 0, "dt": 0.1, "duration": WARM_DURATION,
+        "ship": {"model": ship_id, "speed_kn": float(speed_kn)},
+        "controller": {"type": controller},
+        "guidance": {"psi0_deg": 0.0, "changes": []}, "environment": {}})
+
+
+def warm_pair(ship_id: str, controller: str, batch: bool = False) -> str:
+    """Run the pair's single-run loop (and the batch loop) once; returns ``"ok"`` or why not."""
+    from steerlab.sim.batch import simulate_batch
+    from steerlab.sim.engine import simulate
+    from steerlab.sim.setup import build
+
+    try:
+        setup = build(warm_scenario(ship_id, controller))
+    except InputError as err:      # a pair whose design needs more than the defaults
+        return f"skipped ({err})"
+    simulate(setup)
+    if batch:
+        simulate_batch([setup, setup])
+    return "ok"

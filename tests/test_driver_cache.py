@@ -1,0 +1,143 @@
+"""Compiled drivers cached across processes (steerlab.sim.drivers): loaded, never stale,
+safe under concurrent writers, rebuilt when corrupt; kernels named for a fresh process."""
+
+from __future__ import annotations
+
+import json
+import os
+from dataclasses import replace
+import shutil
+import subprocess
+import sys
+import textwrap
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from steerlab import kernel_refs
+from steerlab.control.registry import get_controller
+from steerlab.control.wave_filtered import wave_filtered
+from steerlab.sensors.wrapper import sensed_spec
+
+SRC = Path(__file__).resolve().parent.parent / "src"
+
+SCRIPT = textwrap.dedent("""
+    import json, sys
+    from steerlab.guidance.reference_models import course_guide
+    from steerlab.sim import drivers
+    from steerlab.sim.engine import simulate
+    from steerlab.sim.scenario import scenario_from_dict
+    from steerlab.sim.setup import build
+    s = build(scenario_from_dict({
+        "name": "cache", "seed": 0, "dt": 0.1, "duration": 60.0,
+        "ship": {"model": "nomoto1", "speed_kn": 10.0}, "controller": {"type": "pid"},
+        "guidance": {"psi0_deg": 0.0, "changes": [{"t": 1.0, "psi_deg": 10.0}]}, "environment": {}}))
+    r = simulate(s)
+    d = drivers.driver(s.ship.rhs, s.controller.update, course_guide, s.x0.shape[0])
+    print(json.dumps({"last": r.states[-1].tolist(), "cached": d._steerlab_cached,
+                      "hits": sum(d.run.stats.cache_hits.values()),
+                      "misses": sum(d.run.stats.cache_misses.values())}))
+""")
+
+
+def _run(cache: Path, src: Path = SRC, wait=True):
+    env = {**os.environ, "STEERLAB_CACHE_DIR": str(cache), "PYTHONPATH": str(src)}
+    env.pop("STEERLAB_DRIVER_CACHE", None)
+    p = subprocess.Popen([sys.executable, "-c", SCRIPT], env=env, stdout=subprocess.PIPE,
+                         stderr=subprocess.PIPE, text=True)
+    return _result(p) if wait else p
+
+
+def _result(p):
+    out, err = p.communicate(timeout=600)
+    assert p.returncode == 0, err
+    return json.loads(out.strip().splitlines()[-1])
+
+
+def test_a_fresh_process_loads_the_compiled_loop_instead_of_compiling(tmp_path):
+    first = _run(tmp_path)
+    assert first["cached"] and first["misses"] == 1 and first["hits"] == 0      # compiled, saved
+    second = _run(tmp_path)
+    assert second["misses"] == 0 and second["hits"] == 1                         # loaded
+    assert second["last"] == first["last"]                                        # same bits
+
+
+def test_two_processes_compiling_the_same_combination_at_once_both_succeed(tmp_path):
+    procs = [_run(tmp_path, wait=False) for _ in range(2)]
+    a, b = (_result(p) for p in procs)
+    assert a["last"] == b["last"]
+    third = _run(tmp_path)
+    assert third["hits"] == 1 and third["last"] == a["last"]
+
+
+def test_truncated_cache_files_are_detected_and_rebuilt(tmp_path):
+    ref = _run(tmp_path)
+    files = [f for f in tmp_path.rglob("*") if f.suffix in (".nbi", ".nbc", ".py")]
+    assert any(f.suffix == ".nbc" for f in files)
+    for f in files:                                   # truncate every entry, the module too
+        data = f.read_bytes()
+        f.write_bytes(data[: len(data) // 3])
+    again = _run(tmp_path)
+    assert again["last"] == ref["last"] and again["misses"] == 1                 # rebuilt, no crash
+    assert _run(tmp_path)["hits"] == 1                                           # and cached again
+
+
+@pytest.mark.slow
+def test_a_changed_steerlab_never_serves_stale_code(tmp_path):
+    """A real source change in a copy of the package (the Nomoto 1 ship's equation) gives the
+    new numbers in the next fresh process, with the same cache directory."""
+    src = tmp_path / "src"
+    shutil.copytree(SRC / "steerlab", src / "steerlab",
+                    ignore=shutil.ignore_patterns("__pycache__"))
+    cache = tmp_path / "cache"
+    before = _run(cache, src)
+    assert _run(cache, src)["hits"] == 1
+    model = src / "steerlab" / "ships" / "nomoto1.py"
+    text = model.read_text()
+    term = "(p[P_K] * (delta + w[W_RUDDER]) - r)"
+    assert term in text, "test needs the Nomoto 1 equation as written"
+    new = text.replace(term, "(2.0 * p[P_K] * (delta + w[W_RUDDER]) - r)")   # twice the rudder gain
+    model.write_text(new)
+    after = _run(cache, src)
+    assert after["misses"] == 1 and after["last"] != before["last"]
+
+
+def test_wrapped_kernels_have_references_that_resolve_to_themselves():
+    pid = get_controller("pid")
+    for spec in (wave_filtered(pid), sensed_spec(pid), sensed_spec(wave_filtered(pid))):
+        ref = kernel_refs.kernel_ref(spec.update)
+        assert ref is not None and ref[0] == "bound"
+        assert kernel_refs.resolve(eval(repr(ref))) is spec.update        # repr is the source form
+    assert kernel_refs.resolve(kernel_refs.kernel_ref(pid.update)) is pid.update
+
+
+def test_kernels_that_cannot_be_named_run_from_an_in_memory_driver(tmp_path, monkeypatch):
+    """A ship kernel made in a closure (no importable name) still runs, compiled in the process,
+    and gives the same numbers as the named kernel through the cached driver."""
+    import numba
+
+    from conftest import make_scenario
+
+    from steerlab.sim import drivers
+    from steerlab.sim.engine import simulate
+    from steerlab.sim.setup import build
+
+    monkeypatch.setenv("STEERLAB_CACHE_DIR", str(tmp_path))
+    setup = build(make_scenario(duration=30.0, ship={"model": "nomoto1", "speed_kn": 10.0}))
+
+    def make():
+        inner = setup.ship.rhs
+
+        @numba.njit
+        def closure_rhs(t, x, delta, w, ps, dx):
+            inner(t, x, delta, w, ps, dx)
+        return closure_rhs
+
+    rhs = make()
+    assert kernel_refs.kernel_ref(rhs) is None
+    d = drivers.driver(rhs, setup.controller.update, None, setup.x0.shape[0])
+    assert d._steerlab_cached is False
+    a = simulate(setup)
+    b = simulate(replace(setup, ship=replace(setup.ship, rhs=rhs)))
+    np.testing.assert_array_equal(a.states, b.states)

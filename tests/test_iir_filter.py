@@ -1,0 +1,56 @@
+"""steerlab's IIR loop gives scipy.signal.lfilter's bits (the wave and gust sequences use it)."""
+
+import numpy as np
+import pytest
+from scipy.signal import lfilter as scipy_lfilter
+
+from steerlab.environment.iir_filter import lfilter
+from steerlab.environment.waves import band_pass_eq39
+
+
+@pytest.mark.parametrize("dt", [0.05, 0.1, 0.5])
+def test_eq39_band_pass_bit_identical_to_scipy(dt):
+    b, a = band_pass_eq39(dt)
+    x = np.random.default_rng(7).standard_normal(20_000) * 0.01
+    np.testing.assert_array_equal(lfilter(b, a, x), scipy_lfilter(b, a, x))
+
+
+@pytest.mark.parametrize("pole", [0.0, 0.5, 0.999, -0.3])
+def test_first_order_bit_identical_to_scipy(pole):
+    x = np.random.default_rng(3).standard_normal(5_000)
+    np.testing.assert_array_equal(lfilter([1.0], [1.0, -pole], x), scipy_lfilter([1.0], [1.0, -pole], x))
+
+
+def test_fir_and_impulse_response():
+    x = np.zeros(6)
+    x[0] = 1.0
+    np.testing.assert_array_equal(lfilter([2.0, 3.0], [1.0], x), [2.0, 3.0, 0, 0, 0, 0])
+    # y[k] = 0.5 y[k-1] + x[k]: impulse response 0.5^k
+    np.testing.assert_allclose(lfilter([1.0], [1.0, -0.5], x), 0.5 ** np.arange(6))
+
+
+def test_bad_coefficients():
+    with pytest.raises(ValueError, match="a\\[0\\] must be 1"):
+        lfilter([1.0], [2.0, 1.0], np.zeros(3))
+    with pytest.raises(ValueError, match="non-empty"):
+        lfilter([], [1.0], np.zeros(3))
+
+
+def test_eq39_coefficients_from_the_disk_memo_equal_python_control(tmp_path, monkeypatch):
+    """The stored ZOH coefficients are python-control's, bit for bit, also when read back
+    in a fresh computation (and a corrupt entry is recomputed)."""
+    from steerlab.environment import waves
+
+    monkeypatch.setenv("STEERLAB_CACHE_DIR", str(tmp_path))
+    direct = waves._c2d_zoh(0.1, waves.EQ39_NUM, waves.EQ39_DEN)
+    for _ in range(2):                       # computed and stored, then read back
+        waves.band_pass_eq39.cache_clear()
+        b, a = waves.band_pass_eq39(0.1)
+        np.testing.assert_array_equal(b, direct[0])
+        np.testing.assert_array_equal(a, direct[1])
+    (entry,) = list(tmp_path.rglob("eq39_zoh_*.json"))
+    entry.write_text(entry.read_text()[:25])  # truncated
+    waves.band_pass_eq39.cache_clear()
+    b, a = waves.band_pass_eq39(0.1)
+    np.testing.assert_array_equal(b, direct[0])
+    waves.band_pass_eq39.cache_clear()
