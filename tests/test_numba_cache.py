@@ -32,7 +32,9 @@ def test_fingerprint_follows_any_file_of_the_tree(tmp_path):
     second = numba_cache.package_fingerprint(tmp_path)
     assert second != first
     st = (tmp_path / "a.py").stat()
-    os.utime(tmp_path / "a.py", ns=(st.st_atime_ns, st.st_mtime_ns + 10**9))   # same size, touched
+    os.utime(tmp_path / "a.py", ns=(st.st_atime_ns, st.st_mtime_ns + 10**9))   # touched only
+    assert numba_cache.package_fingerprint(tmp_path) == second                  # same source: same code
+    (tmp_path / "a.py").write_text("X = 7\n")                                  # same size, new text
     assert numba_cache.package_fingerprint(tmp_path) not in (first, second)
 
 

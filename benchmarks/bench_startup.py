@@ -1,0 +1,137 @@
+#!/usr/bin/env python
+"""Start-up speed: what a user waits for, whole processes, against an import-only reference.
+
+Usage::
+
+    python benchmarks/bench_startup.py                  # 5 repeats of each, medians
+    python benchmarks/bench_startup.py --repeats 9 --json > startup.json
+    python benchmarks/bench_startup.py --skip-cold      # without the cold-cache run
+
+Measured (wall time of whole processes, medians of ``--repeats``; these machines are noisy,
+so the figures that matter are the ratios to the reference measured in the same session,
+interleaved with the runs):
+
+* ``reference``: ``python -c "import numpy, numba, matplotlib.pyplot"``;
+* ``run_default_warm``: ``python -m steerlab run --out DIR --quiet`` on the bundled default
+  scenario with a warm driver cache (target: <= 1.5x the reference);
+* ``first_sim_and_batch_beyond_import``: in a fresh process with a warm cache, the time of
+  the first ``simulate`` plus the first ``simulate_batch`` (of 32 runs) after
+  ``import steerlab`` (target: <= 0.8 s);
+* ``run_default_cold``: the default run with an empty driver cache (a fresh
+  ``STEERLAB_CACHE_DIR``; target <= 10 s, and it says that it is compiling).
+
+Each measurement uses its own cache directory under a temporary folder, so the user's cache
+is neither used nor changed.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+SRC = Path(__file__).resolve().parent.parent / "src"
+
+FIRST_CALLS = """
+import time
+t0 = time.perf_counter()
+import steerlab
+from steerlab.sim.batch import simulate_batch, vary_controller
+from steerlab.sim.engine import simulate
+from steerlab.sim.scenario import default_scenario
+from steerlab.sim.setup import build
+t1 = time.perf_counter()
+setup = build(default_scenario())
+simulate(setup)
+import numpy as np
+simulate_batch(vary_controller(setup, np.tile(setup.pc, (32, 1))))
+t2 = time.perf_counter()
+print(t1 - t0, t2 - t1)
+"""
+
+
+def _env(cache: Path) -> dict:
+    env = {**os.environ, "STEERLAB_CACHE_DIR": str(cache), "MPLBACKEND": "Agg"}
+    env["PYTHONPATH"] = os.pathsep.join(p for p in (str(SRC), os.environ.get("PYTHONPATH")) if p)
+    return env
+
+
+def _timed(cmd, env) -> tuple[float, subprocess.CompletedProcess]:
+    t0 = time.perf_counter()
+    p = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=900)
+    dt = time.perf_counter() - t0
+    if p.returncode != 0:
+        raise RuntimeError(f"{' '.join(cmd)} failed: {p.stderr.strip()[-400:]}")
+    return dt, p
+
+
+def measure(repeats: int, cold: bool, progress=print) -> dict:
+    """The medians and ratios of the module docstring."""
+    py = sys.executable
+    tmp = Path(tempfile.mkdtemp(prefix="steerlab-startup-"))
+    warm = tmp / "warm"
+    out = tmp / "out"
+    reference_cmd = [py, "-c", "import numpy, numba, matplotlib.pyplot"]
+    run_cmd = [py, "-m", "steerlab", "run", "--out", str(out), "--quiet"]
+    progress("warming the cache (default run, first calls) ...")
+    _timed(run_cmd, _env(warm))
+    _timed([py, "-c", FIRST_CALLS], _env(warm))
+    ref, run, imports, first = [], [], [], []
+    for i in range(repeats):
+        progress(f"repeat {i + 1}/{repeats}")
+        ref.append(_timed(reference_cmd, _env(warm))[0])
+        run.append(_timed(run_cmd, _env(warm))[0])
+        _, p = _timed([py, "-c", FIRST_CALLS], _env(warm))
+        a, b = (float(v) for v in p.stdout.split())
+        imports.append(a)
+        first.append(b)
+    res = {
+        "repeats": repeats,
+        "reference_s": statistics.median(ref),
+        "run_default_warm_s": statistics.median(run),
+        "import_steerlab_s": statistics.median(imports),
+        "first_sim_and_batch_beyond_import_s": statistics.median(first),
+    }
+    res["run_default_warm_vs_reference"] = res["run_default_warm_s"] / res["reference_s"]
+    if cold:
+        colds = []
+        said = []
+        for i in range(max(1, min(3, repeats))):
+            progress(f"cold run {i + 1}")
+            dt, p = _timed([py, "-m", "steerlab", "run", "--out", str(out)], _env(tmp / f"cold{i}"))
+            colds.append(dt)
+            said.append("compiling" in p.stderr)
+        res["run_default_cold_s"] = statistics.median(colds)
+        res["cold_run_says_compiling"] = all(said)
+    res["targets"] = {"run_default_warm_vs_reference": 1.5, "first_sim_and_batch_beyond_import_s": 0.8,
+                      "run_default_cold_s": 10.0}
+    return res
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--repeats", type=int, default=5)
+    ap.add_argument("--skip-cold", action="store_true")
+    ap.add_argument("--json", action="store_true")
+    args = ap.parse_args(argv)
+    if args.repeats < 1:
+        print("bench_startup: error: --repeats: must be >= 1", file=sys.stderr)
+        return 2
+    res = measure(args.repeats, not args.skip_cold,
+                  progress=lambda m: print(m, file=sys.stderr, flush=True))
+    if args.json:
+        print(json.dumps(res, indent=2))
+    else:
+        for k, v in res.items():
+            print(f"{k:40s} {v}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
