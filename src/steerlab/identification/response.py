@@ -1,6 +1,7 @@
 """A model's heading and yaw-rate response to a recorded rudder angle.
 
-Uses the engine's own RK4 plant step (:func:`steerlab.sim.kernels.plant_step`) and the ship
+Uses the engine's own RK4 plant step (the ``replay_rudder`` loop of the ship's driver,
+:mod:`steerlab.sim.driver_template`) and the ship
 kernels, so the model identified is exactly the model simulated. The recorded rudder is the
 input: before the step from sample k to k+1 the plant's rudder state is set to the mean of the
 two samples and the gear is ordered to the same angle, so it holds it over the step (with the
@@ -11,41 +12,19 @@ records sampled from a continuous rudder by about dt/2.
 
 from __future__ import annotations
 
-from functools import lru_cache
-
-import numba
 import numpy as np
 
 from steerlab.environment.channels import N_CHANNELS
-from steerlab.sim.kernels import plant_step
 from steerlab.steering_gear import SteeringGear
 
 _PG = SteeringGear(delta_max=np.pi / 2, rate_max=100.0, T_sg=1.0, dead_zone=0.0).pack()
 
 
-@lru_cache(maxsize=None)
 def _loop(ship_rhs):
-    step = plant_step(ship_rhs)
+    """The plant-only driver's rudder replay (:mod:`steerlab.sim.driver_template`)."""
+    from steerlab.sim.drivers import driver, entry
 
-    @numba.njit
-    def run(x, delta, ps, pg, dt, w, psi_out, r_out, work):
-        n = delta.shape[0]
-        nd = x.shape[0] - 1
-        psi_out[0] = x[2]
-        r_out[0] = x[5]
-        for k in range(n - 1):
-            d = 0.5 * (delta[k] + delta[k + 1])
-            x[nd] = d
-            step(k * dt, x, d, w, ps, pg, dt, work)
-            psi_out[k + 1] = x[2]
-            r_out[k + 1] = x[5]
-            if not (abs(x[5]) < 10.0):      # diverged: stop, mark the rest
-                for j in range(k + 2, n):
-                    psi_out[j] = np.nan
-                    r_out[j] = np.nan
-                return
-
-    return run
+    return entry(driver(ship_rhs, None, None, 0), "replay_rudder")
 
 
 def simulate_response(ship_rhs, n_states: int, ps: np.ndarray, delta: np.ndarray, dt: float,

@@ -13,6 +13,7 @@ What is in a driver (one definition of each loop, for every engine):
 * the plant: ship + steering gear right-hand side (``plant_rhs``), one RK4 step (``rk4``),
   and ``rk4_step`` (the step the readable engine, the runtime's ship server and the trials
   call from Python);
+* ``replay_rudder``: the plant driven by a recorded rudder (identification);
 * ``run``: the single run's closed loop (:func:`steerlab.sim.kernels.guided_closed_loop`
   documents its arguments);
 * ``group``: the batch engine's loop over a group of ``LANES`` runs in lock step,
@@ -96,6 +97,30 @@ def rk4(t, x, delta_cmd, w, ps, pg, dt, k1, k2, k3, k4, xt):
 def rk4_step(t, x, delta_cmd, w, ps, pg, dt, work):
     """Advance ``x`` in place by one RK4 step; ``work`` is a (5, nx) scratch array."""
     rk4(t, x, delta_cmd, w, ps, pg, dt, work[0], work[1], work[2], work[3], work[4])
+
+
+@numba.njit(cache=CACHE)
+def replay_rudder(x, delta, ps, pg, dt, w, psi_out, r_out, work):
+    """The plant driven by a recorded rudder ``delta`` (identification,
+    :mod:`steerlab.identification.response`): before the step from sample k to k+1 the rudder
+    state is set to the mean of the two samples and the gear is ordered to it (so it holds it);
+    heading and yaw rate are written per sample. A run whose yaw rate leaves (-10, 10) rad/s
+    has diverged: it stops and the rest is NaN."""
+    n = delta.shape[0]
+    nd = x.shape[0] - 1
+    psi_out[0] = x[2]
+    r_out[0] = x[5]
+    for k in range(n - 1):
+        d = 0.5 * (delta[k] + delta[k + 1])
+        x[nd] = d
+        rk4(k * dt, x, d, w, ps, pg, dt, work[0], work[1], work[2], work[3], work[4])
+        psi_out[k + 1] = x[2]
+        r_out[k + 1] = x[5]
+        if not (abs(x[5]) < 10.0):      # diverged: stop, mark the rest
+            for j in range(k + 2, n):
+                psi_out[j] = np.nan
+                r_out[j] = np.nan
+            return
 
 
 # ---------------------------------------------------------------- the single run

@@ -54,7 +54,7 @@ from steerlab.numba_cache import _fingerprint
 TEMPLATE = Path(__file__).with_name("driver_template.py")
 BEGIN = "# ---- bindings: replaced in every generated driver ----"
 END = "# ---- end of bindings ----"
-ENTRY_POINTS = ("run", "group", "rk4_step")
+ENTRY_POINTS = ("run", "group", "rk4_step", "replay_rudder")
 MODULE_PREFIX = "steerlab_driver_"
 
 _LOCK = threading.RLock()
@@ -256,7 +256,8 @@ def entry(mod: types.ModuleType, name: str):
     """``mod.name``, after telling :data:`on_compile` if calling it will compile."""
     disp = getattr(mod, name)
     if on_compile is not None and not disp.signatures and not is_compiled_on_disk(mod, name):
-        what = {"run": "closed loop", "group": "batch loop", "rk4_step": "plant step"}[name]
+        what = {"run": "closed loop", "group": "batch loop", "rk4_step": "plant step",
+                "replay_rudder": "rudder replay"}[name]
         on_compile(f"steerlab: compiling the {what} for {mod._steerlab_label} "
                    f"(first use{'; cached for next time' if mod._steerlab_cached else ''}) ...")
     return disp
