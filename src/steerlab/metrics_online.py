@@ -10,15 +10,22 @@ import math
 import numba
 import numpy as np
 
-M_IAE, M_ISE, M_ITAE = 0, 1, 2          # [rad s], [rad^2 s], [rad s^2]
-M_E2_DEG, M_D2_DEG = 3, 4               # int e^2 dt, int delta^2 dt [deg^2 s] (speed-loss J)
-M_ABS_DELTA = 5                         # int |delta| dt [rad s]
-M_TRAVEL = 6                            # rudder travel sum |d delta| [rad]
-M_REVERSALS = 7                         # number of rudder direction reversals [-]
-M_MAX_ABS_E = 8                         # max |e| [rad]
-M_DURATION = 9                          # integrated time [s]
-M_LAST_DIR = 10                         # internal: sign of the last rudder move
-N_ACC = 11
+from steerlab.records import Field, Layout
+
+ACCUMULATOR = Layout("online_metrics", "M_", [
+    Field("IAE", "iae", "rad s", "integral of |e| dt"),
+    Field("ISE", "ise", "rad^2 s", "integral of e^2 dt"),
+    Field("ITAE", "itae", "rad s^2", "integral of t |e| dt"),
+    Field("E2_DEG", "int_e2_deg", "deg^2 s", "integral of e^2 dt in degrees (speed-loss J)"),
+    Field("D2_DEG", "int_delta2_deg", "deg^2 s", "integral of delta^2 dt in degrees (speed-loss J)"),
+    Field("ABS_DELTA", "int_abs_delta", "rad s", "integral of |delta| dt"),
+    Field("TRAVEL", "rudder_travel", "rad", "rudder travel, sum of |d delta|"),
+    Field("REVERSALS", "rudder_reversals", "-", "number of rudder direction reversals"),
+    Field("MAX_ABS_E", "max_abs_e", "rad", "max |e|"),
+    Field("DURATION", "duration", "s", "integrated time"),
+    Field("LAST_DIR", "last_rudder_dir", "-", "internal: sign of the last rudder move"),
+], size_name="N_ACC")
+ACCUMULATOR.export(globals())    # M_IAE = 0, ..., N_ACC = 11
 
 REVERSAL_EPS = 1e-9
 """Rudder moves smaller than this [rad per step] do not count as a direction."""

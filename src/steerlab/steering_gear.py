@@ -23,10 +23,17 @@ import numba
 import numpy as np
 
 from steerlab.errors import require_finite_range
+from steerlab.records import Field, Layout
 from steerlab.units import rad
 
-G_DMAX, G_RATE, G_INV_TSG, G_DEAD = 0, 1, 2, 3  # [rad], [rad/s], 1/T_SG [1/s], [rad]
-N_PARAMS = 4
+GEAR = Layout("gear", "G_", [
+    Field("DMAX", "delta_max", "rad", "rudder limit (eq 15: 35 deg)", 0.0, rad(90.0), lo_open=True),
+    Field("RATE", "rate_max", "rad/s", "rudder rate limit (eq 15: 2.33 deg/s)", 0.0, lo_open=True),
+    Field("INV_TSG", "inv_T_sg", "1/s", "1/T_SG, the servo's inverse time constant (eq 15: T_SG = 1 s)",
+          0.0, lo_open=True),
+    Field("DEAD", "dead_zone", "rad", "dead zone (Morawski & Pomirski; 0 = none)", 0.0, rad(90.0)),
+], size_name="N_PARAMS")
+GEAR.export(globals())           # G_DMAX = 0, G_RATE = 1, G_INV_TSG = 2, G_DEAD = 3, N_PARAMS = 4
 
 
 class SteeringGear(NamedTuple):
@@ -46,7 +53,8 @@ class SteeringGear(NamedTuple):
 
     def pack(self) -> np.ndarray:
         g = self.validated()
-        return np.array([g.delta_max, g.rate_max, 1.0 / g.T_sg, g.dead_zone], dtype=np.float64)
+        return GEAR.pack(delta_max=g.delta_max, rate_max=g.rate_max, inv_T_sg=1.0 / g.T_sg,
+                         dead_zone=g.dead_zone)
 
 
 @numba.njit(cache=True)

@@ -23,19 +23,25 @@ ignores the others (a channel a model cannot represent is documented in its docs
 ``W_YAW_MOMENT``
     Yaw-moment disturbance expressed as a yaw acceleration [rad/s^2] (wave moments
     divided by the ship's yaw inertia), for models that take a moment.
+
+The layout is declared once, as :data:`CHANNELS` (:mod:`steerlab.records`); the index
+constants, ``N_CHANNELS``, the names and the units are generated from it.
 """
 
-W_RUDDER = 0
-W_WIND_SPEED = 1
-W_WIND_DIR = 2
-W_CURRENT_N = 3
-W_CURRENT_E = 4
-W_YAW_RATE = 5
-W_YAW_MOMENT = 6
-N_CHANNELS = 7
-CHANNEL_NAMES = ("d_rudder", "wind_speed", "wind_dir", "current_north", "current_east",
-                 "d_yaw_rate", "d_yaw_accel")
-CHANNEL_UNITS = ("rad", "m/s", "rad", "m/s", "m/s", "rad/s", "rad/s^2")
+from steerlab.records import Field, Layout
+
+CHANNELS = Layout("environment", "W_", [
+    Field("RUDDER", "d_rudder", "rad", "equivalent rudder angle, > 0 pushes the ship to starboard"),
+    Field("WIND_SPEED", "wind_speed", "m/s", "true wind speed"),
+    Field("WIND_DIR", "wind_dir", "rad", "direction the true wind comes from, clockwise from north"),
+    Field("CURRENT_N", "current_north", "m/s", "current velocity, north component"),
+    Field("CURRENT_E", "current_east", "m/s", "current velocity, east component"),
+    Field("YAW_RATE", "d_yaw_rate", "rad/s", "additive yaw-rate disturbance"),
+    Field("YAW_MOMENT", "d_yaw_accel", "rad/s^2", "yaw-moment disturbance as a yaw acceleration"),
+], size_name="N_CHANNELS")
+CHANNELS.export(globals())       # W_RUDDER = 0, ..., N_CHANNELS = 7
+CHANNEL_NAMES = CHANNELS.names
+CHANNEL_UNITS = CHANNELS.units
 
 
 def set_current(w, speed, direction):

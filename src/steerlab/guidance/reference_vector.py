@@ -10,17 +10,24 @@ unchanged); the other entries are for the engine (``REF_RPM``), the logs and the
     REF_XTE   e         [m]        cross-track error, > 0 when the ship is to starboard of the leg
                                    (NaN for guidance without a route)
     REF_LEG   k         [-]        active leg (index of its first waypoint; -1 without a route)
+
+The layout is declared once, as :data:`REFERENCE` (:mod:`steerlab.records`); the index
+constants, ``N_REF``, the names and the units are generated from it.
 """
 
-REF_PSI = 0
-REF_R = 1
-REF_RDOT = 2
-REF_RPM = 3
-REF_XTE = 4
-REF_LEG = 5
-N_REF = 6
-REF_NAMES = ("psi_ref", "r_ref", "rdot_ref", "rpm_cmd", "xte", "leg")
-REF_UNITS = ("rad", "rad/s", "rad/s^2", "rev/s", "m", "-")
+from steerlab.records import Field, Layout
+
+REFERENCE = Layout("reference", "REF_", [
+    Field("PSI", "psi_ref", "rad", "reference heading"),
+    Field("R", "r_ref", "rad/s", "reference rate of turn"),
+    Field("RDOT", "rdot_ref", "rad/s^2", "reference yaw acceleration (0 where the guidance has none)"),
+    Field("RPM", "rpm_cmd", "rev/s", "propeller-rate order; < 0 = no order (the ship keeps its own)"),
+    Field("XTE", "xte", "m", "cross-track error, > 0 to starboard of the leg (NaN without a route)"),
+    Field("LEG", "leg", "-", "active leg: index of its first waypoint (-1 without a route)"),
+], size_name="N_REF")
+REFERENCE.export(globals())      # REF_PSI = 0, REF_R = 1, ..., N_REF = 6
+REF_NAMES = REFERENCE.names
+REF_UNITS = REFERENCE.units
 
 
 def initial_reference():

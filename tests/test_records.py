@@ -1,0 +1,82 @@
+"""Named records (steerlab.records): layouts declared once; constants, packing, names generated."""
+
+from __future__ import annotations
+
+import importlib
+import inspect
+import math
+import re
+
+import numpy as np
+import pytest
+
+from steerlab.errors import InputError
+from steerlab.records import Field, Layout
+
+# modules whose record layouts are declared with steerlab.records (grows as components move)
+DECLARED = {
+    "steerlab.steering_gear": ("GEAR", "G_", "N_PARAMS"),
+    "steerlab.guidance.reference_vector": ("REFERENCE", "REF_", "N_REF"),
+    "steerlab.environment.channels": ("CHANNELS", "W_", "N_CHANNELS"),
+    "steerlab.metrics_online": ("ACCUMULATOR", "M_", "N_ACC"),
+}
+
+_HAND_WRITTEN_INDEX = re.compile(r"^[A-Z][A-Z0-9_]*(\s*,\s*[A-Z][A-Z0-9_]*)*\s*=\s*(\d+\s*(,\s*\d+\s*)*(#.*)?$|range\()", re.M)
+
+
+@pytest.mark.parametrize("module", sorted(DECLARED))
+def test_declared_modules_have_no_hand_written_index_constants(module):
+    mod = importlib.import_module(module)
+    layout_name, prefix, size_name = DECLARED[module]
+    layout = getattr(mod, layout_name)
+    assert not _HAND_WRITTEN_INDEX.search(inspect.getsource(mod)), "an index constant is written by hand"
+    for i, f in enumerate(layout.fields):                     # every constant comes from the layout
+        assert getattr(mod, prefix + f.const) == i
+    assert getattr(mod, size_name) == layout.size
+
+
+def test_generated_layouts_keep_the_kernels_slots():
+    """The slots the compiled kernels were built with (the numbers did not move)."""
+    from steerlab import metrics_online as m
+    from steerlab import steering_gear as g
+    from steerlab.environment import channels as w
+    from steerlab.guidance import reference_vector as r
+
+    assert (g.G_DMAX, g.G_RATE, g.G_INV_TSG, g.G_DEAD, g.N_PARAMS) == (0, 1, 2, 3, 4)
+    assert (r.REF_PSI, r.REF_R, r.REF_RDOT, r.REF_RPM, r.REF_XTE, r.REF_LEG, r.N_REF) == tuple(range(7))
+    assert r.REF_NAMES == ("psi_ref", "r_ref", "rdot_ref", "rpm_cmd", "xte", "leg")
+    assert (w.W_RUDDER, w.W_CURRENT_N, w.W_YAW_MOMENT, w.N_CHANNELS) == (0, 3, 6, 7)
+    assert (m.M_IAE, m.M_E2_DEG, m.M_REVERSALS, m.M_LAST_DIR, m.N_ACC) == (0, 3, 7, 10, 11)
+    gear = g.SteeringGear(math.radians(30.0), math.radians(3.0), 2.0, math.radians(0.5)).pack()
+    np.testing.assert_array_equal(gear, [math.radians(30.0), math.radians(3.0), 0.5, math.radians(0.5)])
+
+
+LAYOUT = Layout("demo", "D_", [
+    Field("KP", "Kp", "rad/rad", "proportional gain", lo=0.0),
+    Field("T", "T", "s", "time constant", lo=0.0, lo_open=True, hi=1e4),
+], size_name="N_DEMO")
+
+
+def test_pack_checks_each_field_by_name():
+    np.testing.assert_array_equal(LAYOUT.pack(Kp=1.5, T=20.0), [1.5, 20.0])
+    with pytest.raises(InputError, match=r"demo\.T: 0\.0 is out of range; allowed range \(0\.0, 10000\.0\]"):
+        LAYOUT.pack(Kp=1.0, T=0.0)
+    with pytest.raises(InputError, match=r"demo\.Kp: must be finite"):
+        LAYOUT.pack(Kp=float("nan"), T=1.0)
+    with pytest.raises(InputError, match=r"demo\.Kd: unknown field; known fields: \['Kp', 'T'\]"):
+        LAYOUT.pack(Kp=1.0, T=1.0, Kd=3.0)
+    with pytest.raises(InputError, match=r"demo\.T: missing"):
+        LAYOUT.pack(Kp=1.0)
+
+
+def test_index_unpack_size_and_composition():
+    assert LAYOUT.index("T") == 1 and LAYOUT.constants() == {"D_KP": 0, "D_T": 1, "N_DEMO": 2}
+    with pytest.raises(InputError, match="demo.Ki: unknown field"):
+        LAYOUT.index("Ki")
+    assert LAYOUT.unpack([2.0, 3.0]) == {"Kp": 2.0, "T": 3.0}
+    with pytest.raises(InputError, match="record of 3 floats, but layout 'demo' has 2 \\(Kp, T\\)"):
+        LAYOUT.check_size(np.zeros(3))
+    wrapper = Layout("wrapped", "S_", [Field("SIGMA", "sigma_psi", "rad")]).then("inner", LAYOUT)
+    assert wrapper.names == ("sigma_psi", "inner.Kp", "inner.T") and wrapper.index("inner.Kp") == 1
+    with pytest.raises(ValueError, match="duplicate field name"):
+        Layout("bad", "B_", [Field("A", "x"), Field("B", "x")])
