@@ -43,6 +43,7 @@ from http import HTTPStatus
 from websockets.asyncio.server import broadcast, serve
 
 from steerlab.errors import InputError
+from steerlab.runtime.http_conn import HttpConnection
 from steerlab.runtime.rate_limit import RateLimiter
 from steerlab.runtime.signalk import MAX_DELTA_BYTES, delta, iso_time
 from steerlab.runtime.signalk_rest import API_PATH, api_get
@@ -244,7 +245,8 @@ class SignalKStreamServer:
     async def start(self) -> "SignalKStreamServer":
         try:
             self.server = await serve(self._handler, self.host, self.port, process_request=self._process_request,
-                                      max_size=MAX_DELTA_BYTES, compression=None, server_header=None)
+                                      max_size=MAX_DELTA_BYTES, compression=None, server_header=None,
+                                      create_connection=HttpConnection)
         except OSError as err:
             raise InputError(self.field, f"cannot bind {self.host}:{self.port}: {err.strerror}") from None
         return self
