@@ -86,6 +86,17 @@ def _f(x: float, nd: int = 1) -> str:
     return f"{x:.{nd}f}"
 
 
+def compass_field(angle: float, nd: int = 1) -> str:
+    """A heading or course [rad] as an NMEA field in degrees, ``nd`` decimals, in [0, 360).
+
+    The one place sentences format a direction: wrap first, round second and wrap the rounded
+    text again, so a heading just west of north (-1e-9 rad, 359.99999 deg) is ``0.0``, never
+    ``360.0`` (NMEA 0183 headings and courses are 0 to 359.9...).
+    """
+    text = f"{deg(angle) % 360.0:.{nd}f}"
+    return f"{0.0:.{nd}f}" if float(text) >= 360.0 else text
+
+
 def geo_position(x_n: float, y_e: float, origin) -> tuple[float, float]:
     """``(lat, lon)`` [deg] of a point ``x_n`` m north and ``y_e`` m east of ``origin``."""
     lat0, lon0 = origin
@@ -107,24 +118,23 @@ def _ddmm(value: float, lat: bool) -> tuple[str, str]:
 def state_sentences(state, origin=(54.5, 18.55), wall: float | None = None, talker: str = TALKER) -> list[str]:
     """HDT, THS, ROT, RSA, RMC and VTG lines for a :class:`~steerlab.runtime.protocol.State`."""
     wall = time.time() if wall is None else wall
-    hdg = deg(state.psi) % 360.0
     ut = time.gmtime(wall)
     hhmmss = time.strftime("%H%M%S", ut) + f".{int((wall % 1) * 100):02d}"
     ddmmyy = time.strftime("%d%m%y", ut)
     vn = state.u * math.cos(state.psi) - state.v * math.sin(state.psi)
     ve = state.u * math.sin(state.psi) + state.v * math.cos(state.psi)
     sog = math.hypot(vn, ve) / KNOT
-    cog = deg(math.atan2(ve, vn)) % 360.0
+    cog = math.atan2(ve, vn)
     lat, lon = geo_position(state.x_n, state.y_e, origin)
     la, ns = _ddmm(lat, True)
     lo, ew = _ddmm(lon, False)
     return [
-        render("HDT", [_f(hdg), "T"], talker),
-        render("THS", [_f(hdg, 2), "S"], talker),        # S = simulator mode
+        render("HDT", [compass_field(state.psi), "T"], talker),
+        render("THS", [compass_field(state.psi, 2), "S"], talker),        # S = simulator mode
         render("ROT", [_f(deg(state.r) * 60.0, 2), "A"], talker),
         render("RSA", [_f(deg(state.delta)), "A", "", "V"], talker),
-        render("RMC", [hhmmss, "A", la, ns, lo, ew, _f(sog, 2), _f(cog), ddmmyy, "", "", "S"], talker),
-        render("VTG", [_f(cog), "T", "", "M", _f(sog, 2), "N", _f(sog * 1.852, 2), "K", "S"], talker),
+        render("RMC", [hhmmss, "A", la, ns, lo, ew, _f(sog, 2), compass_field(cog), ddmmyy, "", "", "S"], talker),
+        render("VTG", [compass_field(cog), "T", "", "M", _f(sog, 2), "N", _f(sog * 1.852, 2), "K", "S"], talker),
     ]
 
 
@@ -132,7 +142,7 @@ def htd_sentence(set_course, rudder_cmd, heading, rudder_limit, off_heading_limi
                  talker: str = "AG") -> str:
     """The autopilot's HTD line (angles [rad]; ``None`` fields left empty)."""
     def d(x):
-        return "" if x is None else _f(deg(x) % 360.0)
+        return "" if x is None else compass_field(x)
     rud = "" if rudder_cmd is None else _f(abs(deg(rudder_cmd)))
     rdir = "" if rudder_cmd is None else ("R" if rudder_cmd >= 0 else "L")
     at_limit = rudder_cmd is not None and abs(rudder_cmd) >= rudder_limit - 1e-9

@@ -4,7 +4,13 @@
   const DEG = 180 / Math.PI;
   const $ = (id) => document.getElementById(id);
   const fmt = (x, unit, nd = 1) => (x === null || x === undefined) ? "-" : (x.toFixed(nd) + unit);
-  const fmtDeg = (rad, nd = 1) => (rad === null || rad === undefined) ? "-" : ((rad * DEG + 360) % 360).toFixed(nd) + "\u00b0";
+  // a direction in [0, 360): wrap, round, wrap the rounded text again (359.99 -> "0.0", never "360.0")
+  const fmtDeg = (rad, nd = 1) => {
+    if (rad === null || rad === undefined) return "-";
+    let t = (((rad * DEG) % 360 + 360) % 360).toFixed(nd);
+    if (parseFloat(t) >= 360) t = (0).toFixed(nd);
+    return t + "\u00b0";
+  };
   let ws = null;
   let track = [];
   let lastT = null;
