@@ -16,8 +16,15 @@ In (autopilot): ``HDT``/``THS`` give the heading; ``APB`` ("heading to steer" if
 else "bearing present position to destination"), ``RMB`` (true bearing to destination) and
 ``HTC`` (heading to steer) give the set course. A bearing is corrected for the sentence's own
 cross-track error ``xte`` with direction to steer L/R: ``course = bearing ± atan(xte / lookahead)``.
-``XTE`` is parsed and counted (APB and RMB carry the same error). Lines need a valid checksum;
-anything else is counted as rejected, never raised.
+``XTE`` is parsed and counted (APB and RMB carry the same error; XTE gives no course). Lines need
+a valid checksum; anything else is counted as rejected, never raised.
+
+Course source priority (:data:`COURSE_PRIORITY`): **APB > RMB > HTC**. A plotter that sends
+both APB and RMB steers by APB alone (it carries the heading to steer and the leg's bearing);
+RMB is used only while no fresh APB arrives, HTC only while neither does. Arrival (chart-plotter
+convention): APB's "arrival circle entered" or "perpendicular passed" = ``A``, or RMB's arrival
+status = ``A``, marks the destination waypoint as reached (``arrived``, ``dest``); the autopilot
+then stops steering for it (:meth:`steerlab.runtime.autopilot.Autopilot.sample`).
 """
 
 from __future__ import annotations
@@ -35,6 +42,7 @@ EARTH_RADIUS = 6_371_000.0
 MAX_LINE = 96
 MAX_LINES = 32
 TALKER = "II"
+COURSE_PRIORITY = ("APB", "RMB", "HTC")   #: course sources, the first fresh one wins
 
 
 class THS(TalkerSentence):
@@ -218,6 +226,17 @@ def _course_from(s, lookahead: float):
     return None
 
 
+def _arrival(s) -> tuple[str, bool]:
+    """``(destination waypoint id, reached?)`` of an APB/RMB sentence (``("", False)`` otherwise)."""
+    kind = type(s).__name__
+    dest = str(getattr(s, "dest_waypoint_id", "") or "")
+    if kind == "APB":
+        return dest, getattr(s, "arr_circle_entered", "") == "A" or getattr(s, "perp_passed", "") == "A"
+    if kind == "RMB":
+        return dest, getattr(s, "arrival_alarm", "") == "A"
+    return "", False
+
+
 def _heading_from(s):
     kind = type(s).__name__
     if kind == "HDT":
@@ -228,11 +247,15 @@ def _heading_from(s):
 
 
 def steering_inputs(data: bytes, lookahead: float = 500.0) -> dict:
-    """Heading [rad] and set course [rad] (the last of each in the datagram, or None).
+    """Heading [rad] and set course [rad] (the last heading; the course of the highest-priority
+    source in the datagram, :data:`COURSE_PRIORITY`), or None.
 
-    Counts ``accepted`` (parsed with a valid checksum) and ``rejected`` lines; never raises.
+    ``courses`` has the last course of each source: ``{"APB": {"course", "dest", "arrived"}, ...}``;
+    ``course_source`` names the source of ``course``. Counts ``accepted`` (parsed with a valid
+    checksum) and ``rejected`` lines; never raises.
     """
-    out = {"heading": None, "course": None, "xte_m": None, "accepted": 0, "rejected": 0}
+    out = {"heading": None, "course": None, "course_source": None, "courses": {}, "xte_m": None,
+           "accepted": 0, "rejected": 0}
     try:
         text = bytes(data).decode("ascii")
     except Exception:
@@ -252,7 +275,8 @@ def steering_inputs(data: bytes, lookahead: float = 500.0) -> dict:
                 out["heading"] = rad(h % 360.0)
             c = _course_from(s, lookahead)
             if c is not None and math.isfinite(c):
-                out["course"] = c
+                dest, arrived = _arrival(s)
+                out["courses"][type(s).__name__] = {"course": c, "dest": dest, "arrived": arrived}
             if type(s).__name__ == "XTE":
                 x = _xte_m(s.cross_track_err_dist, s.dist_units)
                 if x is not None:
@@ -260,4 +284,8 @@ def steering_inputs(data: bytes, lookahead: float = 500.0) -> dict:
         except Exception:
             out["rejected"] += 1
             out["accepted"] -= 1
+    for kind in COURSE_PRIORITY:
+        if kind in out["courses"]:
+            out["course"], out["course_source"] = out["courses"][kind]["course"], kind
+            break
     return out
