@@ -192,3 +192,22 @@ def test_compass_field_and_wrap_are_in_range_for_any_angle(a):
     w = wrap_to_2pi(a)
     assert 0.0 <= w < 2 * math.pi
     assert math.isclose(math.remainder(w - a, 2 * math.pi), 0.0, abs_tol=1e-9)
+
+
+def test_default_origin_is_at_sea_and_one_definition():
+    """The model origin the RMC positions start from: the Gulf of Gdansk, ~14 km off the coast
+    (54.5 N 18.9 E), the same in the library and at serve-ship's --origin default."""
+    import argparse
+
+    from steerlab.commands import serve_ship
+    from steerlab.runtime.ship_server import ShipServer
+
+    assert nmea.DEFAULT_ORIGIN == (54.5, 18.9)
+    p = argparse.ArgumentParser()
+    serve_ship.register(p.add_subparsers(), argparse.HelpFormatter)
+    args = p.parse_args(["serve-ship"])
+    assert serve_ship._origin(args.origin) == nmea.DEFAULT_ORIGIN
+    import inspect
+    assert inspect.signature(ShipServer).parameters["origin"].default is None       # None -> DEFAULT_ORIGIN
+    rmc = pynmea2.parse(nmea.state_sentences(STATE._replace(x_n=0.0, y_e=0.0), wall=WALL)[4].strip())
+    assert (rmc.latitude, rmc.longitude) == pytest.approx(nmea.DEFAULT_ORIGIN, abs=1e-6)

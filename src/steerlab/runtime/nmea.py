@@ -43,6 +43,9 @@ MAX_LINE = 96
 MAX_LINES = 32
 TALKER = "II"
 COURSE_PRIORITY = ("APB", "RMB", "HTC")   #: course sources, the first fresh one wins
+DEFAULT_ORIGIN = (54.5, 18.9)
+"""Default model origin (lat, lon) [deg]: open water in the Gulf of Gdansk, about 14 km off the
+nearest coast (the former default, 54.5 N 18.55 E, is in Gdynia, on land)."""
 
 
 class THS(TalkerSentence):
@@ -123,7 +126,7 @@ def _ddmm(value: float, lat: bool) -> tuple[str, str]:
     return (f"{d:02d}{m:07.4f}" if lat else f"{d:03d}{m:07.4f}"), hemi
 
 
-def state_sentences(state, origin=(54.5, 18.55), wall: float | None = None, talker: str = TALKER) -> list[str]:
+def state_sentences(state, origin=DEFAULT_ORIGIN, wall: float | None = None, talker: str = TALKER) -> list[str]:
     """HDT, THS, ROT, RSA, RMC and VTG lines for a :class:`~steerlab.runtime.protocol.State`."""
     wall = time.time() if wall is None else wall
     ut = time.gmtime(wall)
