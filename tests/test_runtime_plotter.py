@@ -110,3 +110,26 @@ def test_at_the_routes_end_the_ship_sails_on_instead_of_circling_the_waypoint(ct
     assert min(dists) < radius                        # it did reach the waypoint
     assert dists[-1] > 3000.0 and dists[-1] == pytest.approx(max(dists[len(dists) // 2:]))
     assert ap.alarms.active(ARRIVAL) and ap.course_source == "APB"
+
+
+def test_status_shows_the_heading_steered_by_and_the_sources(ctrl):  # noqa: F811
+    """The bridge page's data: the heading the controller used (NMEA HDT here, not the state's)
+    with its source, and what set the set course."""
+    ap = Autopilot(ctrl, ("127.0.0.1", 9), AutopilotConfig(), heading=0.0)
+    _feed(ap, 0.0, psi=math.radians(10.0))
+    ap.sample(0.0)
+    s = ap.status()
+    assert s["heading_source"] == "state" and s["steered_heading"] == pytest.approx(math.radians(10.0))
+    assert s["course_source"] == "operator"
+    hdt = nmea.render("HDT", ["20.0", "T"])
+    ap.on_nmea_datagram((hdt + apb(30.0)).encode(), t=0.1)
+    _feed(ap, H, psi=math.radians(10.0))
+    row = ap.sample(H)
+    s = ap.status()
+    assert s["heading_source"] == "nmea" == row["heading_source"]
+    assert s["steered_heading"] == pytest.approx(math.radians(20.0)) and s["heading"] == pytest.approx(math.radians(10.0))
+    assert s["course_source"] == "APB" and s["set_course"] == pytest.approx(math.radians(30.0))
+    _feed(ap, 5.0, psi=-1e-12)                       # NMEA stale again; a heading just west of north
+    ap.sample(5.0)
+    s = ap.status()
+    assert s["heading_source"] == "state" and 0.0 <= s["steered_heading"] < 2 * math.pi

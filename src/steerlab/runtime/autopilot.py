@@ -156,6 +156,7 @@ class Autopilot:
         self.nmea_courses: dict = {}   # source -> (psi_set [rad], t, dest, arrived)
         self.arrived: dict = {}        # source -> the destination id it reported reached
         self.course_source = None      # what the set course came from last ("APB", "RMB", "HTC", ...)
+        self.steered = (None, None)    # (heading [rad] the last sample steered by, its source)
         self.nmea_counts = {"accepted": 0, "rejected": 0}
         self.signalk_counts = {"accepted": 0, "rejected": 0}
         self.track: deque = deque(maxlen=4000)
@@ -305,6 +306,7 @@ class Autopilot:
         psi = src = None
         if link_ok:
             psi, src = self._heading(t)
+            self.steered = (psi, src)
             x = self.ctrl.measured_state(st.x_n, st.y_e, psi, st.u, st.v, st.r, st.delta)
             self.track.append((st.x_n, st.y_e))
             if self.route is not None:       # the simulator's guidance kernel, same call
@@ -376,13 +378,20 @@ class Autopilot:
         return P.Command(self.cmd_sent, self.config.rpm_cmd, mode)
 
     def status(self) -> dict:
-        """Everything the bridge page shows (SI; the page converts to degrees)."""
+        """Everything the bridge page shows (SI; the page converts to degrees).
+
+        ``heading`` is the ship state's; ``steered_heading`` the one the last sample steered by
+        and ``heading_source`` where it came from (``nmea``: HDT/THS, ``state``: the state
+        datagram); ``course_source`` what set the set course (``operator``, ``APB``, ``route``...).
+        """
         st = self.latest
         r = self.last_row
         return {
             "t": r.get("t", 0.0), "mode": self.mode, "link_ok": bool(r.get("link_ok", 0)),
             "state_age": r.get("state_age"),
             "heading": None if st is None else wrap_to_2pi(st.psi),
+            "steered_heading": None if self.steered[0] is None else wrap_to_2pi(self.steered[0]),
+            "heading_source": self.steered[1], "course_source": self.course_source,
             "set_course": None if self.psi_set is None else wrap_to_2pi(self.psi_set),
             "reference": None if self.gd is None else wrap_to_2pi(float(self.ref[0])),
             "yaw_rate": None if st is None else st.r, "rudder": None if st is None else st.delta,

@@ -69,14 +69,19 @@
     $("link").textContent = s.link_ok ? "link OK" : "link LOST";
     $("link").className = "badge " + (s.link_ok ? "ok" : "bad");
     $("controller").textContent = "controller: " + s.controller + "   t = " + fmt(s.t, " s", 1);
-    $("heading").textContent = fmtDeg(s.heading);
+    // the heading the autopilot steers by (NMEA HDT/THS or the ship state) and where it came from
+    const steered = (s.steered_heading === null || s.steered_heading === undefined) ? s.heading : s.steered_heading;
+    $("heading").textContent = fmtDeg(steered);
+    $("heading-source").textContent = s.heading_source ? "(" + s.heading_source + ")" : "";
+    $("state-heading").textContent = fmtDeg(s.heading);
     $("set-course").textContent = fmtDeg(s.set_course);
+    $("course-source").textContent = s.course_source ? "(" + s.course_source + ")" : "";
     $("reference").textContent = fmtDeg(s.reference);
     $("yaw-rate").textContent = s.yaw_rate === null ? "-" : fmt(s.yaw_rate * DEG * 60, " \u00b0/min", 1);
     $("speed").textContent = s.speed === null ? "-" : fmt(s.speed / 0.514444, " kn", 1);
     $("rudder-angle").textContent = s.rudder === null ? "-" : fmt(s.rudder * DEG, "\u00b0", 1);
     $("rudder-order").textContent = s.rudder_cmd === null ? "-" : fmt(s.rudder_cmd * DEG, "\u00b0", 1);
-    rotate("ship-needle", s.heading);
+    rotate("ship-needle", steered);
     rotate("set-marker", s.set_course);
     rotate("ref-marker", s.reference);
     const r = s.rudder === null ? 0 : Math.max(-35, Math.min(35, s.rudder * DEG)) / 35 * 100;
