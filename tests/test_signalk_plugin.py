@@ -219,6 +219,15 @@ def test_signalk_server_v2_autopilot_api_steers_steerlab(controller, tmp_path): 
         time.sleep(1.0)
         assert sl.ap.psi_set == before and sl.ap.mode == "auto"
 
+        # Signal K v1 PUT through the server (REST): the same link, the same checks
+        v1 = "/signalk/v1/api/vessels/self/steering/autopilot/target/headingTrue"
+        status, reply = _request(http_port, "PUT", v1, {"value": math.radians(60.0)})
+        assert status == 200 and reply["statusCode"] == 200, reply
+        _until(lambda: _angle_diff(math.degrees(sl.ap.psi_set), 60.0) < 1e-6, 10.0, "set course 60 deg (v1 PUT)")
+        status, reply = _request(http_port, "PUT", v1, {"value": 7.0})
+        assert status == 400 and reply["statusCode"] == 400, reply
+        assert _angle_diff(math.degrees(sl.ap.psi_set), 60.0) < 1e-6
+
         # disengage: standby, no more rudder orders
         status, _ = _request(http_port, "POST", f"{dev}/disengage")
         assert status == 200

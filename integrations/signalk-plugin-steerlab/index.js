@@ -12,6 +12,7 @@
  *     statusPort): steering.autopilot.state and steering.autopilot.target.headingTrue.
  * Without a status datagram for `offlineTimeout` seconds the device is "off-line" and commands
  * are refused (503). Angles are radians, true heading, as everywhere in Signal K.
+ * Signal K v1 PUTs on those two paths are handled too (registerPutHandler), with the same checks.
  */
 'use strict'
 
@@ -262,6 +263,15 @@ module.exports = function (app) {
     })
     timer = setInterval(publish, 1000) // notices off-line
     app.registerAutopilotProvider(provider, [opts.deviceId])
+    // Signal K v1 PUT (REST .../vessels/self/steering/autopilot/... or a stream PUT) on the two
+    // paths steerlab takes: the same checks and link as the v2 API
+    const v1 = (fn) => (context, path, value) => fn(value).then(
+      () => ({ state: 'COMPLETED', statusCode: 200 }),
+      (e) => ({ state: 'COMPLETED', statusCode: e.statusCode || 500, message: e.message }))
+    if (typeof app.registerPutHandler === 'function') {
+      app.registerPutHandler('vessels.self', STATE, v1((v) => provider.setState(v, opts.deviceId)), plugin.id)
+      app.registerPutHandler('vessels.self', TARGET, v1((v) => provider.setTarget(v, opts.deviceId)), plugin.id)
+    }
   }
 
   plugin.stop = function () {
