@@ -140,3 +140,37 @@ def test_websocket_upgrade_still_works_through_the_http_layer(path):
             await web.close()
 
     asyncio.run(go())
+
+
+@pytest.mark.skipif(__import__("shutil").which("node") is None, reason="node not found (Node.js >= 19 for its keep-alive default agent)")
+def test_node_keep_alive_agent_gets_100_answers_from_each_endpoint():
+    """Node's default HTTP agent (keep-alive since Node 19; the one @signalk/client uses) and its
+    fetch: 100 sequential GETs to each endpoint, none failing with "socket hang up"."""
+    import subprocess
+
+    script = r"""
+const http = require('http');
+const agent = new http.Agent({ keepAlive: true, maxSockets: 1 });
+const get = (url) => new Promise((resolve, reject) => {
+  http.get(url, { agent }, (res) => { let n = 0; res.on('data', (c) => { n += c.length });
+    res.on('end', () => resolve([res.statusCode, n])) }).on('error', reject) });
+(async () => {
+  const out = {};
+  for (const url of JSON.parse(process.argv[1])) {
+    let ok = 0;
+    for (let i = 0; i < 100; i++) { const [s, n] = await get(url); if (s === 200 && n > 0) ok++ }
+    for (let i = 0; i < 20; i++) { const r = await fetch(url); await r.arrayBuffer(); if (r.status === 200) ok++ }
+    out[url] = ok;
+  }
+  process.stdout.write(JSON.stringify(out));
+})().catch((e) => { process.stdout.write(JSON.stringify({ error: String(e) })); });
+"""
+
+    def check(sk, web):
+        urls = [f"http://{sk[0]}:{sk[1]}{p}" for w, p in ENDPOINTS if w == "sk"] + \
+               [f"http://{web[0]}:{web[1]}{p}" for w, p in ENDPOINTS if w == "web"]
+        res = subprocess.run(["node", "-e", script, json.dumps(urls)], capture_output=True, text=True, timeout=120)
+        got = json.loads(res.stdout or "{}")
+        assert got == {u: 120 for u in urls}, (got, res.stderr[-1000:])
+
+    _servers(check)
