@@ -11,6 +11,7 @@ import math
 import pytest
 
 from steerlab.runtime import nmea
+from steerlab.runtime import protocol as P
 from steerlab.runtime.alarms import ARRIVAL
 from steerlab.runtime.autopilot import Autopilot, AutopilotConfig
 from test_runtime_autopilot_logic import H, _feed, ctrl  # noqa: F401  (fixture)
@@ -133,3 +134,19 @@ def test_status_shows_the_heading_steered_by_and_the_sources(ctrl):  # noqa: F81
     ap.sample(5.0)
     s = ap.status()
     assert s["heading_source"] == "state" and 0.0 <= s["steered_heading"] < 2 * math.pi
+
+
+def test_status_track_is_the_autopilots_own_history_thinned(ctrl):  # noqa: F811
+    ap = Autopilot(ctrl, ("127.0.0.1", 9), AutopilotConfig(), heading=0.0)
+    assert ap.status()["track"] == []
+    for k in range(1000):                             # a ship going north-north-east, one state a sample
+        t = k * H
+        ap.latest = P.State(t, 5.0 * t, 0.5 * t, 0.0, 0.0, 5.0, 0.0, 0.0, math.nan, 0.0, 0)
+        ap.latest_t = t
+        ap.sample(t)
+    track = ap.status()["track"]
+    full = list(ap.track)
+    assert len(full) == 1000 and len(track) <= 401
+    assert track[0] == list(full[0]) and track[-1] == list(full[-1])      # from the start to now
+    assert all(list(p) in [list(q) for q in full] for p in track)
+    assert [p[0] for p in track] == sorted(p[0] for p in track)            # in time order

@@ -377,12 +377,25 @@ class Autopilot:
         mode = (P.MODE_ENGAGED if self.mode == "auto" else 0) | (P.MODE_SAFE if self.mode == "safe" else 0)
         return P.Command(self.cmd_sent, self.config.rpm_cmd, mode)
 
+    def _track_summary(self, max_points: int = 400) -> list:
+        """The autopilot's own track history (x_n, y_e) [m], every k-th sample so that at most
+        ``max_points`` (+ the newest) are sent: the page draws it whenever it was opened."""
+        pts = list(self.track)
+        if not pts:
+            return []
+        step = -(-len(pts) // max_points)
+        out = pts[::step]
+        if out[-1] != pts[-1]:
+            out.append(pts[-1])
+        return [[float(x), float(y)] for x, y in out]
+
     def status(self) -> dict:
         """Everything the bridge page shows (SI; the page converts to degrees).
 
         ``heading`` is the ship state's; ``steered_heading`` the one the last sample steered by
         and ``heading_source`` where it came from (``nmea``: HDT/THS, ``state``: the state
-        datagram); ``course_source`` what set the set course (``operator``, ``APB``, ``route``...).
+        datagram); ``course_source`` what set the set course (``operator``, ``APB``, ``route``...);
+        ``track`` the autopilot's track history (:meth:`_track_summary`).
         """
         st = self.latest
         r = self.last_row
@@ -400,6 +413,7 @@ class Autopilot:
             "alarms": self.alarms.snapshot(), "controller": self.ctrl.name,
             "link": {k: v for k, v in self.filter.counts.items()},
             "route": self.route.route.tolist() if self.route is not None else [],
+            "track": self._track_summary(),
             "off_course_limit": self.config.off_course_limit,
             "ship_status": None if st is None else st.status,
         }

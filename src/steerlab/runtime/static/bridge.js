@@ -38,8 +38,20 @@
     $(id).setAttribute("transform", "rotate(" + (rad * DEG) + ")");
   }
 
+  // a scale bar of a round length (1, 2 or 5 x 10^k m) about a quarter of the plot wide
+  function drawScale(span) {
+    const target = span / 4;
+    const p = Math.pow(10, Math.floor(Math.log10(target)));
+    const nice = [5, 2, 1].map((k) => k * p).find((v) => v <= target) || p;
+    const px = nice / span * 300;
+    $("scale-bar").setAttribute("x2", (10 + px).toFixed(1));
+    $("scale-text").textContent = nice >= 1000 ? (nice / 1000) + " km" : nice + " m";
+  }
+
   function drawTrack(s) {
-    if (s.position) {
+    if (Array.isArray(s.track)) {        // the autopilot's own history: the whole track, whenever the page opened
+      track = s.track.slice();
+    } else if (s.position) {
       if (lastT !== null && s.t < lastT) track = [];
       lastT = s.t;
       const p = s.position;
@@ -52,6 +64,7 @@
     let xmin = Infinity, xmax = -Infinity, ymin = Infinity, ymax = -Infinity;
     for (const [x, y] of pts) { xmin = Math.min(xmin, x); xmax = Math.max(xmax, x); ymin = Math.min(ymin, y); ymax = Math.max(ymax, y); }
     const span = Math.max(xmax - xmin, ymax - ymin, 200) * 1.1;
+    drawScale(span);
     const cx = (xmin + xmax) / 2, cy = (ymin + ymax) / 2;
     const toSvg = ([x, y]) => [150 + (y - cy) / span * 300, 150 - (x - cx) / span * 300];  // east right, north up
     const poly = (arr) => arr.map(toSvg).map(([a, b]) => a.toFixed(1) + "," + b.toFixed(1)).join(" ");
