@@ -174,17 +174,20 @@ def _check_live_values(page):
     box = page.locator("#compass").bounding_box()
     assert box and box["width"] > 100 and box["height"] > 100
     needle0 = _attr(page, "ship-needle", "transform")
-    points0 = len((_attr(page, "track-line", "points") or "").split())
+    points0 = _attr(page, "track-line", "points") or ""
     heading0, yaw0, rudder0, order0, ctl0 = _texts(page, "heading", "yaw-rate", "rudder-angle",
                                                    "rudder-order", "controller")
     assert re.fullmatch(r"\d{1,3}\.\d\u00b0", heading0) and yaw0.endswith("\u00b0/min")
     assert re.fullmatch(r"-?\d+\.\d\u00b0", rudder0) and re.fullmatch(r"-?\d+\.\d\u00b0", order0)
-    # the values are live: the needle turns, the track grows, rudder and yaw rate move (waves)
+    # the track is the autopilot's own history, with a scale bar of a round length
+    assert re.fullmatch(r"(1|2|5)0* (m|km)", page.text_content("#scale-text")), page.text_content("#scale-text")
+    assert float(_attr(page, "scale-bar", "x2")) > float(_attr(page, "scale-bar", "x1")) + 10
+    # the values are live: the needle turns, the track moves on, rudder and yaw rate move (waves)
     page.wait_for_function(
         """([needle, points, yaw, rudder, ctl]) => {
              const E = (i) => document.getElementById(i);
              return E("ship-needle").getAttribute("transform") !== needle
-               && E("track-line").getAttribute("points").split(" ").length > points + 3
+               && E("track-line").getAttribute("points") !== points
                && E("yaw-rate").textContent !== yaw && E("rudder-angle").textContent !== rudder
                && E("controller").textContent !== ctl && E("rudder-bar").getAttribute("width") !== null;
            }""", arg=[needle0, points0, yaw0, rudder0, ctl0])

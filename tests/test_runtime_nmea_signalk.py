@@ -154,3 +154,60 @@ def test_signalk_parse_rejects_what_is_not_a_delta():
                 b'{"updates": [{"values": [{"path": "a", "value": NaN}]}]}', b"\xff\xfe",
                 b"[" * 100_000, json.dumps({**good, "context": 5}).encode()):
         assert signalk.parse_delta(bad) is None
+
+
+# ------------------------------------------------------------------ headings just west of north
+NEAR_NORTH = (-1e-9, -1e-12, -1e-17, 2 * math.pi - 1e-12, 2 * math.pi - 1e-9, -2 * math.pi - 1e-13,
+              4 * math.pi - 1e-15)
+
+
+@pytest.mark.parametrize("psi", NEAR_NORTH)
+def test_heading_just_west_of_north_is_never_360(psi):
+    """HDT/THS/RMC/VTG/HTD carry 0.0 (not 360.0) and Signal K headingTrue is in [0, 2 pi) strictly."""
+    from steerlab.angles import wrap_to_2pi
+
+    st = STATE._replace(psi=psi, v=0.0)                 # COG = heading when there is no sway
+    lines = nmea.state_sentences(st, origin=(54.0, 18.0), wall=WALL)
+    lines.append(nmea.htd_sentence(psi, 0.01, psi, 0.6, 0.17, False))
+    raw = {ln[3:6]: ln.strip().split("*")[0].split(",") for ln in lines}     # the fields as sent
+    for ln in lines:
+        pynmea2.parse(ln.strip(), check=True)
+    fields = {"HDT": raw["HDT"][1], "THS": raw["THS"][1], "RMC": raw["RMC"][8], "VTG": raw["VTG"][1],
+              "HTD set": raw["HTD"][10], "HTD heading": raw["HTD"][17]}
+    for name, text in fields.items():
+        assert 0.0 <= float(text) < 360.0, (name, text)
+        assert float(text) == 0.0, (name, text)       # all of these are within 0.05 deg of north
+        assert not text.startswith("360"), (name, text)
+    for value in (wrap_to_2pi(psi), signalk.state_values(st)["navigation.headingTrue"]):
+        assert 0.0 <= value < 2 * math.pi, value
+    assert nmea.compass_field(math.radians(359.96)) == "0.0" and nmea.compass_field(math.radians(359.94)) == "359.9"
+    assert nmea.compass_field(math.radians(359.996), 2) == "0.00"
+
+
+@given(st.floats(-1e3, 1e3, allow_nan=False))
+def test_compass_field_and_wrap_are_in_range_for_any_angle(a):
+    from steerlab.angles import wrap_to_2pi
+
+    assert 0.0 <= float(nmea.compass_field(a)) < 360.0 and 0.0 <= float(nmea.compass_field(a, 2)) < 360.0
+    w = wrap_to_2pi(a)
+    assert 0.0 <= w < 2 * math.pi
+    assert math.isclose(math.remainder(w - a, 2 * math.pi), 0.0, abs_tol=1e-9)
+
+
+def test_default_origin_is_at_sea_and_one_definition():
+    """The model origin the RMC positions start from: the Gulf of Gdansk, ~14 km off the coast
+    (54.5 N 18.9 E), the same in the library and at serve-ship's --origin default."""
+    import argparse
+
+    from steerlab.commands import serve_ship
+    from steerlab.runtime.ship_server import ShipServer
+
+    assert nmea.DEFAULT_ORIGIN == (54.5, 18.9)
+    p = argparse.ArgumentParser()
+    serve_ship.register(p.add_subparsers(), argparse.HelpFormatter)
+    args = p.parse_args(["serve-ship"])
+    assert serve_ship._origin(args.origin) == nmea.DEFAULT_ORIGIN
+    import inspect
+    assert inspect.signature(ShipServer).parameters["origin"].default is None       # None -> DEFAULT_ORIGIN
+    rmc = pynmea2.parse(nmea.state_sentences(STATE._replace(x_n=0.0, y_e=0.0), wall=WALL)[4].strip())
+    assert (rmc.latitude, rmc.longitude) == pytest.approx(nmea.DEFAULT_ORIGIN, abs=1e-6)

@@ -20,7 +20,7 @@ from steerlab.cli import main
 from steerlab.runtime.autopilot import Autopilot, AutopilotConfig
 from steerlab.runtime.rate_limit import RateLimiter
 from steerlab.runtime.ship_server import ShipServer, ShipServerConfig
-from steerlab.runtime.signalk import AUTOPILOT_STATE, TARGET_HEADING, autopilot_put
+from steerlab.runtime.signalk import AUTOPILOT_STATE, SELF_ID, SELF_URN, TARGET_HEADING, autopilot_put
 from steerlab.runtime.signalk_ws import SignalKStreamServer, Subscriptions
 from steerlab.sim.scenario import scenario_from_dict
 from test_runtime_e2e import SCENARIO, SPEEDUP, controller  # noqa: F401  (fixture)
@@ -46,7 +46,13 @@ def test_subscriptions_patterns_and_modes():
     p = Subscriptions("none")                                      # regular-expression characters are literal
     assert p.apply({"subscribe": [{"path": "a.[b"}]})
     assert p.wants("a.[b") and not p.wants("a.b")
+    for ctx in ("vessels.*", "*", SELF_ID, "vessels.urn:mrn:*"):                 # contexts naming self
+        w = Subscriptions("none")
+        assert w.apply({"context": ctx, "subscribe": [{"path": "navigation.headingTrue"}]}), ctx
+        assert w.wants("navigation.headingTrue")
     for bad in ({"context": "vessels.other", "subscribe": [{"path": "*"}]}, {"subscribe": "*"},
+                {"context": "vessels.urn:mrn:imo:mmsi:*", "subscribe": [{"path": "*"}]},
+                {"context": "aircraft.*", "subscribe": [{"path": "*"}]}, {"context": 7, "subscribe": [{"path": "*"}]},
                 {"subscribe": [{"path": 3}]}, {"subscribe": [{}]}, {"subscribe": [{"path": ""}]},
                 {"subscribe": [{"path": "*"}] * 65}, {"context": "vessels.self"}):
         assert not Subscriptions("none").apply(bad)
@@ -186,7 +192,7 @@ def test_ship_and_autopilot_signalk_streams(controller):  # noqa: F811
 
         async with connect(url) as ws:                    # the ship server: state paths, read-only
             hello = json.loads(await ws.recv())
-            assert hello["version"] == "1.7.0" and hello["self"] == "vessels.self" and "master" in hello["roles"]
+            assert hello["version"] == "1.7.0" and hello["self"] == SELF_ID and "master" in hello["roles"]
             deltas = await _deltas(ws, 5)
             for d in deltas:
                 assert set(d) == STATE_PATHS
@@ -255,8 +261,16 @@ def test_signalk_rest_api_serves_the_latest_values_to_a_real_http_client():
             assert api == f"http://{host}:{port}/signalk/v1/api/"
             status, ctype, full = await asyncio.to_thread(get, api)
             assert status == 200 and ctype == "application/json"
-            vessel = full["vessels"]["self"]
-            assert full["self"] == "vessels.self" and full["version"] == disco["endpoints"]["v1"]["version"]
+            assert full["self"] == SELF_ID and full["version"] == disco["endpoints"]["v1"]["version"]
+            vessel = full["vessels"][SELF_URN]
+            # GET /self: the self vessel's id (a JSON string); "self" and the URN are aliases
+            _, _, self_id = await asyncio.to_thread(get, api + "self")
+            assert self_id == SELF_ID == "vessels." + SELF_URN and SELF_URN.startswith("urn:mrn:signalk:uuid:")
+            _, _, by_urn = await asyncio.to_thread(get, api + f"vessels/{SELF_URN}/navigation/headingTrue")
+            _, _, by_alias = await asyncio.to_thread(get, api + "vessels/self/navigation/headingTrue")
+            assert by_urn == by_alias and by_alias["value"] == 1.25
+            _, _, vessels = await asyncio.to_thread(get, api + "vessels")
+            assert list(vessels) == [SELF_URN]
             assert vessel["navigation"]["headingTrue"]["value"] == 1.25
             assert vessel["steering"]["rudderAngle"] == {
                 "value": 0.2, "timestamp": iso_time(1_700_000_001.0), "$source": "steerlab.steerlab-runtime"}

@@ -19,8 +19,13 @@ def wrap_to_pi(angle):
 
 
 def wrap_to_2pi(angle: float) -> float:
-    """Wrap an angle [rad] to [0, 2*pi) (a compass heading)."""
-    return angle % (2.0 * math.pi)
+    """Wrap an angle [rad] to [0, 2*pi) (a compass heading), strictly.
+
+    ``a % (2 pi)`` alone rounds a tiny negative angle (``-1e-17``) to exactly ``2 pi``; that
+    value is north, so it is returned as 0.
+    """
+    a = angle % (2.0 * math.pi)
+    return 0.0 if a >= 2.0 * math.pi else a
 
 
 def wrap_to_pi_array(angle):

@@ -48,7 +48,8 @@ def register(sub, formatter_class) -> None:
     p.add_argument("--signalk-ws", metavar="HOST:PORT",
                    help="serve the Signal K stream here (WebSocket ws://HOST:PORT/signalk/v1/stream, read-only)")
     p.add_argument("--nmea-period", type=float, default=0.2, help="NMEA / Signal K period [s] (default 0.2)")
-    p.add_argument("--origin", default="54.5,18.55", help="LAT,LON [deg] of the model origin for RMC")
+    p.add_argument("--origin", default="54.5,18.9",
+                   help="LAT,LON [deg] of the model origin for RMC (default 54.5,18.9: Gulf of Gdansk, at sea)")
     add_link_security(p)
     p.add_argument("--quiet", action="store_true")
     p.set_defaults(func=run)

@@ -13,8 +13,16 @@ change, so a commanded turn does not trip it.
 Guidance: a set course (``--heading``; ``course_reference`` slews the reference at the turn-rate
 limit), a route (the simulator's LOS kernel ``guide(t, x, gd, gz, ref, h)`` called with the
 received state, :mod:`steerlab.runtime.route`; the route is then the only course source) or a
-chart plotter's APB/RMB/XTE sentences (:mod:`steerlab.runtime.nmea`). The heading may come
+chart plotter's APB/RMB/HTC sentences (:mod:`steerlab.runtime.nmea`). The heading may come
 from NMEA HDT/THS instead of the state datagram.
+
+Plotter course: one source steers, by priority APB > RMB > HTC (the first with a sentence younger
+than ``nmea_timeout``; no alternation when a plotter sends both APB and RMB). **Arrival**: once
+the winning source reports its destination waypoint reached (arrival circle or perpendicular
+passed), the autopilot stops steering for that waypoint: it holds the set course in effect and
+raises the ``arrival`` alarm, until the plotter names another destination (it advanced to the
+next leg: steering resumes, the alarm clears). At a route's end the ship so keeps the last course
+instead of circling the passed waypoint.
 
 Clock: ship time ``t = speedup * (wall time since start)``; all periods and timeouts are in
 ship seconds (freshness limits on datagram stamps are in wall seconds). Samples are due at
@@ -40,7 +48,7 @@ from steerlab.errors import InputError, require_finite_range
 from steerlab.guidance.reference_models import course_reference, course_schedule
 from steerlab.guidance.reference_vector import REF_LEG, REF_PSI, REF_XTE, initial_reference
 from steerlab.runtime import protocol as P
-from steerlab.runtime.alarms import LINK, OFF_COURSE, AlarmBoard
+from steerlab.runtime.alarms import ARRIVAL, LINK, OFF_COURSE, AlarmBoard
 from steerlab.runtime.link_filter import LinkFilter
 from steerlab.runtime.udp import LOOPBACK, open_udp, send
 from steerlab.units import deg, rad
@@ -144,7 +152,11 @@ class Autopilot:
         self.samples = 0
         self.skipped = 0               # samples skipped after stalls (not replayed)
         self.nmea_heading = None       # (psi [rad], t)
-        self.nmea_course = None        # (psi_set [rad], t)
+        self.nmea_course = None        # (psi_set [rad], t) of the last course sentence, any source
+        self.nmea_courses: dict = {}   # source -> (psi_set [rad], t, dest, arrived)
+        self.arrived: dict = {}        # source -> the destination id it reported reached
+        self.course_source = None      # what the set course came from last ("APB", "RMB", "HTC", ...)
+        self.steered = (None, None)    # (heading [rad] the last sample steered by, its source)
         self.nmea_counts = {"accepted": 0, "rejected": 0}
         self.signalk_counts = {"accepted": 0, "rejected": 0}
         self.track: deque = deque(maxlen=4000)
@@ -194,6 +206,10 @@ class Autopilot:
             self.nmea_heading = (got["heading"], t)
         if got["course"] is not None:
             self.nmea_course = (got["course"], t)
+        for kind, c in got.get("courses", {}).items():
+            self.nmea_courses[kind] = (c["course"], t, c["dest"], c["arrived"])
+            if c["arrived"]:
+                self.arrived[kind] = c["dest"]
 
     def on_signalk_datagram(self, data: bytes, addr=None, t: float | None = None) -> None:
         from steerlab.runtime.signalk import parse_delta
@@ -214,13 +230,16 @@ class Autopilot:
             self.standby(t)
 
     # ------------------------------------------------------------ operator actions
-    def set_course(self, psi: float, t: float) -> None:
+    def set_course(self, psi: float, t: float, source: str = "operator") -> None:
         """New set course [rad]; the reference slews to it at the turn-rate limit.
 
+        ``source`` names where it came from (``operator``: bridge page, Signal K, ``--heading``;
+        ``APB``/``RMB``/``HTC``: the chart plotter; ``heading``: the heading at engagement).
         Ignored while following a route (the route guidance is the only course source).
         """
         if self.route is not None:
             return
+        self.course_source = source
         psi = wrap_to_pi(float(psi))
         if self.psi_set is not None and abs(wrap_to_pi(psi - self.psi_set)) < 1e-9 and self.gd is not None:
             return
@@ -247,6 +266,26 @@ class Autopilot:
         self.alarms.acknowledge(t, name)
 
     # ------------------------------------------------------------ one sample
+    def _plotter_course(self, t: float):
+        """``(course [rad] or None, source, holding)`` from the chart plotter's sentences.
+
+        The first source in :data:`steerlab.runtime.nmea.COURSE_PRIORITY` with a fresh sentence
+        wins. ``holding``: it is steering for a waypoint it reported reached (course None: keep
+        the set course in effect).
+        """
+        from steerlab.runtime.nmea import COURSE_PRIORITY
+
+        for kind in COURSE_PRIORITY:
+            c = self.nmea_courses.get(kind)
+            if c is None or t - c[1] > self.config.nmea_timeout:
+                continue
+            course, _, dest, arrived = c
+            if arrived or (kind in self.arrived and dest == self.arrived[kind]):
+                return None, kind, True
+            self.arrived.pop(kind, None)          # a new destination: the plotter advanced
+            return course, kind, False
+        return None, None, False
+
     def _heading(self, t: float):
         if self.nmea_heading is not None and t - self.nmea_heading[1] <= self.config.nmea_timeout:
             return self.nmea_heading[0], "nmea"
@@ -267,19 +306,25 @@ class Autopilot:
         psi = src = None
         if link_ok:
             psi, src = self._heading(t)
+            self.steered = (psi, src)
             x = self.ctrl.measured_state(st.x_n, st.y_e, psi, st.u, st.v, st.r, st.delta)
             self.track.append((st.x_n, st.y_e))
             if self.route is not None:       # the simulator's guidance kernel, same call
                 self.route.guide(t, x, self.route.gd, self.gz, self.ref, cfg.sample_time)
                 self.psi_set = float(self.ref[REF_PSI])
                 self.gd = self.route.gd
+                self.course_source = "route"
             else:
-                if self.nmea_course is not None and t - self.nmea_course[1] <= cfg.nmea_timeout:
-                    self.set_course(self.nmea_course[0], t)
+                course, source, holding = self._plotter_course(t)
+                if course is not None:
+                    self.set_course(course, t, source)
+                if source is not None:               # a stale plotter leaves the alarm as it was
+                    self.alarms.set(ARRIVAL, holding, t,
+                                    f"{source}: destination waypoint reached, holding the last course")
                 if self.psi_set is None:
-                    self.set_course(psi, t)
+                    self.set_course(psi, t, "heading")
                 if self.gd is None:
-                    self.set_course(self.psi_set, t)
+                    self.set_course(self.psi_set, t, self.course_source or "operator")
                 course_reference(t, self.gd, self.ref)
             if self.want_engaged and not self.engaged:
                 self.ctrl.reset(x, self.ref)
@@ -332,14 +377,34 @@ class Autopilot:
         mode = (P.MODE_ENGAGED if self.mode == "auto" else 0) | (P.MODE_SAFE if self.mode == "safe" else 0)
         return P.Command(self.cmd_sent, self.config.rpm_cmd, mode)
 
+    def _track_summary(self, max_points: int = 400) -> list:
+        """The autopilot's own track history (x_n, y_e) [m], every k-th sample so that at most
+        ``max_points`` (+ the newest) are sent: the page draws it whenever it was opened."""
+        pts = list(self.track)
+        if not pts:
+            return []
+        step = -(-len(pts) // max_points)
+        out = pts[::step]
+        if out[-1] != pts[-1]:
+            out.append(pts[-1])
+        return [[float(x), float(y)] for x, y in out]
+
     def status(self) -> dict:
-        """Everything the bridge page shows (SI; the page converts to degrees)."""
+        """Everything the bridge page shows (SI; the page converts to degrees).
+
+        ``heading`` is the ship state's; ``steered_heading`` the one the last sample steered by
+        and ``heading_source`` where it came from (``nmea``: HDT/THS, ``state``: the state
+        datagram); ``course_source`` what set the set course (``operator``, ``APB``, ``route``...);
+        ``track`` the autopilot's track history (:meth:`_track_summary`).
+        """
         st = self.latest
         r = self.last_row
         return {
             "t": r.get("t", 0.0), "mode": self.mode, "link_ok": bool(r.get("link_ok", 0)),
             "state_age": r.get("state_age"),
             "heading": None if st is None else wrap_to_2pi(st.psi),
+            "steered_heading": None if self.steered[0] is None else wrap_to_2pi(self.steered[0]),
+            "heading_source": self.steered[1], "course_source": self.course_source,
             "set_course": None if self.psi_set is None else wrap_to_2pi(self.psi_set),
             "reference": None if self.gd is None else wrap_to_2pi(float(self.ref[0])),
             "yaw_rate": None if st is None else st.r, "rudder": None if st is None else st.delta,
@@ -348,6 +413,7 @@ class Autopilot:
             "alarms": self.alarms.snapshot(), "controller": self.ctrl.name,
             "link": {k: v for k, v in self.filter.counts.items()},
             "route": self.route.route.tolist() if self.route is not None else [],
+            "track": self._track_summary(),
             "off_course_limit": self.config.off_course_limit,
             "ship_status": None if st is None else st.status,
         }

@@ -16,8 +16,15 @@ In (autopilot): ``HDT``/``THS`` give the heading; ``APB`` ("heading to steer" if
 else "bearing present position to destination"), ``RMB`` (true bearing to destination) and
 ``HTC`` (heading to steer) give the set course. A bearing is corrected for the sentence's own
 cross-track error ``xte`` with direction to steer L/R: ``course = bearing ± atan(xte / lookahead)``.
-``XTE`` is parsed and counted (APB and RMB carry the same error). Lines need a valid checksum;
-anything else is counted as rejected, never raised.
+``XTE`` is parsed and counted (APB and RMB carry the same error; XTE gives no course). Lines need
+a valid checksum; anything else is counted as rejected, never raised.
+
+Course source priority (:data:`COURSE_PRIORITY`): **APB > RMB > HTC**. A plotter that sends
+both APB and RMB steers by APB alone (it carries the heading to steer and the leg's bearing);
+RMB is used only while no fresh APB arrives, HTC only while neither does. Arrival (chart-plotter
+convention): APB's "arrival circle entered" or "perpendicular passed" = ``A``, or RMB's arrival
+status = ``A``, marks the destination waypoint as reached (``arrived``, ``dest``); the autopilot
+then stops steering for it (:meth:`steerlab.runtime.autopilot.Autopilot.sample`).
 """
 
 from __future__ import annotations
@@ -35,6 +42,10 @@ EARTH_RADIUS = 6_371_000.0
 MAX_LINE = 96
 MAX_LINES = 32
 TALKER = "II"
+COURSE_PRIORITY = ("APB", "RMB", "HTC")   #: course sources, the first fresh one wins
+DEFAULT_ORIGIN = (54.5, 18.9)
+"""Default model origin (lat, lon) [deg]: open water in the Gulf of Gdansk, about 14 km off the
+nearest coast (the former default, 54.5 N 18.55 E, is in Gdynia, on land)."""
 
 
 class THS(TalkerSentence):
@@ -86,6 +97,17 @@ def _f(x: float, nd: int = 1) -> str:
     return f"{x:.{nd}f}"
 
 
+def compass_field(angle: float, nd: int = 1) -> str:
+    """A heading or course [rad] as an NMEA field in degrees, ``nd`` decimals, in [0, 360).
+
+    The one place sentences format a direction: wrap first, round second and wrap the rounded
+    text again, so a heading just west of north (-1e-9 rad, 359.99999 deg) is ``0.0``, never
+    ``360.0`` (NMEA 0183 headings and courses are 0 to 359.9...).
+    """
+    text = f"{deg(angle) % 360.0:.{nd}f}"
+    return f"{0.0:.{nd}f}" if float(text) >= 360.0 else text
+
+
 def geo_position(x_n: float, y_e: float, origin) -> tuple[float, float]:
     """``(lat, lon)`` [deg] of a point ``x_n`` m north and ``y_e`` m east of ``origin``."""
     lat0, lon0 = origin
@@ -104,27 +126,26 @@ def _ddmm(value: float, lat: bool) -> tuple[str, str]:
     return (f"{d:02d}{m:07.4f}" if lat else f"{d:03d}{m:07.4f}"), hemi
 
 
-def state_sentences(state, origin=(54.5, 18.55), wall: float | None = None, talker: str = TALKER) -> list[str]:
+def state_sentences(state, origin=DEFAULT_ORIGIN, wall: float | None = None, talker: str = TALKER) -> list[str]:
     """HDT, THS, ROT, RSA, RMC and VTG lines for a :class:`~steerlab.runtime.protocol.State`."""
     wall = time.time() if wall is None else wall
-    hdg = deg(state.psi) % 360.0
     ut = time.gmtime(wall)
     hhmmss = time.strftime("%H%M%S", ut) + f".{int((wall % 1) * 100):02d}"
     ddmmyy = time.strftime("%d%m%y", ut)
     vn = state.u * math.cos(state.psi) - state.v * math.sin(state.psi)
     ve = state.u * math.sin(state.psi) + state.v * math.cos(state.psi)
     sog = math.hypot(vn, ve) / KNOT
-    cog = deg(math.atan2(ve, vn)) % 360.0
+    cog = math.atan2(ve, vn)
     lat, lon = geo_position(state.x_n, state.y_e, origin)
     la, ns = _ddmm(lat, True)
     lo, ew = _ddmm(lon, False)
     return [
-        render("HDT", [_f(hdg), "T"], talker),
-        render("THS", [_f(hdg, 2), "S"], talker),        # S = simulator mode
+        render("HDT", [compass_field(state.psi), "T"], talker),
+        render("THS", [compass_field(state.psi, 2), "S"], talker),        # S = simulator mode
         render("ROT", [_f(deg(state.r) * 60.0, 2), "A"], talker),
         render("RSA", [_f(deg(state.delta)), "A", "", "V"], talker),
-        render("RMC", [hhmmss, "A", la, ns, lo, ew, _f(sog, 2), _f(cog), ddmmyy, "", "", "S"], talker),
-        render("VTG", [_f(cog), "T", "", "M", _f(sog, 2), "N", _f(sog * 1.852, 2), "K", "S"], talker),
+        render("RMC", [hhmmss, "A", la, ns, lo, ew, _f(sog, 2), compass_field(cog), ddmmyy, "", "", "S"], talker),
+        render("VTG", [compass_field(cog), "T", "", "M", _f(sog, 2), "N", _f(sog * 1.852, 2), "K", "S"], talker),
     ]
 
 
@@ -132,7 +153,7 @@ def htd_sentence(set_course, rudder_cmd, heading, rudder_limit, off_heading_limi
                  talker: str = "AG") -> str:
     """The autopilot's HTD line (angles [rad]; ``None`` fields left empty)."""
     def d(x):
-        return "" if x is None else _f(deg(x) % 360.0)
+        return "" if x is None else compass_field(x)
     rud = "" if rudder_cmd is None else _f(abs(deg(rudder_cmd)))
     rdir = "" if rudder_cmd is None else ("R" if rudder_cmd >= 0 else "L")
     at_limit = rudder_cmd is not None and abs(rudder_cmd) >= rudder_limit - 1e-9
@@ -208,6 +229,17 @@ def _course_from(s, lookahead: float):
     return None
 
 
+def _arrival(s) -> tuple[str, bool]:
+    """``(destination waypoint id, reached?)`` of an APB/RMB sentence (``("", False)`` otherwise)."""
+    kind = type(s).__name__
+    dest = str(getattr(s, "dest_waypoint_id", "") or "")
+    if kind == "APB":
+        return dest, getattr(s, "arr_circle_entered", "") == "A" or getattr(s, "perp_passed", "") == "A"
+    if kind == "RMB":
+        return dest, getattr(s, "arrival_alarm", "") == "A"
+    return "", False
+
+
 def _heading_from(s):
     kind = type(s).__name__
     if kind == "HDT":
@@ -218,11 +250,15 @@ def _heading_from(s):
 
 
 def steering_inputs(data: bytes, lookahead: float = 500.0) -> dict:
-    """Heading [rad] and set course [rad] (the last of each in the datagram, or None).
+    """Heading [rad] and set course [rad] (the last heading; the course of the highest-priority
+    source in the datagram, :data:`COURSE_PRIORITY`), or None.
 
-    Counts ``accepted`` (parsed with a valid checksum) and ``rejected`` lines; never raises.
+    ``courses`` has the last course of each source: ``{"APB": {"course", "dest", "arrived"}, ...}``;
+    ``course_source`` names the source of ``course``. Counts ``accepted`` (parsed with a valid
+    checksum) and ``rejected`` lines; never raises.
     """
-    out = {"heading": None, "course": None, "xte_m": None, "accepted": 0, "rejected": 0}
+    out = {"heading": None, "course": None, "course_source": None, "courses": {}, "xte_m": None,
+           "accepted": 0, "rejected": 0}
     try:
         text = bytes(data).decode("ascii")
     except Exception:
@@ -242,7 +278,8 @@ def steering_inputs(data: bytes, lookahead: float = 500.0) -> dict:
                 out["heading"] = rad(h % 360.0)
             c = _course_from(s, lookahead)
             if c is not None and math.isfinite(c):
-                out["course"] = c
+                dest, arrived = _arrival(s)
+                out["courses"][type(s).__name__] = {"course": c, "dest": dest, "arrived": arrived}
             if type(s).__name__ == "XTE":
                 x = _xte_m(s.cross_track_err_dist, s.dist_units)
                 if x is not None:
@@ -250,4 +287,8 @@ def steering_inputs(data: bytes, lookahead: float = 500.0) -> dict:
         except Exception:
             out["rejected"] += 1
             out["accepted"] -= 1
+    for kind in COURSE_PRIORITY:
+        if kind in out["courses"]:
+            out["course"], out["course_source"] = out["courses"][kind]["course"], kind
+            break
     return out

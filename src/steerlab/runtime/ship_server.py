@@ -96,12 +96,13 @@ class ShipServer:
     signalk_ws : (host, port) or None
         Serve the Signal K stream here (WebSocket, read-only), updated every ``nmea_period``.
     origin : (lat_deg, lon_deg)
-        Geographic position of the model's origin (for RMC).
+        Geographic position of the model's origin (for RMC); None: at sea in the Gulf of Gdansk
+        (:data:`steerlab.runtime.nmea.DEFAULT_ORIGIN`).
     """
 
     def __init__(self, scenario, config: ShipServerConfig = ShipServerConfig(), key=None,
                  bind=(LOOPBACK, 0), publish_to=(), nmea_to=None, signalk_to=None,
-                 origin=(54.5, 18.55), signalk_ws=None):
+                 origin=None, signalk_ws=None):
         from steerlab.sim.kernels import plant_step
         from steerlab.sim.setup import build
         from steerlab.units import knots_to_ms
@@ -134,6 +135,8 @@ class ShipServer:
         self.signalk_to = signalk_to
         self.signalk_ws = signalk_ws
         self.signalk_stream = None
+        if origin is None:
+            from steerlab.runtime.nmea import DEFAULT_ORIGIN as origin
         self.origin = origin
         self.stats = ShipServerStats()
         self.rk4_step(0.0, self.x.copy(), 0.0, s.w[0], self.ps, s.pg, self.h, self.work)  # compile now

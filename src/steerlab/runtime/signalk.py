@@ -21,7 +21,9 @@ from __future__ import annotations
 
 import json
 import math
+import re
 import time
+import uuid
 
 from steerlab.angles import wrap_to_2pi
 
@@ -30,6 +32,19 @@ MAX_DELTA_BYTES = 65536
 TARGET_HEADING = "steering.autopilot.target.headingTrue"
 AUTOPILOT_STATE = "steering.autopilot.state"
 WRITABLE = (TARGET_HEADING, AUTOPILOT_STATE)   #: paths a PUT may set on the autopilot
+SELF_URN = "urn:mrn:signalk:uuid:" + str(uuid.uuid5(uuid.NAMESPACE_URL, "steerlab:self"))
+"""The self vessel's identity (Signal K 1.7 "Vessel identity": a URN; fixed, as steerlab serves one vessel)."""
+SELF_ID = "vessels." + SELF_URN      #: what ``GET /signalk/v1/api/self`` and the stream's hello give
+SELF_ALIASES = ("vessels.self", SELF_ID)
+
+
+def is_self_context(ctx) -> bool:
+    """True if a subscription context names the self vessel: ``vessels.self``, :data:`SELF_ID`,
+    or a pattern matching one of them (``*`` = any characters: ``*``, ``vessels.*``)."""
+    if not isinstance(ctx, str) or not 0 < len(ctx) <= 256:
+        return False
+    pat = re.compile("".join(".*" if c == "*" else re.escape(c) for c in ctx))
+    return any(pat.fullmatch(a) for a in SELF_ALIASES)
 
 
 def iso_time(wall: float) -> str:

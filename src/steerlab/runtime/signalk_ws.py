@@ -9,7 +9,8 @@ The part of the Signal K specification (1.7, "Streaming API", "Subscription Prot
 ``GET /signalk/v1/api/...``
     The read-only REST API over the latest values (:mod:`steerlab.runtime.signalk_rest`).
 ``WS /signalk/v1/stream[?subscribe=self|all|none][&sendCachedValues=true|false]``
-    On connection a *hello* (``{"name", "version", "timestamp", "self": "vessels.self", "roles"}``),
+    On connection a *hello* (``{"name", "version", "timestamp", "self": SELF_ID, "roles"}``, the
+    self vessel's URN, :data:`steerlab.runtime.signalk.SELF_ID`; deltas use the alias ``vessels.self``),
     the cached values (unless ``sendCachedValues=false``), then every update as a delta message
     (:func:`steerlab.runtime.signalk.delta`, SI units; the same paths as over UDP), filtered by
     the client's subscriptions. ``subscribe=self`` (default) and ``all`` stream every path,
@@ -18,7 +19,8 @@ The part of the Signal K specification (1.7, "Streaming API", "Subscription Prot
 
 Messages from the client (JSON, at most 64 KiB, at most ``msg_rate`` per second per connection):
 
-* ``{"context": "vessels.self" | "*", "subscribe": [{"path": "navigation.*"}, ...]}`` adds path
+* ``{"context": "vessels.self" | SELF_ID | "vessels.*" | "*", "subscribe": [{"path": "navigation.*"}, ...]}``
+  (a context pattern that matches the self vessel; another vessel's is refused) adds path
   patterns (``*`` matches any characters); ``period``/``policy`` are accepted and ignored (every
   update is sent as it is made: the "instant" policy).
 * ``{"context": ..., "unsubscribe": [{"path": "*"}]}`` removes patterns (``*``: all).
@@ -43,8 +45,9 @@ from http import HTTPStatus
 from websockets.asyncio.server import broadcast, serve
 
 from steerlab.errors import InputError
+from steerlab.runtime.http_conn import HttpConnection
 from steerlab.runtime.rate_limit import RateLimiter
-from steerlab.runtime.signalk import MAX_DELTA_BYTES, delta, iso_time
+from steerlab.runtime.signalk import MAX_DELTA_BYTES, SELF_ID, delta, is_self_context, iso_time
 from steerlab.runtime.signalk_rest import API_PATH, api_get
 from steerlab.runtime.web import _response, same_origin
 
@@ -75,8 +78,7 @@ class Subscriptions:
 
     def apply(self, msg: dict) -> bool:
         """Apply a subscribe / unsubscribe message; False if it is not a valid one."""
-        ctx = msg.get("context", "vessels.self")
-        if ctx not in CONTEXTS:
+        if not is_self_context(msg.get("context", "vessels.self")):
             return False
         for key, add in (("subscribe", True), ("unsubscribe", False)):
             items = msg.get(key)
@@ -159,7 +161,7 @@ class SignalKStreamServer:
         self.counts["clients"] += 1
         try:
             await ws.send(json.dumps({"name": self.name, "version": SIGNALK_VERSION, "timestamp": iso_time(time.time()),
-                                      "self": "vessels.self", "roles": ["master", "main"]}))
+                                      "self": SELF_ID, "roles": ["master", "main"]}))
             self.clients[ws] = subs
             if opts.get("sendCachedValues", "true") == "true":
                 self._send(ws, subs, self.cache)
@@ -244,7 +246,8 @@ class SignalKStreamServer:
     async def start(self) -> "SignalKStreamServer":
         try:
             self.server = await serve(self._handler, self.host, self.port, process_request=self._process_request,
-                                      max_size=MAX_DELTA_BYTES, compression=None, server_header=None)
+                                      max_size=MAX_DELTA_BYTES, compression=None, server_header=None,
+                                      create_connection=HttpConnection)
         except OSError as err:
             raise InputError(self.field, f"cannot bind {self.host}:{self.port}: {err.strerror}") from None
         return self

@@ -26,6 +26,7 @@ from websockets.datastructures import Headers
 from websockets.http11 import Response
 
 from steerlab.errors import InputError
+from steerlab.runtime.http_conn import HttpConnection
 
 STATIC = {"/": ("bridge.html", "text/html; charset=utf-8"),
           "/bridge.js": ("bridge.js", "text/javascript; charset=utf-8"),
@@ -50,7 +51,7 @@ def _json_safe(o):
 
 def _response(status: HTTPStatus, body: bytes, ctype: str) -> Response:
     headers = Headers([("Content-Type", ctype), ("Content-Length", str(len(body))),
-                       ("Cache-Control", "no-store"), ("X-Content-Type-Options", "nosniff"),
+                       ("Connection", "close"), ("Cache-Control", "no-store"), ("X-Content-Type-Options", "nosniff"),
                        ("Content-Security-Policy", "default-src 'self'; connect-src 'self'")])
     return Response(status.value, status.phrase, headers, body)
 
@@ -140,7 +141,7 @@ class BridgeServer:
         try:
             self.server = await serve(self._handler, self.host, self.port,
                                       process_request=self._process_request, max_size=4096,
-                                      compression=None, server_header=None)
+                                      compression=None, server_header=None, create_connection=HttpConnection)
         except OSError as err:
             raise InputError("--web", f"cannot bind {self.host}:{self.port}: {err.strerror}") from None
         return self

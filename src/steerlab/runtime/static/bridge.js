@@ -4,7 +4,13 @@
   const DEG = 180 / Math.PI;
   const $ = (id) => document.getElementById(id);
   const fmt = (x, unit, nd = 1) => (x === null || x === undefined) ? "-" : (x.toFixed(nd) + unit);
-  const fmtDeg = (rad, nd = 1) => (rad === null || rad === undefined) ? "-" : ((rad * DEG + 360) % 360).toFixed(nd) + "\u00b0";
+  // a direction in [0, 360): wrap, round, wrap the rounded text again (359.99 -> "0.0", never "360.0")
+  const fmtDeg = (rad, nd = 1) => {
+    if (rad === null || rad === undefined) return "-";
+    let t = (((rad * DEG) % 360 + 360) % 360).toFixed(nd);
+    if (parseFloat(t) >= 360) t = (0).toFixed(nd);
+    return t + "\u00b0";
+  };
   let ws = null;
   let track = [];
   let lastT = null;
@@ -32,8 +38,20 @@
     $(id).setAttribute("transform", "rotate(" + (rad * DEG) + ")");
   }
 
+  // a scale bar of a round length (1, 2 or 5 x 10^k m) about a quarter of the plot wide
+  function drawScale(span) {
+    const target = span / 4;
+    const p = Math.pow(10, Math.floor(Math.log10(target)));
+    const nice = [5, 2, 1].map((k) => k * p).find((v) => v <= target) || p;
+    const px = nice / span * 300;
+    $("scale-bar").setAttribute("x2", (10 + px).toFixed(1));
+    $("scale-text").textContent = nice >= 1000 ? (nice / 1000) + " km" : nice + " m";
+  }
+
   function drawTrack(s) {
-    if (s.position) {
+    if (Array.isArray(s.track)) {        // the autopilot's own history: the whole track, whenever the page opened
+      track = s.track.slice();
+    } else if (s.position) {
       if (lastT !== null && s.t < lastT) track = [];
       lastT = s.t;
       const p = s.position;
@@ -46,6 +64,7 @@
     let xmin = Infinity, xmax = -Infinity, ymin = Infinity, ymax = -Infinity;
     for (const [x, y] of pts) { xmin = Math.min(xmin, x); xmax = Math.max(xmax, x); ymin = Math.min(ymin, y); ymax = Math.max(ymax, y); }
     const span = Math.max(xmax - xmin, ymax - ymin, 200) * 1.1;
+    drawScale(span);
     const cx = (xmin + xmax) / 2, cy = (ymin + ymax) / 2;
     const toSvg = ([x, y]) => [150 + (y - cy) / span * 300, 150 - (x - cx) / span * 300];  // east right, north up
     const poly = (arr) => arr.map(toSvg).map(([a, b]) => a.toFixed(1) + "," + b.toFixed(1)).join(" ");
@@ -63,14 +82,19 @@
     $("link").textContent = s.link_ok ? "link OK" : "link LOST";
     $("link").className = "badge " + (s.link_ok ? "ok" : "bad");
     $("controller").textContent = "controller: " + s.controller + "   t = " + fmt(s.t, " s", 1);
-    $("heading").textContent = fmtDeg(s.heading);
+    // the heading the autopilot steers by (NMEA HDT/THS or the ship state) and where it came from
+    const steered = (s.steered_heading === null || s.steered_heading === undefined) ? s.heading : s.steered_heading;
+    $("heading").textContent = fmtDeg(steered);
+    $("heading-source").textContent = s.heading_source ? "(" + s.heading_source + ")" : "";
+    $("state-heading").textContent = fmtDeg(s.heading);
     $("set-course").textContent = fmtDeg(s.set_course);
+    $("course-source").textContent = s.course_source ? "(" + s.course_source + ")" : "";
     $("reference").textContent = fmtDeg(s.reference);
     $("yaw-rate").textContent = s.yaw_rate === null ? "-" : fmt(s.yaw_rate * DEG * 60, " \u00b0/min", 1);
     $("speed").textContent = s.speed === null ? "-" : fmt(s.speed / 0.514444, " kn", 1);
     $("rudder-angle").textContent = s.rudder === null ? "-" : fmt(s.rudder * DEG, "\u00b0", 1);
     $("rudder-order").textContent = s.rudder_cmd === null ? "-" : fmt(s.rudder_cmd * DEG, "\u00b0", 1);
-    rotate("ship-needle", s.heading);
+    rotate("ship-needle", steered);
     rotate("set-marker", s.set_course);
     rotate("ref-marker", s.reference);
     const r = s.rudder === null ? 0 : Math.max(-35, Math.min(35, s.rudder * DEG)) / 35 * 100;
