@@ -19,6 +19,7 @@ DECLARED = {
     "steerlab.guidance.reference_vector": ("REFERENCE", "REF_", "N_REF"),
     "steerlab.environment.channels": ("CHANNELS", "W_", "N_CHANNELS"),
     "steerlab.metrics_online": ("ACCUMULATOR", "M_", "N_ACC"),
+    "steerlab.control.pid": ("PARAMS", "C_", "N_PARAMS"),
 }
 
 _HAND_WRITTEN_INDEX = re.compile(r"^[A-Z][A-Z0-9_]*(\s*,\s*[A-Z][A-Z0-9_]*)*\s*=\s*(\d+\s*(,\s*\d+\s*)*(#.*)?$|range\()", re.M)
@@ -80,3 +81,18 @@ def test_index_unpack_size_and_composition():
     assert wrapper.names == ("sigma_psi", "inner.Kp", "inner.T") and wrapper.index("inner.Kp") == 1
     with pytest.raises(ValueError, match="duplicate field name"):
         Layout("bad", "B_", [Field("A", "x"), Field("B", "x")])
+
+
+def test_pid_gain_is_named_once_config_record_and_constants_agree():
+    """The PID's Kp: one declaration gives the scenario field (default, bounds, unit), the
+    record slot and the record type."""
+    from steerlab.control import pid
+
+    schema = pid.PIDConfig.model_json_schema()["properties"]
+    for f in pid.PARAMS.fields[:3]:
+        assert schema[f.name]["default"] == f.default and schema[f.name]["minimum"] == f.lo
+        assert f"[{f.unit}]" in schema[f.name]["description"]
+    rec = pid.PID(Kp=2.0, Ki=0.1, Kd=5.0, u_max=0.5).pack()
+    assert rec[pid.C_KP] == 2.0 and rec[pid.C_KI] == 0.1 and rec[pid.C_KD] == 5.0 and rec[pid.C_UMAX] == 0.5
+    with pytest.raises(InputError, match=r"controller\.u_max: .*allowed range \(0\.0, inf\)"):
+        pid.PID(u_max=0.0).pack()

@@ -57,6 +57,7 @@ class Field:
     hi: Optional[float] = None
     lo_open: bool = False
     hi_open: bool = False
+    default: Optional[float] = None
 
 
 class Layout:
@@ -163,8 +164,48 @@ class Layout:
         (constants ``<inner prefix><const>`` are not exported: kernels read the inner record
         through a view at offset :attr:`size`)."""
         fields = list(self.fields) + [Field(f"{label.upper()}_{f.const}", f"{label}.{f.name}", f.unit, f.doc,
-                                            f.lo, f.hi, f.lo_open, f.hi_open) for f in inner.fields]
+                                            f.lo, f.hi, f.lo_open, f.hi_open, f.default)
+                                      for f in inner.fields]
         return Layout(component or self.component, self.prefix, fields)
+
+    # ---------------------------------------------------------------- generated types
+    def record_type(self, name: str, methods: Optional[dict] = None):
+        """A ``NamedTuple`` class with one attribute per field (defaults from the layout) and
+        ``pack()`` -> the checked record; ``methods`` adds more (e.g. ``init_state``)."""
+        from typing import NamedTuple
+
+        missing = [f.name for f in self.fields if f.default is None]
+        order = sorted(self.fields, key=lambda f: f.default is not None)   # required ones first
+        base = NamedTuple(name + "Fields", [(f.name, float) for f in order])
+        base.__new__.__defaults__ = tuple(f.default for f in order if f.default is not None) or None
+        layout = self
+
+        def pack(rec) -> np.ndarray:
+            return layout.pack(rec._asdict())
+
+        ns = {"pack": pack, "__doc__": f"{self.component} record: " + ", ".join(
+            f"{f.name} [{f.unit}]" for f in self.fields), "LAYOUT": self, **(methods or {})}
+        cls = type(name, (base,), ns)
+        cls.__required__ = tuple(missing)
+        return cls
+
+    def config_fields(self, names: Iterable[str], upper: Optional[Mapping[str, float]] = None) -> dict:
+        """pydantic field definitions ``{name: (float, Field(...))}`` for the scenario schema:
+        default, bounds and ``[unit] doc`` from the layout; ``upper`` adds input-edge upper
+        bounds (sanity limits of a TOML value that the record itself does not need)."""
+        from pydantic import Field as PField
+
+        out = {}
+        for n in names:
+            f = self.fields[self.index(n)]
+            kw = {"description": f"[{f.unit}] {f.doc}"}
+            if f.lo is not None:
+                kw["gt" if f.lo_open else "ge"] = f.lo
+            hi = (upper or {}).get(n, f.hi)
+            if hi is not None:
+                kw["lt" if f.hi_open and n not in (upper or {}) else "le"] = hi
+            out[n] = (float, PField(f.default, **kw))
+        return out
 
     def __repr__(self) -> str:
         return f"Layout({self.component!r}, {self.size} fields: {', '.join(self.names)})"

@@ -14,63 +14,62 @@ compare their ADRC with Kp = 3.81, Kd = 3.95, Ki = 0.00547.
 
 from __future__ import annotations
 
-from typing import Literal, NamedTuple, Optional
+from typing import Literal, Optional
 
 import numba
 import numpy as np
-from pydantic import Field
+from pydantic import Field, create_model
 
 from steerlab.angles import wrap_to_pi
 from steerlab.config_base import FrozenConfig
 from steerlab.control.registry import ControllerSpec
-from steerlab.errors import require_finite_range
+from steerlab.records import Field as RecordField
+from steerlab.records import Layout
 from steerlab.units import rad
 
-C_KP, C_KI, C_KD, C_UMAX = 0, 1, 2, 3
-N_PARAMS = 4
-N_STATE = 1  # integral of the heading error [rad s]
+PARAMS = Layout("controller", "C_", [
+    RecordField("KP", "Kp", "rad/rad", "proportional gain (Zwierzewicz et al. 2021, Sec. 7: 3.81)",
+                lo=0.0, default=3.81),
+    RecordField("KI", "Ki", "1/s", "integral gain (Sec. 7: 0.00547)", lo=0.0, default=0.00547),
+    RecordField("KD", "Kd", "s", "derivative gain on the measured yaw rate (Sec. 7: 3.95)",
+                lo=0.0, default=3.95),
+    RecordField("UMAX", "u_max", "rad", "output limit (scenario default: the gear's limit)",
+                lo=0.0, lo_open=True, default=rad(35.0)),
+], size_name="N_PARAMS")
+PARAMS.export(globals())         # C_KP = 0, C_KI = 1, C_KD = 2, C_UMAX = 3, N_PARAMS = 4
+STATE = Layout("controller state", "Z_", [
+    RecordField("INT", "integral", "rad s", "integral of the heading error (clamping anti-windup)"),
+], size_name="N_STATE")
+STATE.export(globals())          # Z_INT = 0, N_STATE = 1
 
 
-class PID(NamedTuple):
-    """PID gains and output limit."""
+def _init_state(self, x0, ref0) -> np.ndarray:
+    return np.zeros(N_STATE)
 
-    Kp: float = 3.81           #: proportional gain [rad/rad]
-    Ki: float = 0.00547        #: integral gain [1/s]
-    Kd: float = 3.95           #: derivative gain on yaw rate [s]
-    u_max: float = rad(35.0)   #: output limit [rad]
 
-    def pack(self) -> np.ndarray:
-        require_finite_range("controller.Kp", self.Kp, 0.0)
-        require_finite_range("controller.Ki", self.Ki, 0.0)
-        require_finite_range("controller.Kd", self.Kd, 0.0)
-        require_finite_range("controller.u_max", self.u_max, 0.0, lo_open=True)
-        return np.array([self.Kp, self.Ki, self.Kd, self.u_max], dtype=np.float64)
-
-    def init_state(self, x0, ref0) -> np.ndarray:
-        return np.zeros(N_STATE)
+PID = PARAMS.record_type("PID", {"init_state": _init_state})
+"""PID gains and output limit: ``PID(Kp=..., Ki=..., Kd=..., u_max=...)``, ``.pack()``."""
 
 
 @numba.njit(cache=True)
 def pid_update(z, p, t, x, ref, h):
-    """One PID sample; returns the rudder order [rad] and advances the integral ``z[0]``."""
+    """One PID sample; returns the rudder order [rad] and advances the integral ``z[Z_INT]``."""
     e = wrap_to_pi(ref[0] - x[2])
-    ud = p[C_KP] * e + p[C_KI] * z[0] - p[C_KD] * (x[5] - ref[1])
+    ud = p[C_KP] * e + p[C_KI] * z[Z_INT] - p[C_KD] * (x[5] - ref[1])
     umax = p[C_UMAX]
     u = min(max(ud, -umax), umax)
     if u == ud or e * ud < 0.0:
-        z[0] += e * h
+        z[Z_INT] += e * h
     return u
 
 
-class PIDConfig(FrozenConfig):
-    """``[controller] type = "pid"`` in a scenario (degrees only at this edge)."""
-
-    type: Literal["pid"]
-    Kp: float = Field(3.81, ge=0.0, le=1e4, description="[rad/rad]")
-    Ki: float = Field(0.00547, ge=0.0, le=1e4, description="[1/s]")
-    Kd: float = Field(3.95, ge=0.0, le=1e5, description="[s]")
-    u_max_deg: Optional[float] = Field(None, gt=0.0, le=90.0, description="default: gear limit")
-    sample_time: Optional[float] = Field(None, gt=0.0, le=60.0, description="default: dt")
+PIDConfig = create_model(
+    "PIDConfig", __base__=FrozenConfig, __doc__='``[controller] type = "pid"`` in a scenario (degrees only at this edge).',
+    type=(Literal["pid"], ...),
+    **PARAMS.config_fields(("Kp", "Ki", "Kd"), upper={"Kp": 1e4, "Ki": 1e4, "Kd": 1e5}),
+    u_max_deg=(Optional[float], Field(None, gt=0.0, le=90.0, description="[deg] default: gear limit")),
+    sample_time=(Optional[float], Field(None, gt=0.0, le=60.0, description="[s] default: dt")))
+PIDConfig.__module__ = __name__
 
 
 def build(cfg: PIDConfig, ctx):
