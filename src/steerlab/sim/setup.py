@@ -209,10 +209,11 @@ _Design = Design   # the former private name
 
 def check_state_size(spec: ControllerSpec, z0) -> None:
     """``ControllerSpec.n_state`` against the initial state the design gives (InputError naming it)."""
-    n = np.asarray(z0).shape[0]
-    if np.asarray(z0).ndim != 1 or n != spec.n_state:
+    z0 = np.asarray(z0)
+    if z0.ndim != 1 or z0.shape[0] != spec.n_state:
+        got = z0.shape[0] if z0.ndim == 1 else f"an array of shape {z0.shape}"
         raise InputError("controller.type", f"controller {spec.name!r} declares n_state = {spec.n_state} "
-                                            f"but its init_state gives {np.asarray(z0).shape} values")
+                                            f"but its init_state gives {got} values")
 
 
 def realise(d: Design, seed: int) -> SimSetup:
