@@ -21,7 +21,8 @@ specs from, in this order,
        STEERLAB_PLUGINS=./my_ship.py:./my_controller.py steerlab tune my.toml ...
 
 4. :meth:`Registry.register` (``steerlab.register_ship(spec)``,
-   ``steerlab.register_controller(spec)``) and :meth:`Registry.register_module`.
+   ``steerlab.register_controller(spec)``) and :func:`register_module` (a module by dotted
+   name or ``.py`` path: its ships and controllers).
 
 A name declared twice is an error. Item assignment (``SHIPS["x"] = spec``) is refused with a
 message pointing to ``register_*``: it used to be accepted and silently ignored.
@@ -249,3 +250,19 @@ class Registry(Mapping):
             return found[name]
         except KeyError:
             raise InputError(self.field, f"unknown {self.kind} {name!r}; known {self.kind}s: {sorted(found)}") from None
+
+
+def register_module(ref: str, replace: bool = False) -> list:
+    """Import a module (dotted name or ``.py`` path) and register every ship (``SHIP_SPECS``)
+    and controller (``CONTROLLER``/``CONTROLLERS``) it declares; returns the specs."""
+    from steerlab.control.registry import CONTROLLERS
+    from steerlab.ships.registry import SHIPS
+
+    module = load_module(ref)
+    out = []
+    for reg in (SHIPS, CONTROLLERS):
+        out += [reg.register(s, replace) for s in reg.collect(module)]
+    if not out:
+        raise InputError(PLUGINS_ENV, f"module {ref!r} declares no ship (SHIP_SPECS) and no controller "
+                                      "(CONTROLLER, CONTROLLERS)")
+    return out
