@@ -31,6 +31,7 @@ _LAZY = {
     "register_ship": "steerlab.ships.registry:register_ship",
     "simulate": "steerlab.sim.engine:simulate",
     "simulate_batch": "steerlab.sim.batch:simulate_batch",
+    "vary": "steerlab.sim.vary:vary",
 }
 
 
