@@ -29,3 +29,14 @@ def test_library_does_not_import_the_cli():
 def test_no_sweeps_tuning_cycle():
     sweeps = _package_imports("sweeps")
     assert not any(m.startswith("steerlab.tuning") for m in sweeps), "sweeps imports tuning"
+
+
+def test_design_context_and_gear_are_built_in_one_place():
+    """Only steerlab.sim.setup builds a DesignContext or a scenario's gear (the one design path)."""
+    allowed = {SRC / "sim" / "setup.py", SRC / "control" / "design_context.py"}
+    for path in SRC.rglob("*.py"):
+        if path in allowed:
+            continue
+        text = path.read_text(encoding="utf-8")
+        assert "DesignContext(" not in text, f"{path.relative_to(SRC)} builds a DesignContext"
+        assert "SteeringGear(rad(" not in text, f"{path.relative_to(SRC)} builds a scenario's gear"

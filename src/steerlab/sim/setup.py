@@ -64,11 +64,6 @@ class SimSetup:
         return tuple(self.ship.state_units) + ("rad",)
 
 
-def controller_params(cfg, ctx: DesignContext):
-    """``(controller, packed params)`` for a validated controller config (its module's ``build``)."""
-    return get_controller(cfg.type).build(cfg, ctx)
-
-
 def controller_spec(name: str) -> ControllerSpec:
     """The spec of a controller name as a setup carries it, wrappers included:
     ``"pid"``, ``"pid+wf"`` (registered) or ``"pid+sensors"`` (the ``[sensors]`` wrapper that
