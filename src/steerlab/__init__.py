@@ -27,8 +27,11 @@ _LAZY = {
     # name: "module:attribute" (one line each; keep sorted within a block)
     "default_scenario": "steerlab.sim.scenario:default_scenario",
     "load_scenario": "steerlab.sim.scenario:load_scenario",
+    "register_controller": "steerlab.control.registry:register_controller",
+    "register_ship": "steerlab.ships.registry:register_ship",
     "simulate": "steerlab.sim.engine:simulate",
     "simulate_batch": "steerlab.sim.batch:simulate_batch",
+    "vary": "steerlab.sim.vary:vary",
 }
 
 

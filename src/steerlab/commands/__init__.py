@@ -8,14 +8,10 @@ Use :func:`steerlab.cli.staged_output` for ``--out`` directories and
 so that ``steerlab --help`` stays fast.
 """
 
-import importlib
-import pkgutil
 
 
 def command_modules():
     """The command modules, in name order."""
-    import steerlab.commands as pkg
+    from steerlab.plugins import package_modules
 
-    for mod in sorted(pkgutil.iter_modules(pkg.__path__), key=lambda m: m.name):
-        if not mod.name.startswith("_"):
-            yield importlib.import_module(f"steerlab.commands.{mod.name}")
+    return package_modules("steerlab.commands")

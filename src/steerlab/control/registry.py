@@ -2,7 +2,9 @@
 
 A controller module declares itself with a module-level ``CONTROLLER = ControllerSpec(...)``
 (or ``CONTROLLERS = [...]`` for several). Nothing else needs editing to add one: the scenario
-schema, the CLI and the engines pick it up from here.
+schema, the CLI and the engines pick it up from here. Controllers outside the package:
+:func:`register_controller`, the entry-point group ``steerlab.controllers`` or the
+``STEERLAB_PLUGINS`` variable (:mod:`steerlab.plugins`); docs/adding-a-controller.md.
 
 ``config`` is a :class:`~steerlab.config_base.FrozenConfig` subclass with a field
 ``type: Literal["<name>"]`` (the discriminator of ``[controller]`` in a scenario) and
@@ -14,13 +16,10 @@ schema, the CLI and the engines pick it up from here.
 
 from __future__ import annotations
 
-import importlib
-import pkgutil
 from dataclasses import dataclass
-from functools import lru_cache
 from typing import Callable
 
-from steerlab.errors import InputError
+from steerlab.plugins import Registry
 
 
 @dataclass(frozen=True)
@@ -34,65 +33,34 @@ class ControllerSpec:
     source: str = ""
 
 
-_SKIP = {"registry", "design_context", "__init__"}
+def _collect(module) -> list:
+    """The controllers a module declares (``CONTROLLERS`` list and/or ``CONTROLLER``)."""
+    specs = list(getattr(module, "CONTROLLERS", ()))
+    if hasattr(module, "CONTROLLER"):
+        specs.append(module.CONTROLLER)
+    return specs
 
 
-@lru_cache(maxsize=None)
+def _wave_filtered(spec) -> list:
+    """Every controller also comes behind the wave filter, as ``"<name>+wf"``."""
+    from steerlab.control.wave_filtered import wave_filtered_variants
+
+    return wave_filtered_variants(spec)
+
+
+CONTROLLERS = Registry("controller", "steerlab.control", _collect, ControllerSpec, "controller.type",
+                       "steerlab.controllers", skip={"registry", "design_context"}, derive=_wave_filtered)
+"""Lazy read-only view ``name -> ControllerSpec`` (:class:`steerlab.plugins.Registry`)."""
+
+
 def _discover() -> dict:
-    import steerlab.control as pkg
-
-    found = {}
-    for mod in sorted(pkgutil.iter_modules(pkg.__path__), key=lambda m: m.name):
-        if mod.name in _SKIP or mod.name.startswith("_"):
-            continue
-        module = importlib.import_module(f"steerlab.control.{mod.name}")
-        specs = list(getattr(module, "CONTROLLERS", ()))
-        if hasattr(module, "CONTROLLER"):
-            specs.append(module.CONTROLLER)
-        for spec in specs:
-            if spec.name in found:
-                raise RuntimeError(f"controller {spec.name!r} declared twice")
-            found[spec.name] = spec
-    return found
-
-
-class _Registry(dict):
-    """Lazy, read-only view of the discovered controllers (name -> ControllerSpec)."""
-
-    def _d(self):
-        return _discover()
-
-    def __getitem__(self, k):
-        return self._d()[k]
-
-    def __contains__(self, k):
-        return k in self._d()
-
-    def __iter__(self):
-        return iter(self._d())
-
-    def __len__(self):
-        return len(self._d())
-
-    def keys(self):
-        return self._d().keys()
-
-    def items(self):
-        return self._d().items()
-
-    def values(self):
-        return self._d().values()
-
-    def get(self, k, default=None):
-        return self._d().get(k, default)
-
-
-CONTROLLERS = _Registry()
+    return CONTROLLERS._discover()
 
 
 def get_controller(name: str) -> ControllerSpec:
-    try:
-        return _discover()[name]
-    except KeyError:
-        raise InputError("controller.type",
-                         f"unknown controller {name!r}; known controllers: {sorted(_discover())}") from None
+    return CONTROLLERS.get_spec(name)
+
+
+def register_controller(spec: ControllerSpec, replace: bool = False) -> ControllerSpec:
+    """Make ``spec`` (and its ``"+wf"`` variant) known to scenarios, the CLI and the engines."""
+    return CONTROLLERS.register(spec, replace)

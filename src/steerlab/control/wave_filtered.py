@@ -27,9 +27,10 @@ The filter's K, T come from ``ctx.nomoto()`` (the ship's first-order Nomoto mode
 design speed) unless ``filter_K``, ``filter_T`` are given; ASA itself uses the same filter
 kernel with its on-line identified K*, tau* instead.
 
-Registration: this module wraps every controller it finds in the sibling modules of
-:mod:`steerlab.control` (except ``asa``, which has its own filter) as ``"<name>+wf"``; the
-scenario syntax is the inner controller's block plus ``wave_filter = {...}``::
+Registration: the controller registry (:mod:`steerlab.control.registry`) wraps every
+controller it knows, plug-ins included (except ``asa``, which has its own filter), as
+``"<name>+wf"`` (:func:`wave_filtered_variants`); the scenario syntax is the inner
+controller's block plus ``wave_filter = {...}``::
 
     [controller]
     type = "pid+wf"
@@ -40,8 +41,6 @@ scenario syntax is the inner controller's block plus ``wave_filter = {...}``::
 
 from __future__ import annotations
 
-import importlib
-import pkgutil
 from functools import lru_cache
 from typing import Literal, NamedTuple, Optional
 
@@ -144,20 +143,8 @@ def wave_filtered(spec: ControllerSpec) -> ControllerSpec:
         source=f"{spec.source}; wave filter: van Amerongen (1982) Fig. 4.13-4.14")
 
 
-def _sibling_specs():
-    import steerlab.control as pkg
-
-    skip = {"registry", "design_context", "__init__", __name__.rsplit(".", 1)[1]}
-    for mod in sorted(pkgutil.iter_modules(pkg.__path__), key=lambda m: m.name):
-        if mod.name in skip or mod.name.startswith("_"):
-            continue
-        module = importlib.import_module(f"steerlab.control.{mod.name}")
-        specs = list(getattr(module, "CONTROLLERS", ()))
-        if hasattr(module, "CONTROLLER"):
-            specs.append(module.CONTROLLER)
-        for spec in specs:
-            if spec.name not in NOT_WRAPPED and not spec.name.endswith(SUFFIX):
-                yield spec
-
-
-CONTROLLERS = [wave_filtered(s) for s in _sibling_specs()]
+def wave_filtered_variants(spec: ControllerSpec) -> list:
+    """``[spec + "+wf"]``, or ``[]`` for controllers not wrapped (``asa``, already filtered)."""
+    if spec.name in NOT_WRAPPED or spec.name.endswith(SUFFIX):
+        return []
+    return [wave_filtered(spec)]

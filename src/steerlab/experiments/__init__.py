@@ -6,20 +6,14 @@ quick=False) -> rows`` (the comparison rows ``{"quantity", "paper", "steerlab", 
 name (e.g. ``witkowska-ga``), ``NAME``. ``EXPERIMENTS`` maps the CLI name to the module.
 """
 
-import importlib
-import pkgutil
+from steerlab.plugins import package_modules
 
 
 def _discover() -> dict:
-    import steerlab.experiments as pkg
-
     found = {}
-    for mod in sorted(pkgutil.iter_modules(pkg.__path__), key=lambda m: m.name):
-        if mod.name.startswith("_"):
-            continue
-        module = importlib.import_module(f"steerlab.experiments.{mod.name}")
+    for module in package_modules("steerlab.experiments"):
         if hasattr(module, "run") and hasattr(module, "DESCRIPTION"):
-            found[getattr(module, "NAME", mod.name)] = module
+            found[getattr(module, "NAME", module.__name__.rsplit(".", 1)[1])] = module
     return found
 
 

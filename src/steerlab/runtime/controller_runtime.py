@@ -19,7 +19,9 @@ def runtime_scenario(scenario, controller: str | None, sample_time: float):
 
     The scenario's ``[controller]`` settings are kept if it is of that type, else the named
     controller's defaults are used; a ``sample_time`` field is set to the runtime's (which is
-    also ``dt``). The duration is cut to a few samples (the runtime has no horizon).
+    also ``dt``). The duration is cut to a few samples (the runtime has no horizon). The
+    simulated seas and the simulated ``[sensors]`` are dropped: on board, the measurements
+    come from the link, with the real sensors' own noise, rates and dropouts.
     """
     from steerlab.sim.scenario import scenario_from_dict
 
@@ -31,6 +33,7 @@ def runtime_scenario(scenario, controller: str | None, sample_time: float):
         ctrl["sample_time"] = sample_time
     d.update(controller=ctrl, dt=sample_time, duration=4 * sample_time)
     d["environment"] = {**d["environment"], "waves": False}
+    d["sensors"] = None
     return scenario_from_dict(d)
 
 
@@ -38,20 +41,15 @@ class ControllerRuntime:
     """``reset(x, ref)`` then ``update(t, x, ref) -> delta_cmd`` [rad] every ``h`` seconds."""
 
     def __init__(self, scenario, controller: str | None = None, sample_time: float = 0.125):
-        from steerlab.control.design_context import DesignContext
-        from steerlab.sim.setup import build, controller_params
-        from steerlab.steering_gear import SteeringGear
-        from steerlab.units import knots_to_ms, rad
+        from steerlab.sim.setup import design, realise
 
         if not (0.001 <= sample_time <= 60.0):
             raise InputError("--sample-time", f"must be in [0.001, 60] s, got {sample_time}")
         self.scenario = sc = runtime_scenario(scenario, controller, sample_time)
-        self.setup = s = build(sc)
-        g = sc.gear
-        gear = SteeringGear(rad(g.delta_max_deg), rad(g.rate_max_deg_s), g.T_sg, rad(g.dead_zone_deg))
-        ctx = DesignContext(s.ship, knots_to_ms(sc.ship.speed_kn), gear, sc.dt, sample_time,
-                            s.ship.options(sc.ship.options))
-        self._design, self.p = controller_params(sc.controller, ctx)
+        d = design(sc)                       # the one design path (context, gear, wrappers)
+        self.setup = s = realise(d, sc.seed)
+        gear = d.gear
+        self._design, self.p = d.ctrl, s.pc
         self.name = s.controller.name
         self.kernel = s.controller.update
         self.h = float(sample_time)

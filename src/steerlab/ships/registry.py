@@ -1,21 +1,21 @@
-"""The ships steerlab knows, by name, discovered from the modules of :mod:`steerlab.ships`.
+"""The ships steerlab knows, by name: the modules of :mod:`steerlab.ships`, plug-ins and the user's.
 
 A module declares ships with a module-level ``SHIP_SPECS`` (a list of :class:`ShipSpec`, or a
 function returning one, e.g. built from data files). Nothing else needs editing to add a
-ship: scenarios, the CLI, the engines and the trials pick it up from here.
+ship: scenarios, the CLI, the engines and the trials pick it up from here. Ships outside the
+package: :func:`register_ship`, the entry-point group ``steerlab.ships`` or the
+``STEERLAB_PLUGINS`` variable (:mod:`steerlab.plugins`).
 """
 
 from __future__ import annotations
 
-import importlib
-import pkgutil
 from dataclasses import dataclass
-from functools import lru_cache
 from typing import Callable
 
 from pydantic import ValidationError
 
 from steerlab.errors import InputError
+from steerlab.plugins import Registry
 from steerlab.ships.b2_estimate import b2_estimate
 
 
@@ -97,66 +97,25 @@ class ShipSpec:
             raise InputError(f"ship.options.{loc}" if loc else "ship.options", msg) from None
 
 
-_SKIP = {"registry", "__init__"}
+def _collect(module) -> list:
+    """The ships a module declares (``SHIP_SPECS``: a list, or a function returning one)."""
+    specs = getattr(module, "SHIP_SPECS", ())
+    return list(specs() if callable(specs) else specs)
 
 
-def _iter_modules(pkg):
-    for mod in sorted(pkgutil.walk_packages(pkg.__path__, prefix=pkg.__name__ + "."),
-                      key=lambda m: m.name):
-        if mod.name.rsplit(".", 1)[-1] in _SKIP or mod.name.rsplit(".", 1)[-1].startswith("_"):
-            continue
-        yield importlib.import_module(mod.name)
+SHIPS = Registry("ship", "steerlab.ships", _collect, ShipSpec, "ship.model", "steerlab.ships",
+                 skip={"registry"}, recursive=True)
+"""Lazy read-only view ``name -> ShipSpec`` (:class:`steerlab.plugins.Registry`)."""
 
 
-@lru_cache(maxsize=None)
 def _discover() -> dict:
-    import steerlab.ships as pkg
-
-    found = {}
-    for module in _iter_modules(pkg):
-        specs = getattr(module, "SHIP_SPECS", ())
-        if callable(specs):
-            specs = specs()
-        for spec in specs:
-            if spec.name in found:
-                raise RuntimeError(f"ship {spec.name!r} declared twice")
-            found[spec.name] = spec
-    return found
-
-
-class _Registry(dict):
-    """Lazy, read-only view of the discovered ships (name -> ShipSpec)."""
-
-    def __getitem__(self, k):
-        return _discover()[k]
-
-    def __contains__(self, k):
-        return k in _discover()
-
-    def __iter__(self):
-        return iter(_discover())
-
-    def __len__(self):
-        return len(_discover())
-
-    def keys(self):
-        return _discover().keys()
-
-    def items(self):
-        return _discover().items()
-
-    def values(self):
-        return _discover().values()
-
-    def get(self, k, default=None):
-        return _discover().get(k, default)
-
-
-SHIPS = _Registry()
+    return SHIPS._discover()
 
 
 def get_ship(name: str) -> ShipSpec:
-    try:
-        return _discover()[name]
-    except KeyError:
-        raise InputError("ship.model", f"unknown ship {name!r}; known ships: {sorted(_discover())}") from None
+    return SHIPS.get_spec(name)
+
+
+def register_ship(spec: ShipSpec, replace: bool = False) -> ShipSpec:
+    """Make ``spec`` known by its name to scenarios, the CLI and the engines (``replace``: override)."""
+    return SHIPS.register(spec, replace)

@@ -144,7 +144,9 @@ def _make(key: _Key) -> types.ModuleType:
     if enabled() and nameable:
         try:
             return _from_disk(key, _source(_bindings(refs, key.nx, key.lanes, True)))
-        except OSError:          # read-only or full disk: compile in memory instead
+        except (OSError, ImportError, AttributeError):
+            # read-only or full disk, or a plug-in kernel whose module cannot be imported back
+            # by name: the same driver, compiled in memory
             pass
     return _in_memory(key)
 

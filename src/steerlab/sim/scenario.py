@@ -130,6 +130,14 @@ class EnvironmentConfig(_Frozen):
     wind_rudder: Optional[WindRudderConfig] = None
 
 
+def _controller_field_updated(_spec=None) -> None:
+    """A controller registered after this module was imported joins the ``[controller]`` union."""
+    field = Scenario.model_fields["controller"]
+    field.annotation = Union[tuple(spec.config for spec in CONTROLLERS.values())]
+    field.discriminator = "type"
+    Scenario.model_rebuild(force=True)
+
+
 class Scenario(_Frozen):
     name: str = "scenario"
     description: str = ""
@@ -150,6 +158,9 @@ class Scenario(_Frozen):
     def replace(self, **changes) -> "Scenario":
         """A validated copy with top-level fields replaced (nested: pass whole sub-configs)."""
         return scenario_from_dict({**self.model_dump(), **_dump(changes)})
+
+
+CONTROLLERS.on_register(_controller_field_updated)
 
 
 def _dump(d):

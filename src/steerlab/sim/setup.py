@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -13,7 +13,8 @@ from steerlab.environment.sea import SeaContext, add_sea, uses_sea
 from steerlab.errors import InputError
 from steerlab.guidance.plan import GuidancePlan, build_guidance
 from steerlab.guidance.reference_vector import initial_reference
-from steerlab.sensors.wrapper import with_sensors
+from steerlab.sensors.wrapper import SUFFIX as SENSORS_SUFFIX
+from steerlab.sensors.wrapper import sensed_spec, with_sensors
 from steerlab.ships.registry import ShipSpec, get_ship
 from steerlab.steering_gear import SteeringGear
 from steerlab.units import knots_to_ms, rad
@@ -63,27 +64,50 @@ class SimSetup:
         return tuple(self.ship.state_units) + ("rad",)
 
 
-def controller_params(cfg, ctx: DesignContext):
-    """``(controller, packed params)`` for a validated controller config (its module's ``build``)."""
-    return get_controller(cfg.type).build(cfg, ctx)
+def controller_spec(name: str) -> ControllerSpec:
+    """The spec of a controller name as a setup carries it, wrappers included:
+    ``"pid"``, ``"pid+wf"`` (registered) or ``"pid+sensors"`` (the ``[sensors]`` wrapper that
+    :func:`realise` applies). Batches keep names, not kernels, and resolve them here."""
+    if name.endswith(SENSORS_SUFFIX):
+        return sensed_spec(controller_spec(name[:-len(SENSORS_SUFFIX)]))
+    return get_controller(name)
+
+
+def scenario_gear(s) -> SteeringGear:
+    """The scenario's steering gear (SI) from its ``[gear]`` table."""
+    g = s.gear
+    return SteeringGear(rad(g.delta_max_deg), rad(g.rate_max_deg_s), g.T_sg, rad(g.dead_zone_deg))
 
 
 def build(scenario) -> SimSetup:
     """Validate the combination and pack the arrays (raises :class:`InputError`)."""
-    return _realise(_Design.of(scenario), scenario.seed)
+    return realise(design(scenario), scenario.seed)
 
 
 def build_seeds(scenario, seeds) -> list[SimSetup]:
     """``build`` of the scenario with each of ``seeds``: the seed-independent part (ship,
     gear, controller design, guidance, initial state) is built once, the seas (and sensor
     noise keys) per seed. Each setup equals ``build(scenario.replace(seed=seed))``."""
-    design = _Design.of(scenario)
-    return [_realise(design, int(seed)) for seed in seeds]
+    d = design(scenario)
+    return [realise(d, int(seed)) for seed in seeds]
+
+
+def design(scenario) -> "Design":
+    """The seed-free :class:`Design` of a validated scenario (raises :class:`InputError`)."""
+    return Design.of(scenario)
 
 
 @dataclass(frozen=True)
-class _Design:
-    """The part of a setup that does not depend on the seed."""
+class Design:
+    """The part of a setup that does not depend on the seed.
+
+    The one place where a scenario's design context (:class:`DesignContext`), steering gear
+    and controller design are built and where the controller wrappers are applied: ``+wf``
+    is a registered controller type (designed here like any other), ``+sensors`` is applied
+    per seed by :meth:`wrapped` (through :meth:`controller_record` and :func:`realise`) when
+    the scenario has ``[sensors]``. Every command (run, batch, Monte-Carlo, robustness, tune, trials, the
+    runtime's controller) goes through it.
+    """
 
     scenario: object
     ship: ShipSpec
@@ -100,19 +124,22 @@ class _Design:
     speed: float
     ship_options: object
     dist: Disturbance
+    gear: SteeringGear = None
+    ctx: DesignContext = None
+    ctrl: object = None          # the designed controller (``init_state``)
 
     @classmethod
-    def of(cls, s) -> "_Design":
+    def of(cls, s) -> "Design":
         ship = get_ship(s.ship.model)
-        ctrl_spec = get_controller(s.controller.type)
         speed = knots_to_ms(s.ship.speed_kn)
         ship_options = ship.options(s.ship.options)
         ps = ship.pack(speed, s.ship.rpm, ship_options)
-        gear = SteeringGear(rad(s.gear.delta_max_deg), rad(s.gear.rate_max_deg_s), s.gear.T_sg,
-                            rad(s.gear.dead_zone_deg))
+        gear = scenario_gear(s)
         pg = gear.pack()
         ts = s.controller.sample_time if s.controller.sample_time is not None else s.dt
-        ctrl, pc = controller_params(s.controller, DesignContext(ship, speed, gear, s.dt, ts, ship_options))
+        ctx = DesignContext(ship, speed, gear, s.dt, ts, ship_options)
+        ctrl_spec = get_controller(s.controller.type)
+        ctrl, pc = ctrl_spec.build(s.controller, ctx)
         nc = int(round(ts / s.dt))
         if nc < 1 or abs(nc * s.dt - ts) > 1e-9 * max(ts, 1.0):
             raise InputError("controller.sample_time", f"must be a positive multiple of dt={s.dt} s, got {ts} s")
@@ -130,6 +157,7 @@ class _Design:
             plan.guide(0.0, x0, plan.gd, plan.gz0.copy(), ref, nc * s.dt)
             ref0 = (float(ref[0]), float(ref[1]))
         z0 = np.asarray(ctrl.init_state(x0, ref0), dtype=float)
+        check_state_size(ctrl_spec, z0)
         ws = s.environment.wave_sample_time
         eq39 = s.environment.waves or (s.environment.wave is not None and s.environment.wave.model == "eq39")
         if eq39 and abs(ws / s.dt - round(ws / s.dt)) > 1e-9 * max(1.0, ws / s.dt):
@@ -140,10 +168,50 @@ class _Design:
                            env.wave_sample_time, env.wave_power, wind_speed=env.wind_speed,
                            wind_dir=rad(env.wind_dir_deg), current_speed=env.current_speed,
                            current_dir=rad(env.current_dir_deg))
-        return cls(s, ship, ctrl_spec, ps, pg, pc, z0, x0, ref0, plan, nc, ts, speed, ship_options, dist)
+        return cls(s, ship, ctrl_spec, ps, pg, pc, z0, x0, ref0, plan, nc, ts, speed, ship_options, dist,
+                   gear, ctx, ctrl)
+
+    def context(self, gear: SteeringGear | None = None, sample_time: float | None = None) -> DesignContext:
+        """The design context, optionally with another gear or controller sample time [s]."""
+        return replace(self.ctx, gear=self.gear if gear is None else gear,
+                       sample_time=self.ts if sample_time is None else float(sample_time))
+
+    def designed(self, cfg=None):
+        """``(spec, controller, pc, z0)`` of the controller config ``cfg`` (default: the
+        scenario's, already designed) in this design's context, starting on ``ref0``."""
+        if cfg is None:
+            return self.ctrl_spec, self.ctrl, np.asarray(self.pc, dtype=np.float64), self.z0
+        spec = get_controller(cfg.type)
+        ctrl, pc = spec.build(cfg, self.ctx)
+        z0 = np.asarray(ctrl.init_state(self.x0, self.ref0), dtype=float)
+        check_state_size(spec, z0)
+        return spec, ctrl, np.asarray(pc, dtype=np.float64), z0
+
+    def wrapped(self, spec: ControllerSpec, pc, z0, seed: int):
+        """``(spec, pc, z0)`` behind the seed's wrappers: the ``[sensors]`` block, if any."""
+        if self.scenario.sensors is None:
+            return spec, pc, z0
+        return with_sensors(spec, pc, z0, self.scenario.sensors, int(seed), self.ts, self.x0.shape[0])
+
+    def controller_record(self, cfg=None, seed: int = 0):
+        """``(spec, pc, z0)`` as a run of ``seed`` uses them (:meth:`designed`, then :meth:`wrapped`)."""
+        spec, _, pc, z0 = self.designed(cfg)
+        return self.wrapped(spec, pc, z0, seed)
 
 
-def _realise(d: _Design, seed: int) -> SimSetup:
+_Design = Design   # the former private name
+
+
+def check_state_size(spec: ControllerSpec, z0) -> None:
+    """``ControllerSpec.n_state`` against the initial state the design gives (InputError naming it)."""
+    z0 = np.asarray(z0)
+    if z0.ndim != 1 or z0.shape[0] != spec.n_state:
+        got = z0.shape[0] if z0.ndim == 1 else f"an array of shape {z0.shape}"
+        raise InputError("controller.type", f"controller {spec.name!r} declares n_state = {spec.n_state} "
+                                            f"but its init_state gives {got} values")
+
+
+def realise(d: Design, seed: int) -> SimSetup:
     """The setup of design ``d`` with the seas (and sensor noise) of ``seed``."""
     s = d.scenario
     ship, speed, ship_options, gd = d.ship, d.speed, d.ship_options, d.plan.gd
@@ -158,11 +226,12 @@ def _realise(d: _Design, seed: int) -> SimSetup:
         add_sea(w, env, SeaContext(ship, d.ps, d.x0, speed, lambda: ship.nomoto(speed, ship_options),
                                    headings, lambda: _rudder_b2(ship, speed, ship_options)),
                 s.dt, seed)
-    ctrl_spec, pc, z0 = d.ctrl_spec, d.pc, d.z0
-    if s.sensors is not None:
-        ctrl_spec, pc, z0 = with_sensors(ctrl_spec, pc, z0, s.sensors, seed, d.ts, d.x0.shape[0])
+    ctrl_spec, pc, z0 = d.controller_record(seed=seed)
     return SimSetup(ship, ctrl_spec, d.ps.copy(), d.pg.copy(), pc.copy(), gd.copy(), d.x0.copy(), z0.copy(),
                     w, s.dt, d.nc, s.n_steps, s.name, seed, d.plan)
+
+
+_realise = realise
 
 
 def _rudder_b2(ship, speed, options) -> float:

@@ -32,9 +32,7 @@ from pathlib import Path
 from steerlab.control.design_context import DesignContext
 from steerlab.errors import InputError
 from steerlab.sim.scenario import Scenario, scenario_from_dict
-from steerlab.sim.setup import SimSetup, build, build_seeds
-from steerlab.steering_gear import SteeringGear
-from steerlab.units import knots_to_ms, rad
+from steerlab.sim.setup import Design, SimSetup, design, realise
 
 MAX_CONDITIONS = 100_000
 
@@ -46,18 +44,17 @@ class Condition:
     label: str
     scenario: Scenario
     setup: SimSetup
-    ctx: DesignContext
+    design: Design
+
+    @property
+    def ctx(self) -> DesignContext:
+        """The controller's design context (from the design)."""
+        return self.design.ctx
 
 
 def design_context(s: Scenario) -> DesignContext:
     """The :class:`DesignContext` :func:`steerlab.sim.setup.build` gives the scenario's controller."""
-    from steerlab.ships.registry import get_ship
-
-    ship = get_ship(s.ship.model)
-    gear = SteeringGear(rad(s.gear.delta_max_deg), rad(s.gear.rate_max_deg_s), s.gear.T_sg,
-                        rad(s.gear.dead_zone_deg))
-    ts = s.controller.sample_time if s.controller.sample_time is not None else s.dt
-    return DesignContext(ship, knots_to_ms(s.ship.speed_kn), gear, s.dt, ts, ship.options(s.ship.options))
+    return design(s).ctx
 
 
 def deep_merge(base: dict, over: dict) -> dict:
@@ -72,7 +69,8 @@ def deep_merge(base: dict, over: dict) -> dict:
 
 
 def make_condition(label: str, scenario: Scenario) -> Condition:
-    return Condition(label, scenario, build(scenario), design_context(scenario))
+    d = design(scenario)
+    return Condition(label, scenario, realise(d, scenario.seed), d)
 
 
 def load_variants(path) -> list[tuple[str, dict]]:
@@ -126,9 +124,9 @@ def condition_set(base: Scenario, n_seeds: int = 1, speeds_kn=(), wave_powers=()
             d["environment"]["waves"] = wp > 0
             parts.append(f"waves {wp:g}")
         scenario = scenario_from_dict(d)
-        ctx = design_context(scenario)
         # the seeds share everything but their seas: designed once, realised per seed
-        for seed, setup in zip(seeds, build_seeds(scenario, seeds)):
+        des = design(scenario)
+        for seed in seeds:
             label = ", ".join(parts + ([f"seed {seed}"] if n_seeds > 1 else [])) or "nominal"
-            out.append(Condition(label, scenario.model_copy(update={"seed": seed}), setup, ctx))
+            out.append(Condition(label, scenario.model_copy(update={"seed": seed}), realise(des, seed), des))
     return out

@@ -150,7 +150,7 @@ def write_montecarlo_outputs(stage, res: MonteCarloResult, scenario_name: str) -
     """``montecarlo.json``, ``runs.csv/.parquet``, ``bands.csv/.parquet``, ``percentile_bands.png``."""
     from pathlib import Path
 
-    from steerlab.cli import dump_json
+    from steerlab.outputs import dump_json
     from steerlab.sweeps.tables import new_figure, save_figure, write_table
 
     stage = Path(stage)

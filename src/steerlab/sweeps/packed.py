@@ -72,6 +72,12 @@ class PackedBatch:
     W: np.ndarray
     w_index: np.ndarray
     state_names: tuple = field(default=())
+    guide: object = None               # state-dependent guidance kernel (None: time-only course)
+    GZ: np.ndarray | None = None       # (n, ngz) initial guidance states (None: no guidance state)
+    rpm_slot: int = -1                 # index in PS of the propeller rate the guidance orders
+
+    def _gz(self) -> np.ndarray:
+        return np.zeros((self.n, 0)) if self.GZ is None else self.GZ
 
     @property
     def n(self) -> int:
@@ -85,11 +91,8 @@ class PackedBatch:
             raise InputError("conditions", "a batch needs at least one run")
         s0 = setups[0]
         for i, s in enumerate(setups):
-            if s.guide is not None:
-                raise InputError("guidance.type",
-                                 "tuning, Monte-Carlo and robustness sweeps support the time-based course "
-                                 "guidance only (type = \"course\"); state-dependent guidance (LOS, berthing, "
-                                 "reference models) runs with 'steerlab run' or steerlab.sim.batch.simulate_batch")
+            if s.guide is not s0.guide or s.rpm_slot != s0.rpm_slot:
+                raise InputError(f"conditions[{i}]", "all runs of a batch must use the same kind of guidance")
             if s.ship.rhs is not s0.ship.rhs or s.controller.update is not s0.controller.update:
                 raise InputError(f"conditions[{i}]",
                                  "all runs of a batch must use the same ship model and controller "
@@ -113,9 +116,10 @@ class PackedBatch:
             return np.ascontiguousarray(np.stack(arrays))
 
         W = np.ascontiguousarray(np.stack(w_list))
+        GZ = None if s0.guide is None else stack("gz0")
         return cls(s0.ship.name, s0.controller.name, s0.dt, s0.nc, s0.n_steps, stack("x0"),
                    stack("z0"), stack("ps"), stack("pg"), stack("pc"), stack("gd"), W, w_index,
-                   tuple(s0.state_names))
+                   tuple(s0.state_names), s0.guide, GZ, s0.rpm_slot)
 
     def take(self, idx) -> "PackedBatch":
         """The runs ``idx`` (any integer index array), with only the disturbances they use."""
@@ -123,13 +127,14 @@ class PackedBatch:
         used, w_new = np.unique(self.w_index[idx], return_inverse=True)
         return replace(self, X=self.X[idx], Z=self.Z[idx], PS=self.PS[idx], PG=self.PG[idx],
                        PC=self.PC[idx], GD=self.GD[idx], W=self.W[used],
-                       w_index=w_new.astype(np.int64).ravel())
+                       w_index=w_new.astype(np.int64).ravel(), GZ=None if self.GZ is None else self.GZ[idx])
 
     def tile(self, reps: int) -> "PackedBatch":
         """``reps`` copies of the whole batch, run-major: run ``k * n + c`` is copy k of run c."""
         idx = np.tile(np.arange(self.n), int(reps))
         return replace(self, X=self.X[idx], Z=self.Z[idx], PS=self.PS[idx], PG=self.PG[idx],
-                       PC=self.PC[idx], GD=self.GD[idx], w_index=self.w_index[idx])
+                       PC=self.PC[idx], GD=self.GD[idx], w_index=self.w_index[idx],
+                       GZ=None if self.GZ is None else self.GZ[idx])
 
     def with_pc(self, PC: np.ndarray, Z: np.ndarray | None = None) -> "PackedBatch":
         """The same runs with other controller parameters (and initial controller states)."""
@@ -142,12 +147,13 @@ class PackedBatch:
     def run(self, record_every: int | None = None, progress=None) -> BatchOutput:
         """Run every row with the compiled batch engine (over the local cores);
         ``progress(done, n)`` as for :func:`steerlab.sim.batch.simulate_batch`."""
-        from steerlab.control.registry import get_controller
+        from steerlab.guidance.reference_vector import N_REF
         from steerlab.ships.registry import get_ship
         from steerlab.sim.lanes import LANES, batch_loop
+        from steerlab.sim.setup import controller_spec
 
         ship = get_ship(self.ship_name)
-        ctrl = get_controller(self.controller_name)
+        ctrl = controller_spec(self.controller_name)     # wrappers (+wf, +sensors) included
         n, N = self.n, self.n_steps
         nx = self.X.shape[1]
         rec = N + 1 if record_every is None else int(record_every)
@@ -156,14 +162,16 @@ class PackedBatch:
         n_rec = N // rec + 1
         out_x = np.empty((n, n_rec, nx))
         out_cmd = np.empty((n, n_rec))
-        out_ref = np.empty((n, n_rec, 2))
+        out_ref = np.empty((n, n_rec, 2 if self.guide is None else N_REF))
         acc = np.zeros((n, N_ACC))
         X = self.X.copy()
         Z = self.Z.copy()
-        run_batch = batch_loop(ship.rhs, ctrl.update, nx, LANES, None)  # same cache key as simulate_batch
-        GZ = np.zeros((n, 0))         # time-only course schedules: no guidance state
-        run_batch(X, Z, self.PS, self.PG, self.PC, self.GD, GZ, self.W, self.w_index, self.dt, self.nc,
-                  N, rec, out_x, out_cmd, out_ref, acc, -1, progress=progress)
+        run_batch = batch_loop(ship.rhs, ctrl.update, nx, LANES, self.guide)  # same cache key as simulate_batch
+        GZ = self._gz().copy()
+        # the guidance may order the propeller rate into PS (berthing): run on a copy
+        PS = self.PS if self.rpm_slot < 0 else self.PS.copy()
+        run_batch(X, Z, PS, self.PG, self.PC, self.GD, GZ, self.W, self.w_index, self.dt, self.nc,
+                  N, rec, out_x, out_cmd, out_ref, acc, self.rpm_slot, progress=progress)
         if record_every is None:
             return BatchOutput(acc, X)
         return BatchOutput(acc, X, np.arange(n_rec) * rec * self.dt, out_x, out_cmd, out_ref)

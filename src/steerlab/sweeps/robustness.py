@@ -31,7 +31,7 @@ from steerlab.sim.scenario import scenario_from_dict
 from steerlab.sweeps.conditions import deep_merge, make_condition
 from steerlab.sweeps.executors import LocalExecutor
 from steerlab.sweeps.packed import PackedBatch
-from steerlab.tuning.cost import ONLINE, metric_arrays, parse_cost
+from steerlab.costs import ONLINE, metric_arrays, parse_cost
 
 MAX_POINTS = 100_000
 SHORTCUTS = {"speed_kn": ("ship", "speed_kn")}
@@ -158,7 +158,7 @@ def write_robustness_outputs(stage, res: RobustnessResult, scenario_name: str) -
     """``robustness.json``, ``table.csv/.parquet`` and ``heatmap.png`` (or ``line.png`` for one variation)."""
     from pathlib import Path
 
-    from steerlab.cli import dump_json
+    from steerlab.outputs import dump_json
     from steerlab.sweeps.tables import new_figure, save_figure, write_table
 
     stage = Path(stage)

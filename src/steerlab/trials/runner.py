@@ -24,11 +24,11 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from steerlab.control.design_context import DesignContext
 from steerlab.errors import InputError, require_finite_range
 from steerlab.sim.engine import simulate
 from steerlab.sim.scenario import scenario_from_dict
-from steerlab.sim.setup import SimSetup, build
+from steerlab.sim.setup import SimSetup, design, realise
+from steerlab.sim.setup import scenario_gear as _scenario_gear
 from steerlab.ships.registry import get_ship
 from steerlab.steering_gear import SteeringGear
 from steerlab.trials.program import TRIAL_PROGRAM, TrialProgramConfig
@@ -97,8 +97,7 @@ def _scenario(cond: TrialConditions, duration: float):
 
 def scenario_gear(scenario) -> SteeringGear:
     """The scenario's steering gear (SI), built the same way as :func:`steerlab.sim.setup.build`."""
-    g = scenario.gear
-    return SteeringGear(rad(g.delta_max_deg), rad(g.rate_max_deg_s), g.T_sg, rad(g.dead_zone_deg))
+    return _scenario_gear(scenario)
 
 
 def ideal_gear(gear: SteeringGear, dt: float) -> SteeringGear:
@@ -117,12 +116,10 @@ def trial_setup(cond: TrialConditions, program: TrialProgramConfig, duration: fl
     if not (0.0 < duration <= MAX_DURATION):
         raise InputError("duration", f"trial duration {duration:.0f} s is outside (0, {MAX_DURATION:.0f}] s")
     scenario = _scenario(cond, duration)
-    base = build(scenario)
-    gear = scenario_gear(scenario)
-    if not cond.gear:
-        gear = ideal_gear(gear, cond.dt)
-    ctx = DesignContext(base.ship, cond.speed, gear, cond.dt, cond.dt, base.ship.options(cond.options))
-    prog, pc = build_program(program, ctx)
+    d = design(scenario)
+    base = realise(d, scenario.seed)
+    gear = d.gear if cond.gear else ideal_gear(d.gear, cond.dt)
+    prog, pc = build_program(program, d.context(gear=gear, sample_time=cond.dt))
     pg = base.pg if cond.gear else gear.pack()
     z0 = prog.init_state(base.x0, (base.x0[2], 0.0))
     return replace(base, controller=TRIAL_PROGRAM, pc=np.asarray(pc, dtype=float), z0=z0, nc=1, pg=pg,

@@ -1,6 +1,6 @@
 """Optimiser-based tuning on the compiled batch engine (``steerlab tune``).
 
-:mod:`~steerlab.tuning.cost` (safe cost expressions over the metrics),
+:mod:`~steerlab.costs` (safe cost expressions over the metrics),
 :mod:`~steerlab.tuning.params` (parameter names -> packed controller records, by probing the
 controller's own design rule), :mod:`~steerlab.tuning.evaluator` (a whole population x
 conditions per compiled call), :mod:`~steerlab.tuning.optimisers` (scipy DE, pymoo GA and

@@ -17,7 +17,7 @@ import numpy as np
 from steerlab.errors import InputError
 from steerlab.sweeps.executors import LocalExecutor
 from steerlab.sweeps.packed import PackedBatch
-from steerlab.tuning.cost import PENALTY, metric_arrays
+from steerlab.costs import PENALTY, metric_arrays
 
 AGGREGATES = ("mean", "max")
 MAX_LOG_ROWS = 1000
@@ -31,7 +31,7 @@ class PopulationEvaluator:
     ----------
     conditions : list of :class:`~steerlab.sweeps.conditions.Condition`
     param_map : :class:`~steerlab.tuning.params.ParamMap`
-    costs : list of :class:`~steerlab.tuning.cost.CostExpression`
+    costs : list of :class:`~steerlab.costs.CostExpression`
         One per objective.
     lam : float
         Rudder weight lambda of the speed-loss criterion ``J``.

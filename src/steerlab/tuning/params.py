@@ -100,11 +100,21 @@ class ParamMap:
     bounds: np.ndarray   # (d, 2)
     direct: list         # per parameter: (index, a (C,), b (C,)) or None (designed)
     base_cfgs: list      # controller config per condition
-    ctxs: list           # DesignContext per condition
-    x0s: list            # initial plant state per condition
-    ref0s: list          # (psi_ref0, 0) per condition
+    designs: list        # steerlab.sim.setup.Design per condition
+    seeds: list          # seed per condition (the [sensors] wrapper's noise key)
     base_pc: np.ndarray  # (C, npc)
     base_z: np.ndarray   # (C, nz)
+
+    def record(self, c: int, cfg, cache: dict):
+        """``(pc, z0)`` of config ``cfg`` for condition ``c``: designed once per (config,
+        design) in ``cache``, wrapped per seed (:meth:`steerlab.sim.setup.Design.controller_record`)."""
+        d = self.designs[c]
+        key = (id(cfg), id(d))
+        if key not in cache:
+            cache[key] = d.designed(cfg)
+        spec, _, pc, z0 = cache[key]
+        _, pc, z0 = d.wrapped(spec, pc, z0, self.seeds[c])
+        return pc, z0
 
     @property
     def all_direct(self) -> bool:
@@ -120,20 +130,17 @@ class ParamMap:
                 PC[:, :, i] = a[None, :] * X[:, j:j + 1] + b[None, :]
             Z = np.repeat(self.base_z[None], P, axis=0)
             return PC.reshape(P * C, -1), Z.reshape(P * C, -1)
-        spec = get_controller(self.base_cfgs[0].type)
         PC = np.empty((P, C, self.base_pc.shape[1]))
         Z = np.empty((P, C, self.base_z.shape[1]))
         for p in range(P):
             cache = {}
+            cfgs = {}
             upd = {f: float(v) for f, v in zip(self.fields, X[p])}
             for c in range(C):
-                key = (id(self.base_cfgs[c]), self.ctxs[c])
-                if key not in cache:
-                    cfg = _validated(self.base_cfgs[c], upd, "--bounds")
-                    cache[key] = spec.build(cfg, self.ctxs[c])
-                ctrl, pc = cache[key]
-                PC[p, c] = pc
-                Z[p, c] = ctrl.init_state(self.x0s[c], self.ref0s[c])
+                base = self.base_cfgs[c]
+                if id(base) not in cfgs:
+                    cfgs[id(base)] = _validated(base, upd, "--bounds")
+                PC[p, c], Z[p, c] = self.record(c, cfgs[id(base)], cache)
         return PC.reshape(P * C, -1), Z.reshape(P * C, -1)
 
     def values_dict(self, x) -> dict:
@@ -149,12 +156,10 @@ def build_param_map(conditions, names, bounds: np.ndarray) -> ParamMap:
     if bounds.shape != (len(fields), 2):
         raise InputError("--bounds", f"needs {len(fields)} ranges, got shape {bounds.shape}")
     base_cfgs = [c.scenario.controller for c in conditions]
-    ctxs = [c.ctx for c in conditions]
-    x0s = [c.setup.x0 for c in conditions]
-    ref0s = [(c.setup.x0[2], 0.0) for c in conditions]
     base_pc = np.stack([c.setup.pc for c in conditions])
     base_z = np.stack([c.setup.z0 for c in conditions])
-    direct = []
+    pm = ParamMap(list(names), fields, bounds, [], base_cfgs, [c.design for c in conditions],
+                  [c.scenario.seed for c in conditions], base_pc, base_z)
     for j, f in enumerate(fields):
         lo, hi = bounds[j]
         probes = (lo, hi, 0.5 * (lo + hi))
@@ -165,16 +170,12 @@ def build_param_map(conditions, names, bounds: np.ndarray) -> ParamMap:
         b = np.empty(len(conditions))
         ok = True
         moved_any = False
-        cache = {}
-        for c, (cfg, ctx) in enumerate(zip(base_cfgs, ctxs)):
-            key = (id(cfg), ctx)
-            if key not in cache:
-                outs = []
-                for v in probes:
-                    ctrl, pc = spec.build(_validated(cfg, {f: float(v)}, f"--bounds {names[j]}"), ctx)
-                    outs.append((np.asarray(pc, float), np.asarray(ctrl.init_state(x0s[c], ref0s[c]), float)))
-                cache[key] = outs
-            outs = cache[key]
+        caches = [{} for _ in probes]
+        cfgs = {}
+        for c, cfg in enumerate(base_cfgs):
+            if id(cfg) not in cfgs:
+                cfgs[id(cfg)] = [_validated(cfg, {f: float(v)}, f"--bounds {names[j]}") for v in probes]
+            outs = [pm.record(c, pv, cache) for pv, cache in zip(cfgs[id(cfg)], caches)]
             (p_lo, z_lo), (p_hi, z_hi), (p_mid, z_mid) = outs
             moved = np.nonzero((p_lo != p_hi) | (p_lo != p_mid))[0]
             if len(moved):
@@ -195,5 +196,5 @@ def build_param_map(conditions, names, bounds: np.ndarray) -> ParamMap:
         if not moved_any:
             raise InputError("--params", f"{names[j]!r} ({f}) does not change the controller's "
                                          "parameters in this scenario; it cannot be tuned here")
-        direct.append((idx, a, b) if ok and idx is not None else None)
-    return ParamMap(list(names), fields, bounds, direct, base_cfgs, ctxs, x0s, ref0s, base_pc, base_z)
+        pm.direct.append((idx, a, b) if ok and idx is not None else None)
+    return pm

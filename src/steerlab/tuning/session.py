@@ -22,7 +22,7 @@ import numpy as np
 from steerlab.metrics import METRIC_UNITS
 from steerlab.sweeps.conditions import condition_set
 from steerlab.sweeps.executors import LocalExecutor
-from steerlab.tuning.cost import ONLINE, parse_cost
+from steerlab.costs import ONLINE, parse_cost
 from steerlab.tuning.evaluator import PopulationEvaluator
 from steerlab.tuning.optimisers import TuningResult, run_optimiser
 from steerlab.tuning.params import build_param_map
@@ -101,7 +101,7 @@ def tune(spec: TuneSpec, executor=None, progress=None) -> TuneOutcome:
 
 def _best_metrics(ev: PopulationEvaluator, x) -> list[dict]:
     """All on-line metrics of the best candidate, per condition."""
-    from steerlab.tuning.cost import LOGGED
+    from steerlab.costs import LOGGED
 
     names = set(ONLINE) | (set(LOGGED) if ev.needs_log else set())
     saved, ev.names = ev.names, names
@@ -146,7 +146,7 @@ def _summary(spec, conditions, ev, r: TuningResult, wall) -> dict:
 
 def write_tuning_outputs(stage: Path, outcome: TuneOutcome) -> list[Path]:
     """``result.json``, ``history.csv/.parquet``, ``front.csv/.parquet`` (NSGA-II) and a figure."""
-    from steerlab.cli import dump_json
+    from steerlab.outputs import dump_json
     from steerlab.sweeps.tables import new_figure, save_figure, write_table
 
     stage = Path(stage)

@@ -1,0 +1,268 @@
+"""One registry class for the ships and the controllers: the package's own, other packages' and the user's.
+
+A :class:`Registry` is a lazy, read-only mapping ``name -> spec``. On first use it collects
+specs from, in this order,
+
+1. the modules of its package (``steerlab.ships``, ``steerlab.control``): each module
+   declares its specs with module-level names (``SHIP_SPECS`` for ships; ``CONTROLLER`` or
+   ``CONTROLLERS`` for controllers);
+2. installed packages, through the entry-point groups ``steerlab.ships`` and
+   ``steerlab.controllers`` (``importlib.metadata``). An entry point names a spec, a list
+   of specs, a function returning them, or a module declaring them as in 1::
+
+       # pyproject.toml of another package
+       [project.entry-points."steerlab.ships"]
+       my_ship = "my_package.my_ship"
+
+3. the modules or ``.py`` files named in the environment variable ``STEERLAB_PLUGINS``
+   (separated by ``os.pathsep``), so that every command (and every worker process) sees a
+   user's own module::
+
+       STEERLAB_PLUGINS=./my_ship.py:./my_controller.py steerlab tune my.toml ...
+
+4. :meth:`Registry.register` (``steerlab.register_ship(spec)``,
+   ``steerlab.register_controller(spec)``) and :func:`register_module` (a module by dotted
+   name or ``.py`` path: its ships and controllers).
+
+A name declared twice is an error. Item assignment (``SHIPS["x"] = spec``) is refused with a
+message pointing to ``register_*``: it used to be accepted and silently ignored.
+"""
+
+from __future__ import annotations
+
+import importlib
+import importlib.util
+import os
+import pkgutil
+import sys
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Callable
+
+from steerlab.errors import InputError
+
+PLUGINS_ENV = "STEERLAB_PLUGINS"
+
+
+def load_module(ref: str):
+    """Import a module by dotted name, or a ``.py`` file by path (registered in ``sys.modules``
+    under its stem, so that pickling the specs it defines works in the same process)."""
+    ref = str(ref).strip()
+    if ref.endswith(".py") or os.sep in ref or "/" in ref:
+        path = Path(ref).expanduser().resolve()
+        if not path.is_file():
+            raise InputError(PLUGINS_ENV, f"no such plug-in file {str(path)!r}")
+        name = path.stem
+        existing = sys.modules.get(name)
+        if existing is not None and Path(getattr(existing, "__file__", "") or "").resolve() == path:
+            return existing
+        spec = importlib.util.spec_from_file_location(name, path)
+        module = importlib.util.module_from_spec(spec)
+        sys.modules[name] = module
+        try:
+            spec.loader.exec_module(module)
+        except BaseException:
+            sys.modules.pop(name, None)
+            raise
+        return module
+    try:
+        return importlib.import_module(ref)
+    except ImportError as err:
+        raise InputError(PLUGINS_ENV, f"cannot import plug-in module {ref!r}: {err}") from None
+
+
+def package_modules(package: str, skip=(), recursive: bool = False):
+    """Import and yield the modules of ``package`` in name order (sub-packages too when
+    ``recursive``), except names starting with ``_`` and the base names in ``skip``. The one
+    scanner behind the registries, the experiments and the CLI commands."""
+    pkg = importlib.import_module(package)
+    walk = pkgutil.walk_packages if recursive else pkgutil.iter_modules
+    kw = {"prefix": pkg.__name__ + "."} if recursive else {}
+    skip = set(skip) | {"__init__"}
+    for mod in sorted(walk(pkg.__path__, **kw), key=lambda m: m.name):
+        base = mod.name.rsplit(".", 1)[-1]
+        if base in skip or base.startswith("_"):
+            continue
+        yield importlib.import_module(mod.name if recursive else f"{package}.{mod.name}")
+
+
+def env_plugins() -> list[str]:
+    """The module names or files listed in ``STEERLAB_PLUGINS``."""
+    return [p for p in os.environ.get(PLUGINS_ENV, "").split(os.pathsep) if p.strip()]
+
+
+class Registry(Mapping):
+    """Lazy read-only mapping ``name -> spec`` of one kind of component (module docstring).
+
+    Parameters
+    ----------
+    kind : str
+        ``"ship"`` or ``"controller"`` (messages).
+    package : str
+        Package whose modules are scanned, e.g. ``"steerlab.ships"``.
+    collect : callable
+        ``collect(module) -> list of specs`` a module declares.
+    spec_type : type
+        Class of the specs (checked on registration).
+    field : str
+        The input field an unknown name is reported on (``"ship.model"``).
+    group : str
+        Entry-point group (``"steerlab.ships"``).
+    skip : set of str
+        Module base names not scanned.
+    recursive : bool
+        Scan sub-packages too.
+    derive : callable, optional
+        ``derive(spec) -> list of specs`` made from each spec found or registered (the
+        controllers' ``"<name>+wf"`` wave-filter variants).
+    """
+
+    def __init__(self, kind: str, package: str, collect: Callable, spec_type: type, field: str, group: str,
+                 skip=(), recursive: bool = False, derive: Callable | None = None):
+        self.kind = kind
+        self.package = package
+        self.collect = collect
+        self.spec_type = spec_type
+        self.field = field
+        self.group = group
+        self.skip = set(skip)
+        self.recursive = recursive
+        self.derive = derive
+        self._found: dict | None = None
+        self._origin: dict = {}
+        self._listeners: list = []
+
+    # ------------------------------------------------------------ discovery
+    def _modules(self):
+        return package_modules(self.package, self.skip, self.recursive)
+
+    def _entry_point_objects(self):
+        from importlib.metadata import entry_points
+
+        for ep in entry_points(group=self.group):
+            try:
+                yield f"entry point {ep.name!r} ({ep.value})", ep.load()
+            except Exception as err:  # noqa: BLE001 - a broken plug-in names itself
+                raise InputError(self.group, f"entry point {ep.name!r} ({ep.value}) failed to load: {err}") from None
+
+    def specs_of(self, obj) -> list:
+        """The specs an object declares: a spec, a list of specs, a function returning them, or a module."""
+        if isinstance(obj, self.spec_type):
+            return [obj]
+        if isinstance(obj, type(sys)):
+            return list(self.collect(obj))
+        if callable(obj) and not isinstance(obj, type):
+            return self.specs_of(obj())
+        if isinstance(obj, (list, tuple)):
+            out = []
+            for o in obj:
+                out.extend(self.specs_of(o))
+            return out
+        raise InputError(self.group, f"{obj!r} is not a {self.spec_type.__name__} (nor a list or module of them)")
+
+    def _add(self, found: dict, spec, origin: str, replace: bool = False) -> None:
+        if not isinstance(spec, self.spec_type):
+            raise TypeError(f"{origin}: {spec!r} is not a {self.spec_type.__name__}")
+        if spec.name in found and found[spec.name] is not spec and not replace:
+            raise InputError(self.field, f"{self.kind} {spec.name!r} declared twice "
+                                         f"({self._origin.get(spec.name, '?')} and {origin})")
+        found[spec.name] = spec
+        self._origin[spec.name] = origin
+
+    def _discover(self) -> dict:
+        if self._found is None:
+            found: dict = {}
+            for module in self._modules():
+                for spec in self.collect(module):
+                    self._add(found, spec, module.__name__)
+            for origin, obj in self._entry_point_objects():
+                for spec in self.specs_of(obj):
+                    self._add(found, spec, origin)
+            for ref in env_plugins():
+                for spec in self.collect(load_module(ref)):
+                    self._add(found, spec, f"{PLUGINS_ENV} {ref}")
+            if self.derive is not None:
+                for spec in list(found.values()):
+                    for d in self.derive(spec):
+                        self._add(found, d, f"derived from {spec.name!r}")
+            self._found = found
+        return self._found
+
+    # ------------------------------------------------------------ registration
+    def register(self, spec, replace: bool = False):
+        """Add ``spec`` under ``spec.name`` (``replace=True`` to override a known name); returns it."""
+        found = self._discover()
+        self._add(found, spec, "register", replace)
+        for d in (self.derive(spec) if self.derive is not None else ()):
+            self._add(found, d, f"derived from {spec.name!r}", replace)
+        for fn in self._listeners:
+            fn(spec)
+        return spec
+
+    def register_module(self, ref: str, replace: bool = False) -> list:
+        """Import a module (dotted name or ``.py`` path) and register the specs it declares."""
+        specs = list(self.collect(load_module(ref)))
+        if not specs:
+            raise InputError(self.kind, f"module {ref!r} declares no {self.kind}")
+        return [self.register(s, replace) for s in specs]
+
+    def unregister(self, name: str) -> None:
+        """Forget ``name`` and what was derived from it (a spec registered for a check or a test)."""
+        found = self._discover()
+        spec = found.pop(name, None)
+        self._origin.pop(name, None)
+        if spec is not None and self.derive is not None:
+            for d in self.derive(spec):
+                if found.get(d.name) is d:
+                    found.pop(d.name)
+                    self._origin.pop(d.name, None)
+        for fn in self._listeners:
+            fn(None)
+
+    def on_register(self, fn: Callable) -> None:
+        """Call ``fn(spec)`` after every :meth:`register` (``fn(None)`` after :meth:`unregister`)."""
+        self._listeners.append(fn)
+
+    def __setitem__(self, key, value):
+        raise TypeError(f"the {self.kind} registry is read-only: use steerlab.register_{self.kind}(spec) "
+                        f"(spec.name = {key!r})")
+
+    def __delitem__(self, key):
+        raise TypeError(f"the {self.kind} registry is read-only")
+
+    # ------------------------------------------------------------ mapping
+    def __getitem__(self, k):
+        return self._discover()[k]
+
+    def __contains__(self, k):
+        return k in self._discover()
+
+    def __iter__(self):
+        return iter(self._discover())
+
+    def __len__(self):
+        return len(self._discover())
+
+    def get_spec(self, name: str):
+        """The spec called ``name``; an unknown name is an :class:`InputError` on :attr:`field`."""
+        found = self._discover()
+        try:
+            return found[name]
+        except KeyError:
+            raise InputError(self.field, f"unknown {self.kind} {name!r}; known {self.kind}s: {sorted(found)}") from None
+
+
+def register_module(ref: str, replace: bool = False) -> list:
+    """Import a module (dotted name or ``.py`` path) and register every ship (``SHIP_SPECS``)
+    and controller (``CONTROLLER``/``CONTROLLERS``) it declares; returns the specs."""
+    from steerlab.control.registry import CONTROLLERS
+    from steerlab.ships.registry import SHIPS
+
+    module = load_module(ref)
+    out = []
+    for reg in (SHIPS, CONTROLLERS):
+        out += [reg.register(s, replace) for s in reg.collect(module)]
+    if not out:
+        raise InputError(PLUGINS_ENV, f"module {ref!r} declares no ship (SHIP_SPECS) and no controller "
+                                      "(CONTROLLER, CONTROLLERS)")
+    return out

@@ -1,0 +1,95 @@
+"""steerlab.testing: kernel rules turned into one readable line, parity of the engines."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+from typing import Literal
+
+import numba
+import numpy as np
+import pytest
+from pydantic import create_model
+
+from steerlab.control.pid import PIDConfig
+from steerlab.control.registry import CONTROLLERS, get_controller
+from steerlab.errors import InputError
+from steerlab.ships.registry import SHIPS, get_ship
+from steerlab.testing import check_controller, check_ship
+
+
+@numba.njit
+def _p_law(z, p, t, x, ref, h):
+    e = ref[0] - x[2]
+    return max(-p[3], min(p[3], p[0] * e))
+
+
+@numba.njit
+def _allocating_law(z, p, t, x, ref, h):
+    tmp = np.zeros(2)                      # breaks the rule: allocation in the kernel
+    tmp[0] = p[0] * (ref[0] - x[2])
+    return tmp[0]
+
+
+@numba.njit
+def _long_reader(z, p, t, x, ref, h):
+    return p[0] * (ref[0] - x[2]) + 0.0 * p[40]   # reads past the 4-value PID record
+
+
+def _spec(name, update, **kw):
+    cfg = create_model(f"Cfg_{name}", __base__=PIDConfig, type=(Literal[name], ...))
+    return replace(get_controller("pid"), name=name, config=cfg, update=update, **kw)
+
+
+def _one_line_naming(err, rule, name):
+    text = str(err.value)
+    assert "\n" not in text and f"rule {rule!r}" in text and repr(name) in text, text
+    assert len(text) < 400
+
+
+def test_allocating_kernel_gives_one_line_naming_the_rule():
+    with pytest.raises(InputError) as err:
+        check_controller(_spec("alloc_law_t", _allocating_law))
+    _one_line_naming(err, "no allocation", "alloc_law_t")
+    assert "alloc_law_t" not in CONTROLLERS          # checked, not left registered
+
+
+def test_kernel_reading_past_its_record_is_named():
+    with pytest.raises(InputError) as err:
+        check_controller(_spec("long_reader_t", _long_reader))
+    _one_line_naming(err, "record size", "long_reader_t")
+    assert "parameter record of 4 values" in str(err.value)
+
+
+def test_wrong_state_size_is_named():
+    spec = _spec("wrong_state_t", _p_law, n_state=get_controller("pid").n_state + 2)
+    with pytest.raises(InputError) as err:
+        check_controller(spec)
+    _one_line_naming(err, "declared sizes", "wrong_state_t")
+
+
+def test_a_good_controller_passes_with_parity():
+    out = check_controller(_spec("p_law_t", _p_law))
+    assert out["parity_max_abs_diff"] <= 1e-12 and "no allocation" in out["rules"]
+    assert check_controller(get_controller("pid"))["n_params"] == 4
+
+
+def test_ship_checks():
+    out = check_ship(get_ship("nomoto1"))
+    assert out["n_states"] == get_ship("nomoto1").n_states and out["parity_max_abs_diff"] <= 1e-12
+    esso = get_ship("esso")
+    with pytest.raises(InputError) as err:
+        check_ship(replace(esso, name="esso_bad_names_t", state_names=esso.state_names[:-1]))
+    _one_line_naming(err, "declared sizes", "esso_bad_names_t")
+
+    inner = esso.rhs
+
+    @numba.njit
+    def rhs_alloc(t, x, delta, w, p, dx):
+        v = np.zeros(x.shape[0])
+        inner(t, x, delta, w, p, dx)
+        dx[0] += v[0]
+
+    with pytest.raises(InputError) as err:
+        check_ship(replace(esso, name="esso_alloc_t", rhs=rhs_alloc))
+    _one_line_naming(err, "no allocation", "esso_alloc_t")
+    assert "esso_alloc_t" not in SHIPS
