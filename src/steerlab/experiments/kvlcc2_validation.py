@@ -16,6 +16,8 @@ What is compared
   carry ``paper = null`` and say so. steerlab does not type numbers from memory into a
   comparison. Fill :data:`PUBLISHED` (value and source) when the source is at hand; the rows,
   the gap and the notes follow.
+* **An open-source MMG implementation** (:data:`OPEN_SOURCE`: ``shipmmg`` 0.0.11 with the same
+  data, model scale): advance and tactical diameter of the 35 deg turns, both sides.
 * **Froude scaling**: the same trials on ``kvlcc2-l7`` (the 7 m model, fresh water) must give
   the same non-dimensional numbers (advance/L, tactical/L, overshoots) to within the effect of
   the different water density on the mass ratio (none: all forces scale alike) and of x_G
@@ -48,6 +50,19 @@ NOT_RETRIEVED = ("published free-running value not retrieved from a citable sour
 
 #: Published values: quantity -> (value, source). Empty entries are reported with paper = null.
 PUBLISHED: dict[str, tuple[float, str]] = {}
+
+#: An independent open-source implementation of the MMG standard method with the same KVLCC2 L7
+#: data: ``shipmmg`` 0.0.11 (PyPI, ShipMMG project), ``shipmmg.mmg_3dof.simulate`` run once by
+#: steerlab (scipy solve_ivp, rtol 1e-8) at 1.1794 m/s, n = 11.855 rev/s (steerlab's
+#: self-propulsion rate), rudder ramped at 15.68 deg/s to +-35 deg from t = 1 s, x'_P = -0.48,
+#: rho = 1000; advance and tactical diameter from the execute position. Its structure differs
+#: from YY2015 in the wake (``w_P = w_P0 exp(-4 beta_P^2)``, symmetric, instead of the C_1/C_2
+#: law) and in taking ``v`` at the centre of gravity in ``U`` and ``beta``; no servo lag.
+OPEN_SOURCE = {"advance_starboard": 3.102, "tactical_starboard": 3.092,
+               "advance_port": 2.951, "tactical_port": 2.817}
+OPEN_SOURCE_NOTE = ("'paper' = shipmmg 0.0.11 (open-source MMG, PyPI) with the same data, run by steerlab "
+                    "(module docstring: conditions); its wake model is symmetric (w_P0 exp(-4 beta_P^2)) where "
+                    "YY2015's is not (C_2 = 1.6 / 1.1), which is where the port-side gap comes from")
 
 
 def conditions(ship: str = "kvlcc2"):
@@ -112,6 +127,11 @@ def comparison_rows(full: dict, model: dict) -> list[dict]:
             gap = 100.0 * (s - pub[0]) / pub[0]
             rows.append({"quantity": label, "paper": pub[0], "steerlab": s, "unit": unit,
                          "note": cond + f"source: {pub[1]}; gap {gap:+.1f} %"})
+    for key, val in OPEN_SOURCE.items():
+        label = dict((k, lab) for k, lab, _ in QUANTITIES)[key]
+        m = _float(model["nd"][key])
+        rows.append({"quantity": f"open-source MMG: {label}", "paper": val, "steerlab": m, "unit": "L",
+                     "note": OPEN_SOURCE_NOTE + f"; steerlab = kvlcc2-l7; gap {100.0 * (m - val) / val:+.1f} %"})
     for key, label, unit in QUANTITIES:
         f, m = _float(full["nd"][key]), _float(model["nd"][key])
         gap = 100.0 * (m - f) / f if f else float("nan")
