@@ -236,3 +236,30 @@ def test_kosoko_slipstream_that_would_drive_the_turn_astern_is_refused():
         mmg.load_mmg_data(text.replace("slipstream = 0.0 ", "slipstream = 0.626 "), "k.toml")
     assert e.value.field == "k.toml: rudder.slipstream" and "1.44" in str(e.value)
     assert mmg.slipstream_drag_ratio(mmg.get_mmg_data("kosoko")) == pytest.approx(1.443, rel=1e-3)
+
+
+# ------------------------------------------------------------------ esso-models experiment
+
+def test_esso_models_experiment(tmp_path):
+    import json
+
+    from steerlab.experiments import EXPERIMENTS
+    from steerlab.experiments import esso_models as em
+
+    assert EXPERIMENTS["esso-models"] is em
+    rows = em.run(tmp_path / "out")
+    assert json.loads((tmp_path / "out" / "comparison.json").read_text()) == rows
+    by = {r["quantity"]: r for r in rows}
+    rate = by["20 deg rudder held: steady rate of turn"]
+    assert rate["paper"] == pytest.approx(0.280, abs=0.003)          # esso, deg/s
+    assert rate["steerlab"] / rate["paper"] == pytest.approx(1.47, abs=0.03)
+    # the first 180 deg are tighter in the paper's form (stronger rudder at the approach speed)
+    tac = by["35 deg turn to starboard: tactical diameter / L"]
+    assert tac["paper"] < tac["steerlab"]
+    # the original is asymmetric (propeller side force), the paper's form is not
+    assert by["35 deg turn to port: advance / L"]["paper"] == pytest.approx(
+        by["35 deg turn to starboard: advance / L"]["paper"], rel=1e-9)
+    assert by["35 deg turn to port: advance / L"]["steerlab"] != pytest.approx(
+        by["35 deg turn to starboard: advance / L"]["steerlab"], rel=1e-3)
+    for f in ("esso_turning_track.png", "mss-tanker_turning_track.png", "mss-tanker_10_10_zigzag.png"):
+        assert (tmp_path / "out" / f).stat().st_size > 10_000
