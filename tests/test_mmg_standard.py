@@ -31,12 +31,14 @@ from steerlab.ships.registry import SHIPS
 
 
 def rk4_run(rhs, p, u0, rudder, T, dt, v0=0.0):
-    """Open loop, ideal rudder ``rudder(t)`` [rad]; returns the state history (N, 6)."""
+    """Open loop, ideal rudder ``rudder(t)`` [rad]; returns the state history (N, nx)."""
+    nx = mt.N_STATES if rhs is mt.tanker_rhs else 6
     w = np.zeros(N_CHANNELS)
-    x = np.array([0.0, 0.0, 0.0, u0, v0, 0.0])
-    out = np.empty((int(round(T / dt)) + 1, 6))
+    x = np.zeros(nx)
+    x[3], x[4] = u0, v0
+    out = np.empty((int(round(T / dt)) + 1, nx))
     out[0] = x
-    k1, k2, k3, k4 = (np.zeros(6) for _ in range(4))
+    k1, k2, k3, k4 = (np.zeros(nx) for _ in range(4))
     for k in range(1, out.shape[0]):
         t = (k - 1) * dt
         d = rudder(t)
@@ -204,6 +206,23 @@ def test_mss_tanker_straight_equilibrium_at_80_rpm():
 def _steady_rate(rhs, p, deg):
     X = rk4_run(rhs, p, 8.23, lambda t: math.radians(deg), 3000.0, 0.5)
     return float(np.mean(X[-200:, 5]))
+
+
+def test_mss_tanker_shaft_dynamics_follow_the_rpm_command():
+    """rpm_schedule 80 -> 40 rpm at t = 100 s: the shaft lags with T_m = 50 s, the ship slows."""
+    spec = SHIPS["mss-tanker"]
+    opts = spec.options({"rpm_schedule": [[0, 80], [100, 80], [100, 40]]})
+    p = spec.pack(8.23, 80.0, opts)
+    X = rk4_run(mt.tanker_rhs, p, 8.23, lambda t: mt.straight_equilibrium(8.23, n_rps=80 / 60)[2], 400.0, 0.5)
+    n = 80 / 60 + X[:, 6]
+    assert np.all(np.abs(n[:200] - 80 / 60) < 1e-12)                       # constant before the step
+    k = 200 + 100                                                         # t = 150 s: 50 s = T_m after the step
+    assert n[k] == pytest.approx(40 / 60 + (40 / 60) * math.exp(-1.0), rel=1e-3)
+    assert X[-1, 3] < 8.23 - 1.0                                           # a heavy ship slows slowly (6.66 m/s)
+    with pytest.raises(InputError, match="rpm_schedule"):
+        spec.options({"rpm_schedule": [[0, 90]]})
+    with pytest.raises(InputError, match="shaft_time_constant_s"):
+        spec.options({"shaft_time_constant_s": 0.0})
 
 
 def test_mss_tanker_turns_about_45_percent_faster_than_the_paper_form():

@@ -30,11 +30,16 @@ Sign convention: MSS's ``delta > 0`` turns to PORT (``Nccd < 0``); steerlab's ``
 turns to starboard, so the kernel uses ``d = -delta``. The rest (NED, ``r > 0`` to
 starboard) is the same.
 
-Not carried over from ``tanker.m``: its own rudder limits (10 deg, 2.33 deg/s: steerlab's
-steering gear does that, 35 deg by default) and the shaft dynamics ``n' = (n_c - n)/T_m``,
-``T_m = 50 s``: steerlab holds ``n`` at the commanded rate from t = 0, which is the same for the
-constant command every steerlab scenario gives. Options (``[ship.options]``): ``depth_m``
-(water depth [m], > 18.5; default deep water).
+Shaft dynamics as ``tanker.m``: ``n' = (n_c - n)/T_m``, ``T_m = 50 s``, the command ``n_c``
+limited to 80 rpm. The seventh state is ``dn = n - n_0`` [rev/s], the shaft rate's deviation
+from the rate ``n_0`` it starts at (the rate that holds the scenario speed, or ``[ship] rpm``),
+so a run starts with the shaft at speed; with a constant command ``dn`` stays 0 (fixed rpm).
+Not carried over: ``tanker.m``'s own rudder limits (10 deg, 2.33 deg/s): steerlab's steering
+gear does that (35 deg by default).
+
+Options (``[ship.options]``): ``depth_m`` (water depth [m], > 18.5; default deep water),
+``rpm_schedule = [[t, rpm], ...]`` (the command ``n_c``, piecewise linear,
+:mod:`steerlab.ships.rpm_schedule`; rpm <= 80), ``shaft_time_constant_s`` (``T_m``, default 50).
 """
 
 from __future__ import annotations
@@ -47,10 +52,13 @@ import numba
 import numpy as np
 from pydantic import Field
 
+from pydantic import field_validator
+
 from steerlab.config_base import FrozenConfig
 from steerlab.environment.channels import W_RUDDER, W_YAW_MOMENT
 from steerlab.errors import InputError
 from steerlab.ships.kinematics import earth_velocity
+from steerlab.ships.rpm_schedule import check_rpm_schedule, pack_rate, scheduled_rate
 
 
 class TankerCoefficients(NamedTuple):
@@ -103,20 +111,38 @@ class TankerCoefficients(NamedTuple):
 
 COEF = TankerCoefficients()
 MIN_DEPTH = 18.5   #: m, tanker.m refuses shallower water (the draught is 18.46 m)
+N_MAX_RPM = 80.0   #: tanker.m's shaft-rate limit [rpm]
+T_SHAFT = 50.0     #: tanker.m's shaft time constant T_m [s]
+N_STATES = 7
+STATE_NAMES = ("x_n", "y_e", "psi", "u", "v", "r", "dn")
+STATE_UNITS = ("m", "m", "rad", "m/s", "m/s", "rad/s", "rev/s")
 
 # packed record
 (P_N, P_Z, P_L, P_M11, P_M22, P_M33L2, P_T, P_CUN, P_CNN, P_TUU, P_TUN, P_TNN, P_D11, P_D22, P_D33,
  P_XUU, P_XVV, P_XCCDD, P_XCCBD, P_XUUZ, P_XVRZ, P_XVVZZ,
  P_YT, P_YVV, P_YUV, P_YCCD, P_YCCBBD, P_YURZ, P_YUVZ, P_YVVZ, P_YCCBBDZ,
- P_NT, P_NVR, P_NUV, P_NCCD, P_NCCBBD, P_NURZ, P_NVRZ, P_NUVZ, P_NCCBBDZ) = range(40)
-N_PARAMS = 40
+ P_NT, P_NVR, P_NUV, P_NCCD, P_NCCBBD, P_NURZ, P_NVRZ, P_NUVZ, P_NCCBBDZ, P_INV_TM) = range(41)
+P_RATE = 41        #: rpm block (ships/rpm_schedule.py) from here: the command n_c
+N_FIXED = 41
 
 
 class TankerOptions(FrozenConfig):
-    """``[ship.options]`` of ``mss-tanker``: ``depth_m`` water depth [m] (> 18.5; omit for deep water)."""
+    """``[ship.options]`` of ``mss-tanker`` (module docstring)."""
 
     depth_m: float | None = Field(None, gt=MIN_DEPTH, le=1e5, allow_inf_nan=False,
                                   description="water depth [m]; None = deep water")
+    rpm_schedule: tuple[tuple[float, float], ...] = ()
+    shaft_time_constant_s: float = Field(T_SHAFT, gt=0.0, le=1e4, allow_inf_nan=False,
+                                         description="shaft time constant T_m [s]")
+
+    @field_validator("rpm_schedule")
+    @classmethod
+    def _check(cls, v):
+        v = check_rpm_schedule(v)
+        for i, (_, n) in enumerate(v):
+            if n > N_MAX_RPM:
+                raise ValueError(f"point {i}: rpm {n} above tanker.m's shaft limit (allowed: 0 <= rpm <= {N_MAX_RPM:g})")
+        return v
 
 
 def depth_parameter(depth_m: float | None, c: TankerCoefficients = COEF) -> float:
@@ -128,10 +154,19 @@ def depth_parameter(depth_m: float | None, c: TankerCoefficients = COEF) -> floa
     return c.T / (depth_m - c.T)
 
 
-def pack(n_rps: float, depth_m: float | None = None, c: TankerCoefficients = COEF) -> np.ndarray:
-    """The float64 record :func:`tanker_rhs` reads (``n_rps`` [rev/s], ``depth_m`` [m] or None)."""
+def pack(n_rps: float, depth_m: float | None = None, c: TankerCoefficients = COEF, schedule=(),
+         t_shaft: float = T_SHAFT) -> np.ndarray:
+    """The float64 record :func:`tanker_rhs` reads.
+
+    ``n_rps``: the shaft rate at t = 0 [rev/s] (``n_0``; also the command when ``schedule`` is
+    empty); ``depth_m`` [m] or None; ``schedule``: ``[(t [s], rpm), ...]`` command;
+    ``t_shaft``: ``T_m`` [s].
+    """
     z = depth_parameter(depth_m, c)
-    p = np.zeros(N_PARAMS)
+    block = pack_rate(n_rps, schedule)
+    p = np.zeros(N_FIXED + block.size)
+    p[P_INV_TM] = 1.0 / t_shaft
+    p[P_RATE:] = block
     p[P_N], p[P_Z], p[P_L] = n_rps, z, c.L
     p[P_M11] = c.m11 - c.Xudotz * z
     p[P_M22] = c.m22 - c.Yvdotz * z
@@ -151,14 +186,14 @@ def pack(n_rps: float, depth_m: float | None = None, c: TankerCoefficients = COE
 
 @numba.njit(cache=True)
 def tanker_rhs(t, x, delta, w, p, dx):
-    """Derivatives of ``[x_n, y_e, psi, u, v, r]`` (module docstring); writes ``dx[0:6]``.
+    """Derivatives of ``[x_n, y_e, psi, u, v, r, dn]`` (module docstring); writes ``dx[0:7]``.
 
     Parameters
     ----------
     t : float
         Time [s] (unused).
     x : ndarray
-        State [m, m, rad, m/s, m/s, rad/s].
+        State [m, m, rad, m/s, m/s, rad/s, rev/s].
     delta : float
         Rudder angle [rad], steerlab sign (> 0 turns to starboard; MSS's is the opposite).
     w : ndarray
@@ -176,7 +211,8 @@ def tanker_rhs(t, x, delta, w, p, dx):
     earth_velocity(psi, u, v, w, dx)
     dx[2] = r
     L = p[P_L]
-    n = p[P_N]
+    n = p[P_N] + x[6]
+    dx[6] = (scheduled_rate(t, p, P_RATE) - n) * p[P_INV_TM]
     z = p[P_Z]
     beta = math.atan2(v, u)
     gT = p[P_TUU] * u * u / L + p[P_TUN] * u * n + L * p[P_TNN] * abs(n) * n
@@ -207,8 +243,8 @@ def _forces(u, v, r, delta, n, depth_m):
     from steerlab.environment.channels import N_CHANNELS
 
     p = pack(n, depth_m)
-    dx = np.zeros(6)
-    tanker_rhs(0.0, np.array([0.0, 0.0, 0.0, u, v, r]), delta, np.zeros(N_CHANNELS), p, dx)
+    dx = np.zeros(N_STATES)
+    tanker_rhs(0.0, np.array([0.0, 0.0, 0.0, u, v, r, 0.0]), delta, np.zeros(N_CHANNELS), p, dx)
     return dx[3:6]
 
 
@@ -261,20 +297,19 @@ def linearise(speed: float, options=None, step: float = 1e-6):
 def _spec():
     from steerlab.ships.linear_analysis import nomoto_from_linear
     from steerlab.ships.ship_traits import TraitShipSpec
-    from steerlab.ships.state import PLANAR_NAMES, PLANAR_UNITS
-
     @dataclass(frozen=True)
     class TankerSpec(TraitShipSpec):
         #: ``(speed, options) -> v0 [m/s]``: the drift that, with ``equilibrium_rudder``, holds a straight course
         equilibrium_sway: object = None
 
     def spec_pack(speed, rpm, options=None):
-        depth = getattr(options, "depth_m", None)
+        o = options or TankerOptions()
+        depth, sched, tm = o.depth_m, o.rpm_schedule, o.shaft_time_constant_s
         if rpm is not None:
-            if not (math.isfinite(rpm) and 0.0 < rpm <= 80.0):
-                raise InputError("ship.rpm", f"must be in (0, 80] rpm (tanker.m's n_max), got {rpm}")
-            return pack(rpm / 60.0, depth)
-        return pack(propeller_rate_for_speed(speed, depth), depth)
+            if not (math.isfinite(rpm) and 0.0 < rpm <= N_MAX_RPM):
+                raise InputError("ship.rpm", f"must be in (0, {N_MAX_RPM:g}] rpm (tanker.m's n_max), got {rpm}")
+            return pack(rpm / 60.0, depth, schedule=sched, t_shaft=tm)
+        return pack(propeller_rate_for_speed(speed, depth), depth, schedule=sched, t_shaft=tm)
 
     def nomoto_KT(speed, options=None):
         nn = nomoto_from_linear(*linearise(speed, options))
@@ -285,11 +320,11 @@ def _spec():
         name="mss-tanker",
         description="Esso Osaka 190 kdwt tanker, original Van Berlekom & Goddard (1972) model as in MSS tanker.m "
                     "(slipstream rudder, thrust(u, n), drift x rudder, propeller side force, shallow water)",
-        rhs=tanker_rhs, n_states=6, state_names=PLANAR_NAMES, state_units=PLANAR_UNITS, pack=spec_pack,
+        rhs=tanker_rhs, n_states=N_STATES, state_names=STATE_NAMES, state_units=STATE_UNITS, pack=spec_pack,
         b2_exact=lambda speed, options=None: float(linearise(speed, options)[1][1]),
         dims=(c.c_B, c.L, c.B),
         source="Van Berlekom & Goddard, Trans. SNAME 80 (1972) 264-298, as in Fossen's MSS VESSELS/tanker.m",
-        linearise=linearise, options_model=TankerOptions, nomoto_KT=nomoto_KT, speed_range=(2.0, 9.0),
+        linearise=linearise, options_model=TankerOptions, nomoto_KT=nomoto_KT, speed_range=(2.0, 8.5),
         equilibrium_rudder=lambda speed, options=None: straight_equilibrium(speed, getattr(options, "depth_m", None))[2],
         symmetric=lambda speed, options=None: False,
         equilibrium_sway=lambda speed, options=None: straight_equilibrium(speed, getattr(options, "depth_m", None))[1])
