@@ -1,7 +1,7 @@
 r"""KVLCC2 on the MMG standard method: 35 deg turns and 10/10, 20/20 zig-zags vs published results.
 
 Ship: ``kvlcc2`` (:mod:`steerlab.ships.mmg_standard`, data ``ships/data/mmgstd_kvlcc2.toml``:
-Yasukawa & Yoshimura 2015, Tables 1-3, Froude-scaled to L = 320 m) at the SIMMAN service
+Yasukawa & Yoshimura 2015 data, Froude-scaled to L = 320 m) at the SIMMAN service
 condition: 15.5 kn (Fn = 0.142), propeller at the self-propulsion rate of that speed and held
 constant, rudder rate 2.32 deg/s (SIMMAN 2008/2020 KVLCC2 case 1.2: "2.32 deg/s on full
 scale"), servo lag 0.2 s (steerlab's gear; SIMMAN gives none), 35 deg rudder limit. Trials by
@@ -11,7 +11,7 @@ change; zig-zag: overshoot angles).
 What is compared
 ----------------
 * **Published free-running results** (MARIN free-running model tests of KVLCC2, SIMMAN 2008,
-  shown by YY2015 Figs 9-12 against their MMG simulation): the session that built this
+  compared graphically with their MMG simulation in YY2015): the session that built this
   experiment could not retrieve the printed values from a source it could cite, so those rows
   carry ``paper = null`` and say so. steerlab does not type numbers from memory into a
   comparison. Fill :data:`PUBLISHED` (value and source) when the source is at hand; the rows,
@@ -46,7 +46,7 @@ SCALE = 45.714                         # L7 model scale (SIMMAN)
 GEAR = {"rate_max_deg_s": 2.32, "T_sg": 0.2, "delta_max_deg": 35.0}
 DT = 0.1
 NOT_RETRIEVED = ("published free-running value not retrieved from a citable source in this session "
-                 "(MARIN free-running tests, SIMMAN 2008; YY2015 Figs 9-12): paper = null")
+                 "(MARIN free-running tests, SIMMAN 2008; plotted in YY2015): paper = null")
 
 #: Published values: quantity -> (value, source). Empty entries are reported with paper = null.
 PUBLISHED: dict[str, tuple[float, str]] = {}

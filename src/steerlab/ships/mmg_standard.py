@@ -1,8 +1,10 @@
 r"""The MMG standard method (Yasukawa & Yoshimura 2015): 3-DOF hull-propeller-rudder model.
 
 Source: H. Yasukawa, Y. Yoshimura, "Introduction of MMG standard method for ship maneuvering
-predictions", *J. Mar. Sci. Technol.* 20 (2015) 37-52 ("YY2015"), eqs (4)-(6) (motion),
-(9)-(10) (hull), (11)-(17) (propeller), (18)-(33) (rudder). Ships are data files
+predictions", *J. Mar. Sci. Technol.* 20 (2015) 37-52 ("YY2015"): motion equations at
+midship, hull, propeller and rudder force models (below; steerlab wrote them from the
+open-source implementations' reading of the paper, ShipMMG.jl and shipmmg, and checked them
+against shipmmg's numbers). Ships are data files
 ``ships/data/mmgstd_*.toml`` (e.g. ``mmgstd_kvlcc2_l7.toml``), hull derivatives given directly,
 every value with its source.
 
@@ -10,19 +12,19 @@ Equations (SI; body axes at MIDSHIP, x forward, y starboard; ``u, v`` the surge 
 velocity at midship relative to the water, ``U = sqrt(u^2 + v^2)``, ``v' = v/U``,
 ``r' = r L/U``, ``beta = atan2(-v, u)``)::
 
-    (m + m_x) u' - (m + m_y) v r - x_G m r^2 = X_H + X_P + X_R                      (4)
+    (m + m_x) u' - (m + m_y) v r - x_G m r^2 = X_H + X_P + X_R
     (m + m_y) v' + (m + m_x) u r + x_G m r'  = Y_H + Y_R
     (I_zG + x_G^2 m + J_z) r' + x_G m (v' + u r) = N_H + N_R
 
-* Hull (9)-(10): ``X_H = 1/2 rho L d U^2 (-R'_0 + X'_vv v'^2 + X'_vr v' r' + X'_rr r'^2 +
+* Hull: ``X_H = 1/2 rho L d U^2 (-R'_0 + X'_vv v'^2 + X'_vr v' r' + X'_rr r'^2 +
   X'_vvvv v'^4)``, ``Y_H = 1/2 rho L d U^2 (Y'_v v' + Y'_R r' + Y'_vvv v'^3 + Y'_vvr v'^2 r'
   + Y'_vrr v' r'^2 + Y'_rrr r'^3)``, ``N_H`` the same with ``L^2`` and the ``N'`` derivatives.
-* Propeller (11)-(17): ``X_P = (1 - t_P) T``, ``T = rho n^2 D^4 K_T(J)``,
+* Propeller: ``X_P = (1 - t_P) T``, ``T = rho n^2 D^4 K_T(J)``,
   ``K_T = k0 + k1 J + k2 J^2``, ``J = u (1 - w_P) / (n D)``; drift-dependent wake
   ``1 - w_P = (1 - w_P0) [1 + (1 - exp(-C_1 |beta_P|)) (C_2 - 1)]``, ``beta_P = beta -
   x'_P r'``, ``C_2`` = ``C_2_plus`` for ``beta_P > 0``, else ``C_2_minus``. Written without
   dividing by ``n``: ``T = rho (k0 n|n| D^4 + k1 u_P n D^3 + k2 u_P|u_P| D^2)``.
-* Rudder (18)-(33): ``X_R = -(1 - t_R) F_N sin(delta)``, ``Y_R = -(1 + a_H) F_N cos(delta)``,
+* Rudder: ``X_R = -(1 - t_R) F_N sin(delta)``, ``Y_R = -(1 + a_H) F_N cos(delta)``,
   ``N_R = -(x_R + a_H x_H) F_N cos(delta)``, ``F_N = 1/2 rho A_R U_R^2 f_alpha sin(alpha_R)``,
   ``alpha_R = delta - atan2(v_R, u_R)``; inflow ``u_R = eps u_P sqrt(eta {1 + kappa
   (sqrt(1 + 8 K_T/(pi J^2)) - 1)}^2 + 1 - eta)`` (written as ``eps sqrt(eta (u_P + kappa
@@ -60,7 +62,7 @@ FINITE = {"allow_inf_nan": False}
 
 
 class MMGStdHull(FrozenConfig):
-    """Principal particulars and hull derivatives (YY2015 Table 1 and Table 3 style)."""
+    """Principal particulars, added masses and hull derivatives (non-dimensional as in YY2015)."""
 
     L: float = Field(gt=0.0, allow_inf_nan=False, description="length between perpendiculars [m]")
     B: float = Field(gt=0.0, allow_inf_nan=False, description="breadth [m]")
@@ -262,7 +264,7 @@ def pack(data: MMGStdShipData, n_rps: float) -> np.ndarray:
 
 @numba.njit(cache=True)
 def mmgstd_rhs(t, x, delta, w, p, dx):
-    """Derivatives of ``[x_n, y_e, psi, u, v, r]`` (module docstring, YY2015 eqs 4-33); writes ``dx[0:6]``.
+    """Derivatives of ``[x_n, y_e, psi, u, v, r]`` (module docstring, YY2015); writes ``dx[0:6]``.
 
     Parameters
     ----------
@@ -293,14 +295,14 @@ def mmgstd_rhs(t, x, delta, w, p, dx):
     vp = v * Ui                     # v'
     rp = r * L * Ui                 # r'
     h = P_HULL
-    # hull (9)-(10), dimensional
+    # hull, dimensional
     XH = p[P_QX] * U2 * (-p[h] + p[h + 1] * vp * vp + p[h + 2] * vp * rp + p[h + 3] * rp * rp
                          + p[h + 4] * vp * vp * vp * vp)
     YH = p[P_QX] * U2 * (p[h + 5] * vp + p[h + 6] * rp + p[h + 7] * vp * vp * vp + p[h + 8] * vp * vp * rp
                          + p[h + 9] * vp * rp * rp + p[h + 10] * rp * rp * rp)
     NH = p[P_QN] * U2 * (p[h + 11] * vp + p[h + 12] * rp + p[h + 13] * vp * vp * vp + p[h + 14] * vp * vp * rp
                          + p[h + 15] * vp * rp * rp + p[h + 16] * rp * rp * rp)
-    # propeller (11)-(17): drift-dependent wake
+    # propeller: drift-dependent wake
     beta = math.atan2(-v, u) if U > 1e-12 else 0.0
     bP = beta - p[P_XP] * rp
     C2 = p[P_C2P] if bP > 0.0 else p[P_C2M]
@@ -311,7 +313,7 @@ def mmgstd_rhs(t, x, delta, w, p, dx):
     rho = p[P_RHO]
     T = rho * (p[P_K0] * n * abs(n) * D * D * D * D + p[P_K1] * uP * n * D * D * D + p[P_K2] * uP * abs(uP) * D * D)
     XP = (1.0 - p[P_TP]) * T
-    # rudder (18)-(33)
+    # rudder
     s2 = uP * uP + 8.0 * T / (math.pi * rho * D * D)
     if s2 < 0.0:
         s2 = 0.0
@@ -329,7 +331,7 @@ def mmgstd_rhs(t, x, delta, w, p, dx):
     XR = -(1.0 - p[P_TR]) * FN * sd
     YR = -p[P_AH] * FN * cd
     NR = -p[P_XRXH] * FN * cd
-    # motion (4)
+    # motion at midship
     X = XH + XP + XR + p[P_MY] * v * r + p[P_XGM] * r * r
     Y = YH + YR - p[P_MX] * u * r
     N = NH + NR - p[P_XGM] * u * r
