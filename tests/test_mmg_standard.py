@@ -282,3 +282,29 @@ def test_esso_models_experiment(tmp_path):
         by["35 deg turn to starboard: advance / L"]["steerlab"], rel=1e-3)
     for f in ("esso_turning_track.png", "mss-tanker_turning_track.png", "mss-tanker_10_10_zigzag.png"):
         assert (tmp_path / "out" / f).stat().st_size > 10_000
+
+
+# ------------------------------------------------------------------ batch: vectorised and bit-identical
+
+@pytest.mark.skipif(not __import__("numba").config.LOOP_VECTORIZE, reason="numba's loop vectoriser is switched off")
+def test_kvlcc2_batch_is_vectorised_and_bit_identical_to_single_runs():
+    """mmgstd_rhs uses steerlab.vecmath (atan2, exp) and sincos: no library call, so the batch
+    engine runs it as vector arithmetic; run i of a batch equals the same run alone."""
+    from steerlab.sim.batch import simulate_batch, vary_controller
+    from steerlab.sim.engine import simulate_compiled
+    from steerlab.sim.lanes import vectorisation_report
+    from steerlab.sim.scenario import scenario_from_dict
+    from steerlab.sim.setup import build
+
+    setup = build(scenario_from_dict({
+        "dt": 0.5, "duration": 120.0, "ship": {"model": "kvlcc2", "speed_kn": 15.5},
+        "controller": {"type": "pid", "Kp": 1.0, "Kd": 10.0, "Ki": 0.0},
+        "guidance": {"changes": [{"t": 5.0, "psi_deg": 15.0}]}}))
+    pcs = np.tile(setup.pc, (3, 1))
+    pcs[1, 0] *= 2.0
+    runs = vary_controller(setup, pcs)
+    batch = simulate_batch(runs)
+    for i, s in enumerate(runs):
+        np.testing.assert_array_equal(batch.final_states[i], simulate_compiled(s).states[-1])
+    report = vectorisation_report(setup.ship.rhs, setup.controller.update, setup.x0.size)
+    assert report["vectorised_stages"] >= 4 and report["per_run_library_calls"] == []

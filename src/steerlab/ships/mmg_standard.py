@@ -26,13 +26,16 @@ velocity at midship relative to the water, ``U = sqrt(u^2 + v^2)``, ``v' = v/U``
   dividing by ``n``: ``T = rho (k0 n|n| D^4 + k1 u_P n D^3 + k2 u_P|u_P| D^2)``.
 * Rudder: ``X_R = -(1 - t_R) F_N sin(delta)``, ``Y_R = -(1 + a_H) F_N cos(delta)``,
   ``N_R = -(x_R + a_H x_H) F_N cos(delta)``, ``F_N = 1/2 rho A_R U_R^2 f_alpha sin(alpha_R)``,
-  ``alpha_R = delta - atan2(v_R, u_R)``; inflow ``u_R = eps u_P sqrt(eta {1 + kappa
+  ``alpha_R = delta - atan2(v_R, u_R)`` (evaluated as ``U_R^2 sin(alpha_R) = U_R (u_R sin(delta)
+  - v_R cos(delta))``); inflow ``u_R = eps u_P sqrt(eta {1 + kappa
   (sqrt(1 + 8 K_T/(pi J^2)) - 1)}^2 + 1 - eta)`` (written as ``eps sqrt(eta (u_P + kappa
   (sqrt(u_P^2 + 8 T/(pi rho D^2)) - u_P))^2 + (1 - eta) u_P^2)``, the same for ``n > 0``, smooth
   at ``J = 0``), ``eta = D/H_R``; flow straightening ``v_R = U gamma_R beta_R``, ``beta_R =
   beta - l'_R r'``, ``gamma_R`` = ``gamma_R_plus`` for ``beta_R > 0``, else
   ``gamma_R_minus`` (the port/starboard asymmetry of the data).
 * ``delta > 0`` turns to starboard in YY2015 as in steerlab (``N_R > 0``): no sign change.
+* Straight-line arithmetic (``atan2``, ``exp`` from :mod:`steerlab.vecmath`, sin/cos from
+  :mod:`steerlab.sincos`, selects instead of branches), so the batch engine vectorises it.
 * Also read: ``W_RUDDER`` (added to delta), ``W_YAW_MOMENT`` (yaw acceleration added to r'),
   the current (track only, :mod:`steerlab.ships.kinematics`). No wind (the data give none).
 
@@ -57,6 +60,7 @@ from steerlab.environment.channels import W_RUDDER, W_YAW_MOMENT
 from steerlab.errors import InputError
 from steerlab.ships.kinematics import earth_velocity
 from steerlab.sincos import sincos
+from steerlab.vecmath import atan2, exp_neg
 
 FINITE = {"allow_inf_nan": False}
 
@@ -291,7 +295,9 @@ def mmgstd_rhs(t, x, delta, w, p, dx):
     L = p[P_L]
     U2 = u * u + v * v
     U = math.sqrt(U2)
-    Ui = 1.0 / U if U > 1e-12 else 0.0
+    moving = U > 1e-12
+    Ui = 1.0 / (U if moving else 1.0)
+    Ui = Ui if moving else 0.0
     vp = v * Ui                     # v'
     rp = r * L * Ui                 # r'
     h = P_HULL
@@ -303,10 +309,10 @@ def mmgstd_rhs(t, x, delta, w, p, dx):
     NH = p[P_QN] * U2 * (p[h + 11] * vp + p[h + 12] * rp + p[h + 13] * vp * vp * vp + p[h + 14] * vp * vp * rp
                          + p[h + 15] * vp * rp * rp + p[h + 16] * rp * rp * rp)
     # propeller: drift-dependent wake
-    beta = math.atan2(-v, u) if U > 1e-12 else 0.0
+    beta = atan2(-v, u)             # 0 at U = 0
     bP = beta - p[P_XP] * rp
     C2 = p[P_C2P] if bP > 0.0 else p[P_C2M]
-    one_wp = (1.0 - p[P_WP0]) * (1.0 + (1.0 - math.exp(-p[P_C1] * abs(bP))) * (C2 - 1.0))
+    one_wp = (1.0 - p[P_WP0]) * (1.0 + (1.0 - exp_neg(-p[P_C1] * abs(bP))) * (C2 - 1.0))
     uP = one_wp * u
     n = p[P_N]
     D = p[P_D]
@@ -314,20 +320,18 @@ def mmgstd_rhs(t, x, delta, w, p, dx):
     T = rho * (p[P_K0] * n * abs(n) * D * D * D * D + p[P_K1] * uP * n * D * D * D + p[P_K2] * uP * abs(uP) * D * D)
     XP = (1.0 - p[P_TP]) * T
     # rudder
-    s2 = uP * uP + 8.0 * T / (math.pi * rho * D * D)
-    if s2 < 0.0:
-        s2 = 0.0
+    s2 = max(uP * uP + 8.0 * T / (math.pi * rho * D * D), 0.0)
     a = uP + p[P_KAPPA] * (math.sqrt(s2) - abs(uP))
     eta = p[P_ETA]
     uR = p[P_EPS] * math.sqrt(eta * a * a + (1.0 - eta) * uP * uP)
     bR = beta - p[P_LR] * rp
     gR = p[P_GRP] if bR > 0.0 else p[P_GRM]
     vR = U * gR * bR
-    UR2 = uR * uR + vR * vR
-    aR = d - math.atan2(vR, uR)
-    sa, _ = sincos(aR)
+    # F_N = q U_R^2 sin(alpha_R), alpha_R = d - atan2(v_R, u_R):
+    # U_R^2 sin(alpha_R) = U_R (u_R sin d - v_R cos d)
+    UR = math.sqrt(uR * uR + vR * vR)
     sd, cd = sincos(d)
-    FN = p[P_QR] * UR2 * sa
+    FN = p[P_QR] * UR * (uR * sd - vR * cd)
     XR = -(1.0 - p[P_TR]) * FN * sd
     YR = -p[P_AH] * FN * cd
     NR = -p[P_XRXH] * FN * cd
