@@ -4,7 +4,7 @@ Numbers asserted here are the ones steerlab computes (this branch), with toleran
 what would count as a change of model rather than of rounding:
 
 * KVLCC2 35 deg turn, 15.5 kn, 2.32 deg/s gear: advance 3.08 L, tactical diameter 3.11 L
-  (starboard), 3.09 / 3.10 L (port). Tolerance 1 %: the trial interpolates the 90/180 deg
+  (starboard), 3.09 / 3.09 L (port). Tolerance 1 %: the trial interpolates the 90/180 deg
   crossings on a 0.1 s grid (about 0.1 % of L); a 1 % move means the forces changed.
 * Against an independent open-source MMG code (shipmmg 0.0.11, same data, run once by steerlab,
   see experiments/kvlcc2_validation.py) the starboard advance and tactical diameter agree
@@ -121,7 +121,7 @@ def test_kvlcc2_turning_and_zigzag_numbers(kv_trials):
     assert nd["advance_starboard"] == pytest.approx(3.08, rel=0.01)
     assert nd["tactical_starboard"] == pytest.approx(3.11, rel=0.01)
     assert nd["advance_port"] == pytest.approx(3.09, rel=0.01)
-    assert nd["tactical_port"] == pytest.approx(3.10, rel=0.01)
+    assert nd["tactical_port"] == pytest.approx(3.09, rel=0.01)
     assert nd["zz10_first"] == pytest.approx(5.0, abs=0.3)
     assert nd["zz10_second"] == pytest.approx(14.0, abs=0.3)
     assert nd["zz20_first"] == pytest.approx(10.6, abs=0.3)
