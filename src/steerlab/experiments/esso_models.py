@@ -119,4 +119,3 @@ def run(out_dir: Path, progress: Optional[Callable[[str], None]] = None, quick: 
     with open(out_dir / "comparison.json", "w", encoding="utf-8") as fh:
         json.dump(rows, fh, indent=2)
     return rows
-

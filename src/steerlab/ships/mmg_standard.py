@@ -62,8 +62,6 @@ from steerlab.ships.kinematics import earth_velocity
 from steerlab.sincos import sincos
 from steerlab.vecmath import atan2, exp_neg
 
-FINITE = {"allow_inf_nan": False}
-
 
 class MMGStdHull(FrozenConfig):
     """Principal particulars, added masses and hull derivatives (non-dimensional as in YY2015)."""
