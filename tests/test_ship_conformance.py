@@ -39,13 +39,20 @@ def operating_speed(spec) -> float:
     return 0.5 * (lo + hi) if math.isfinite(hi) else knots_to_ms(10.0)
 
 
-def open_loop(spec, speed, rudder, duration, dt=0.5, delta0=0.0):
+def straight_sway(spec, speed) -> float:
+    """Sway speed [m/s] of the straight-course equilibrium: 0 unless the spec says (a propeller side force)."""
+    f = getattr(spec, "equilibrium_sway", None)
+    return 0.0 if f is None else float(f(speed, spec.options(None)))
+
+
+def open_loop(spec, speed, rudder, duration, dt=0.5, delta0=0.0, v0=0.0):
     """Open-loop run with ``rudder(t, x) -> order [rad]``; returns (t, X) with the rudder last."""
     ps = spec.pack(speed, None, spec.options(None))
     pg = GEAR.pack()
     step = plant_step(spec.rhs)
     x = np.zeros(spec.n_states + 1)
     x[3] = speed
+    x[4] = v0
     x[-1] = delta0
     w = np.zeros(N_CHANNELS)
     work = np.empty((5, x.size))
@@ -65,7 +72,7 @@ def test_straight_with_equilibrium_rudder_stays_straight(name):
     v = operating_speed(spec)
     d0 = straight_rudder(spec, v)
     assert abs(d0) < GEAR.delta_max
-    _, X = open_loop(spec, v, lambda t, x: d0, 300.0, delta0=d0)
+    _, X = open_loop(spec, v, lambda t, x: d0, 300.0, delta0=d0, v0=straight_sway(spec, v))
     assert np.all(np.isfinite(X))
     assert np.max(np.abs(X[:, 2])) < 1e-9          # heading [rad]
     assert np.max(np.abs(X[:, 5])) < 1e-11         # yaw rate [rad/s]

@@ -145,15 +145,50 @@ class MMGShipData(FrozenConfig):
         return WindGeometry(self.hull.L, self.hull.B, w.A_F, w.A_L, w.A_OD, w.C, w.C_BR, w.H_BR, w.H_C)
 
 
+SLIPSTREAM_CHECK_DEG = 35.0   # rudder angle at which the slipstream's momentum bound is checked
+
+
+def slipstream_drag_ratio(data: MMGShipData, delta_deg: float = SLIPSTREAM_CHECK_DEG) -> float:
+    """Rudder drag caused by the slipstream, per unit of the slipstream's own thrust share.
+
+    The kernel's drag ``X_R = -|Y_delta| U_R^2 delta sin(delta)`` with the slipstream term
+    ``eta_s (8/pi) T/(rho D^2)`` of ``U_R^2`` gives a drag ``eta_s T * R`` with ``R = |Y_delta|
+    (8/pi) delta sin(delta) / (rho D^2)`` (independent of ``eta_s`` and ``T``). A rudder cannot
+    take more axial momentum out of the jet that passes it than the propeller put in
+    (``eta_s T``), so ``R <= 1`` is required for ``eta_s > 0``; with ``R > 1`` a hard-over turn
+    can drive the ship astern while the propeller runs ahead. ``|Y_delta|`` is Clarke's
+    whole-ship rudder derivative (hull interaction included), ``0.5 rho L^2 |Y'_delta|``.
+    """
+    d = data.derivatives()
+    Yd = 0.5 * data.hull.rho * data.hull.L**2 * abs(d.Y_delta)
+    a = math.radians(delta_deg)
+    return Yd * (8.0 / math.pi) * a * math.sin(a) / (data.hull.rho * data.propeller.D**2)
+
+
 def load_mmg_data(text: str, name: str = "ship data") -> MMGShipData:
-    """Parse and validate one MMG ship data file (raises :class:`InputError`)."""
+    """Parse and validate one MMG ship data file (raises :class:`InputError`).
+
+    A ``rudder.slipstream > 0`` is refused when :func:`slipstream_drag_ratio` exceeds 1 (the
+    data's rudder derivative and propeller diameter make the slipstream drag exceed the jet's
+    momentum at 35 deg of rudder).
+    """
     try:
-        return MMGShipData.model_validate(tomllib.loads(text))
+        data = MMGShipData.model_validate(tomllib.loads(text))
     except tomllib.TOMLDecodeError as err:
         raise InputError(name, f"malformed TOML: {err}") from None
     except ValidationError as err:
         first = err.errors()[0]
         raise InputError(f"{name}: " + ".".join(str(p) for p in first["loc"]), first["msg"]) from None
+    if data.rudder.slipstream > 0.0:
+        R = slipstream_drag_ratio(data)
+        if R > 1.0:
+            raise InputError(
+                f"{name}: rudder.slipstream",
+                f"must be 0 for this ship: at {SLIPSTREAM_CHECK_DEG:.0f} deg of rudder the slipstream's drag would "
+                f"be {R:.2f} times the momentum the jet carries (Clarke's Y'_delta = {abs(data.derivatives().Y_delta):.4g} "
+                f"with D = {data.propeller.D} m), which drives a hard-over turn astern; allowed only when that "
+                f"ratio is <= 1 (see steerlab.ships.mmg.slipstream_drag_ratio)")
+    return data
 
 
 @lru_cache(maxsize=None)
