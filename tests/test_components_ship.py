@@ -35,7 +35,7 @@ def test_ship_and_controller_objects_reproduce_the_engine_run(scenario):
 def test_named_states_and_disturbance_dict():
     s = ship("nomoto1", 10.0, ship_options={"K": 0.1, "T": 20.0})
     assert s.state_names[-1] == "delta" and s["u"] == pytest.approx(s.speed)
-    for _ in range(600):
+    for _ in range(2000):                # 200 s = 10 T
         s.step(0.0, 0.1, disturbance={"d_rudder": rad(1.0)})
     # a constant equivalent rudder of 1 deg: r -> K * 1 deg (T r' + r = K (delta + d))
     assert s.yaw_rate == pytest.approx(0.1 * rad(1.0), rel=1e-3)
