@@ -1,0 +1,85 @@
+r"""One compiled call that advances N ships (same model) by one environment step each.
+
+``step_lanes`` loops over the N plants; each plant takes ``nc`` classic RK4 steps of ship +
+steering gear with its rudder order held - the engines' own kernel
+(:func:`steerlab.sim.kernels.plant_step`) - at the engine's times ``t = k dt``, then the
+observation and the reward of the lane are computed by scalar code, so a lane's numbers do
+not depend on N or on the other lanes (the single environment is the same call with N = 1).
+
+Observation ``[e, r, delta]``: heading error ``e = wrap_to_pi(psi_ref - psi)`` [rad], yaw
+rate ``r`` [rad/s], rudder angle ``delta`` [rad]. Reward of the speed-loss criterion
+(Koyama; van Amerongen 1982 eq 3.1, ``J = mean(eps^2 + lambda delta^2)``) over the step::
+
+    reward = -(e^2 + lambda delta^2) * dt_env      (after the step, e and delta in rad)
+"""
+
+from __future__ import annotations
+
+import math
+from functools import lru_cache
+
+import numba
+import numpy as np
+
+from steerlab.angles import wrap_to_pi
+from steerlab.sim.kernels import plant_step
+
+
+R_MAX = math.pi   #: |r| [rad/s] beyond which a ship counts as diverged (180 deg/s; the observation bound)
+
+
+@lru_cache(maxsize=None)
+def lane_stepper(ship_rhs):
+    """``step_lanes(X, K, J, cmd, W, PS, PG, dt, nc, ref, lam, active, obs, rew, bad, work)``.
+
+    ``X`` (N, nx) plant states, ``K`` (N,) plant-step counters, ``J`` (N,) env-step counters,
+    ``cmd`` (N,) rudder orders [rad], ``W`` (N, n_steps + 1, channels) disturbances, ``PS``,
+    ``PG`` packed ship and gear records, ``ref`` (n_env_steps + 1,) reference heading at each
+    env step [rad], ``active`` (N,) lanes to step; writes ``obs`` (N, 3), ``rew`` (N,), ``bad``
+    (N,) non-finite state. ``work`` is a (5, nx) scratch array.
+    """
+    rk4_step = plant_step(ship_rhs)
+
+    @numba.njit
+    def step_lanes(X, K, J, cmd, W, PS, PG, dt, nc, ref, lam, active, obs, rew, bad, work):
+        nx = X.shape[1]
+        h_env = nc * dt
+        for i in range(X.shape[0]):
+            if not active[i]:
+                continue
+            x = X[i]
+            for _ in range(nc):
+                k = K[i]
+                rk4_step(k * dt, x, cmd[i], W[i, k], PS[i], PG[i], dt, work)
+                K[i] = k + 1
+            j = J[i] + 1
+            J[i] = j
+            ok = True
+            for q in range(nx):
+                if not np.isfinite(x[q]):
+                    ok = False
+            if not abs(x[5]) <= R_MAX:
+                ok = False
+            bad[i] = not ok
+            if ok:
+                e = wrap_to_pi(ref[j] - x[2])
+                d = x[nx - 1]
+                obs[i, 0] = e
+                obs[i, 1] = x[5]
+                obs[i, 2] = d
+                rew[i] = -(e * e + lam * d * d) * h_env
+            else:
+                obs[i, 0] = 0.0
+                obs[i, 1] = 0.0
+                obs[i, 2] = 0.0
+                rew[i] = 0.0
+
+    return step_lanes
+
+
+@numba.njit
+def observe(x, psi_ref, out):
+    """The observation ``[wrap(psi_ref - psi), r, delta]`` of plant state ``x``."""
+    out[0] = wrap_to_pi(psi_ref - x[2])
+    out[1] = x[5]
+    out[2] = x[x.shape[0] - 1]
