@@ -99,3 +99,27 @@ def test_bad_settings():
     with pytest.raises(InputError) as ei:
         gym.make("steerlab/CourseKeeping-v0", ship="titanic")
     assert ei.value.field == "ship.model"
+
+
+def test_a_steerlab_pid_beats_a_random_policy_through_the_env():
+    from steerlab.components.controller import controller
+
+    env = gym.make("steerlab/CourseChange-v0", episode_s=200.0)
+    pid = controller("pid", ship="esso", speed_kn=16.0, sample_time=1.0)
+    rng = np.random.default_rng(0)
+
+    def episode(policy):
+        obs, _ = env.reset(seed=1)
+        pid.reset()
+        total, k, done = 0.0, 0, False
+        while not done:
+            obs, r, te, tr, _ = env.step(policy(obs, k))
+            total, k, done = total + r, k + 1, te or tr
+        return total, obs
+
+    rand, _ = episode(lambda o, k: rng.uniform(-1, 1, size=1).astype(np.float32))
+    dmax = np.radians(35.0)
+    ctrl, last = episode(lambda o, k: np.array([np.clip(pid.step(k, 0.0, o[1], o[0], rudder=o[2]) / dmax, -1, 1)],
+                                               dtype=np.float32))
+    assert ctrl > 2.0 * rand                   # returns are negative: the PID's cost is under half
+    assert abs(last[0]) < np.radians(8.0)      # and it has turned most of the 20 deg (slow Esso)

@@ -148,6 +148,12 @@ class Controller:
         self._last = u
         return u
 
+    def transfer_function(self):
+        """``C(s)`` as a ``control.TransferFunction`` (PID-family laws; :func:`steerlab.components.linear.transfer_function`)."""
+        from steerlab.components.linear import transfer_function
+
+        return transfer_function(self)
+
     def vector(self, n: int):
         """``n`` copies of this controller (same design, same state) stepped in one compiled call."""
         from steerlab.components.controller_vector import ControllerVector

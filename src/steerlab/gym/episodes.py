@@ -43,7 +43,7 @@ class Episodes:
     """N lanes (see the module docstring); all arrays SI."""
 
     def __init__(self, n, task="course_keeping", ship="esso", speed_kn=16.0, gear=None, environment=None,
-                 ship_options=None, dt=0.1, control_dt=1.0, episode_s=300.0, lam=1.0,
+                 ship_options=None, dt=0.1, control_dt=1.0, episode_s=300.0, lam=0.1,
                  initial_offset_deg=10.0, change_deg=20.0, change_t=10.0):
         from steerlab.gym.plant_batch import lane_stepper
         from steerlab.sim.setup import build_seeds, reference_headings
