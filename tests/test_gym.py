@@ -123,3 +123,22 @@ def test_a_steerlab_pid_beats_a_random_policy_through_the_env():
                                                dtype=np.float32))
     assert ctrl > 2.0 * rand                   # returns are negative: the PID's cost is under half
     assert abs(last[0]) < np.radians(8.0)      # and it has turned most of the 20 deg (slow Esso)
+
+
+def test_track_following_with_a_pid_converges_on_the_route():
+    from steerlab.components.controller import controller
+
+    env = gym.make("steerlab/TrackFollowing-v0", ship="nomoto1", speed_kn=10.0, environment={},
+                   episode_s=600.0, control_dt=0.5, dt=0.5)
+    pid = controller("pid", Kp=3.0, Ki=0.0, Kd=67.0, sample_time=0.5)   # docs/guidance.md's LOS example
+    obs, _ = env.reset(seed=0)
+    xte = []
+    dmax = np.radians(35.0)
+    for k in range(1200):
+        a = np.clip(pid.step(0.5 * k, 0.0, obs[1], obs[0], rudder=obs[2]) / dmax, -1, 1)
+        obs, r, te, tr, info = env.step(np.array([a], dtype=np.float32))
+        xte.append(info["xte"])
+        if te or tr:
+            break
+    assert abs(xte[0]) > 150.0                  # started 200 m off the line
+    assert abs(xte[-1]) < 10.0                  # and converged onto it

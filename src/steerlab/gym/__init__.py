@@ -5,6 +5,7 @@ r"""Gymnasium environments on steerlab ships (optional extra ``steerlab[gym]``).
 
     steerlab/CourseKeeping-v0   hold 0 deg from a seeded initial offset, in waves
     steerlab/CourseChange-v0    a 20 deg step of the reference at 10 s, in waves
+    steerlab/TrackFollowing-v0  LOS route following from 200 m off a straight route, in waves
 
 each with a single environment (:class:`~steerlab.gym.env.SteeringEnv`) and a native vector
 one (:class:`~steerlab.gym.vector_env.SteeringVectorEnv`,
@@ -13,7 +14,8 @@ one (:class:`~steerlab.gym.vector_env.SteeringVectorEnv`,
 
 from __future__ import annotations
 
-IDS = {"steerlab/CourseKeeping-v0": "course_keeping", "steerlab/CourseChange-v0": "course_change"}
+IDS = {"steerlab/CourseKeeping-v0": "course_keeping", "steerlab/CourseChange-v0": "course_change",
+       "steerlab/TrackFollowing-v0": "track_following"}
 
 
 def register_envs() -> None:

@@ -12,8 +12,11 @@ rate beyond the observation bound) ends it
 (``terminated``, ``info["reason"] == "diverged"``, observation zeros).
 Tasks: ``course_keeping`` (``steerlab/CourseKeeping-v0``: hold 0 deg from a seeded initial
 offset of up to ``initial_offset_deg``), ``course_change`` (``steerlab/CourseChange-v0``: a
-``change_deg`` step of the reference at ``change_t``), both in the scenario sea
-``environment`` (default ``{"waves": True}``, the coloured wave noise of eq 39).
+``change_deg`` step of the reference at ``change_t``), ``track_following``
+(``steerlab/TrackFollowing-v0``: LOS guidance along a route, ``guidance=`` a scenario
+``[guidance]`` table; the heading error is then the one to the LOS heading and
+``info["xte"]`` the cross-track error [m]), all in the scenario sea ``environment`` (default
+``{"waves": True}``, the coloured wave noise of eq 39).
 """
 
 from __future__ import annotations
@@ -23,6 +26,7 @@ import math
 import gymnasium as gym
 import numpy as np
 
+from steerlab.guidance.reference_vector import REF_XTE
 from steerlab.gym.episodes import Episodes
 
 
@@ -56,6 +60,9 @@ class SteeringEnv(gym.Env):
             raise RuntimeError("episode over: call reset() first")
         obs, rew, term, trunc = self.core.step(np.asarray(action).reshape(1))
         info = {"t": float(self.core.J[0] * self.core.control_dt)}
+        xte = float(self.core.REF[0, REF_XTE])
+        if xte == xte:                                   # NaN without a route
+            info["xte"] = xte
         if term[0]:
             info["reason"] = "diverged"
         self._done = bool(term[0] or trunc[0])

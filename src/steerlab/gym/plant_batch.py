@@ -3,8 +3,9 @@ r"""One compiled call that advances N ships (same model) by one environment step
 ``step_lanes`` loops over the N plants; each plant takes ``nc`` classic RK4 steps of ship +
 steering gear with its rudder order held - the engines' own kernel
 (:func:`steerlab.sim.kernels.plant_step`) - at the engine's times ``t = k dt``, then the
-observation and the reward of the lane are computed by scalar code, so a lane's numbers do
-not depend on N or on the other lanes (the single environment is the same call with N = 1).
+scenario's guidance kernel gives the new reference and the observation and the reward of the
+lane are computed by scalar code, so a lane's numbers do not depend on N or on the other lanes
+(the single environment is the same call with N = 1).
 
 Observation ``[e, r, delta]``: heading error ``e = wrap_to_pi(psi_ref - psi)`` [rad], yaw
 rate ``r`` [rad/s], rudder angle ``delta`` [rad]. Reward of the speed-loss criterion
@@ -22,6 +23,7 @@ import numba
 import numpy as np
 
 from steerlab.angles import wrap_to_pi
+from steerlab.guidance.reference_vector import REF_RPM
 from steerlab.sim.kernels import plant_step
 
 
@@ -29,19 +31,23 @@ R_MAX = math.pi   #: |r| [rad/s] beyond which a ship counts as diverged (180 deg
 
 
 @lru_cache(maxsize=None)
-def lane_stepper(ship_rhs):
-    """``step_lanes(X, K, J, cmd, W, PS, PG, dt, nc, ref, lam, active, obs, rew, bad, work)``.
+def lane_stepper(ship_rhs, guide):
+    """``step_lanes(X, K, J, cmd, W, PS, PG, dt, nc, gd, GZ, REF, rpm_slot, lam, active, obs, rew, bad, work)``.
 
     ``X`` (N, nx) plant states, ``K`` (N,) plant-step counters, ``J`` (N,) env-step counters,
     ``cmd`` (N,) rudder orders [rad], ``W`` (N, n_steps + 1, channels) disturbances, ``PS``,
-    ``PG`` packed ship and gear records, ``ref`` (n_env_steps + 1,) reference heading at each
-    env step [rad], ``active`` (N,) lanes to step; writes ``obs`` (N, 3), ``rew`` (N,), ``bad``
-    (N,) non-finite state. ``work`` is a (5, nx) scratch array.
+    ``PG`` packed ship and gear records, ``gd`` the guidance record, ``GZ`` (N, n_gz) guidance
+    states and ``REF`` (N, N_REF) reference vectors (advanced in place); after the plant steps
+    the guidance kernel ``guide(t, x, gd, gz, ref, h)`` (the engines' one, e.g. the time-only
+    course schedule or LOS) gives the new reference, and, as in the engines, a propeller-rate
+    order ``ref[REF_RPM] >= 0`` goes to ``PS[i, rpm_slot]`` when ``rpm_slot >= 0``. ``active``
+    (N,) lanes to step; writes ``obs`` (N, 3), ``rew`` (N,), ``bad`` (N,) diverged (a
+    non-finite state or ``|r| > R_MAX``). ``work`` is a (5, nx) scratch array.
     """
     rk4_step = plant_step(ship_rhs)
 
     @numba.njit
-    def step_lanes(X, K, J, cmd, W, PS, PG, dt, nc, ref, lam, active, obs, rew, bad, work):
+    def step_lanes(X, K, J, cmd, W, PS, PG, dt, nc, gd, GZ, REF, rpm_slot, lam, active, obs, rew, bad, work):
         nx = X.shape[1]
         h_env = nc * dt
         for i in range(X.shape[0]):
@@ -52,8 +58,7 @@ def lane_stepper(ship_rhs):
                 k = K[i]
                 rk4_step(k * dt, x, cmd[i], W[i, k], PS[i], PG[i], dt, work)
                 K[i] = k + 1
-            j = J[i] + 1
-            J[i] = j
+            J[i] += 1
             ok = True
             for q in range(nx):
                 if not np.isfinite(x[q]):
@@ -62,7 +67,11 @@ def lane_stepper(ship_rhs):
                 ok = False
             bad[i] = not ok
             if ok:
-                e = wrap_to_pi(ref[j] - x[2])
+                ref = REF[i]
+                guide(K[i] * dt, x, gd, GZ[i], ref, h_env)
+                if rpm_slot >= 0 and ref[REF_RPM] >= 0.0:
+                    PS[i, rpm_slot] = ref[REF_RPM]
+                e = wrap_to_pi(ref[0] - x[2])
                 d = x[nx - 1]
                 obs[i, 0] = e
                 obs[i, 1] = x[5]
