@@ -142,3 +142,21 @@ def test_track_following_with_a_pid_converges_on_the_route():
             break
     assert abs(xte[0]) > 150.0                  # started 200 m off the line
     assert abs(xte[-1]) < 10.0                  # and converged onto it
+
+
+def test_selectable_rewards_are_the_criteria_of_the_observed_error():
+    envs = {name: gym.make("steerlab/CourseKeeping-v0", reward=name, **KW) for name in ("speed_loss", "itae", "iae")}
+    out = {}
+    for name, env in envs.items():
+        env.reset(seed=3)
+        for _ in range(4):
+            o, r, *_ = env.step(np.array([0.2], dtype=np.float32))
+        out[name] = (o, r)
+    o = out["iae"][0]
+    assert np.array_equal(o, out["itae"][0]) and np.array_equal(o, out["speed_loss"][0])
+    assert out["iae"][1] == pytest.approx(-abs(o[0]) * 1.0)
+    assert out["itae"][1] == pytest.approx(-4.0 * abs(o[0]) * 1.0)          # t = 4 s
+    assert out["speed_loss"][1] == pytest.approx(-(o[0] ** 2 + 0.1 * o[2] ** 2))
+    with pytest.raises(InputError) as ei:
+        gym.make("steerlab/CourseKeeping-v0", reward="fun")
+    assert ei.value.field == "reward"

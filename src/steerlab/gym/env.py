@@ -5,8 +5,10 @@ Observation (``Box``, float64, shape (3,)): ``[heading error e [rad] in [-pi, pi
 Action (``Box``, float32, shape (1,), in [-1, 1]): the rudder order as a fraction of the gear's
 limit (``order = a * delta_max``), held for ``control_dt`` seconds. An action outside the
 space raises :class:`~steerlab.errors.InputError` (no silent clipping).
-Reward: ``-(e^2 + lam delta^2) * control_dt`` after the step - the speed-loss criterion
-(Koyama; van Amerongen 1982 eq 3.1), ``lam`` dimensionless (default 0.1, as steerlab.metrics.speed_loss_J).
+Reward (``reward=``): ``"speed_loss"`` (default) ``-(e^2 + lam delta^2) * control_dt`` after
+the step - the speed-loss criterion (Koyama; van Amerongen 1982 eq 3.1), ``lam`` dimensionless
+(default 0.1, as steerlab.metrics.speed_loss_J); ``"itae"`` ``-t |e| control_dt``; ``"iae"``
+``-|e| control_dt`` (:mod:`steerlab.gym.plant_batch`).
 Episode: ``episode_s`` seconds (``truncated``); a diverged ship (non-finite state, or a yaw
 rate beyond the observation bound) ends it
 (``terminated``, ``info["reason"] == "diverged"``, observation zeros).

@@ -55,14 +55,17 @@ class Episodes:
 
     def __init__(self, n, task="course_keeping", ship="esso", speed_kn=16.0, gear=None, environment=None,
                  ship_options=None, dt=0.1, control_dt=1.0, episode_s=300.0, lam=0.1,
-                 initial_offset_deg=10.0, change_deg=20.0, change_t=10.0, guidance=None):
-        from steerlab.gym.plant_batch import lane_stepper
+                 initial_offset_deg=10.0, change_deg=20.0, change_t=10.0, guidance=None, reward="speed_loss"):
+        from steerlab.gym.plant_batch import REWARDS, lane_stepper
         from steerlab.guidance.reference_models import course_guide
         from steerlab.guidance.reference_vector import initial_reference
         from steerlab.sim.setup import build_seeds
 
         if task not in TASKS:
             raise InputError("task", f"must be one of {TASKS}, got {task!r}")
+        if reward not in REWARDS:
+            raise InputError("reward", f"must be one of {REWARDS}, got {reward!r}")
+        self.reward = REWARDS.index(reward)
         for name, v, lo, hi in (("control_dt", control_dt, 0.0, 60.0), ("episode_s", episode_s, 0.0, 1e5),
                                 ("lam", lam, 0.0, 1e6), ("initial_offset_deg", initial_offset_deg, 0.0, 180.0)):
             if not (isinstance(v, (int, float)) and math.isfinite(v) and lo <= v <= hi) or (name != "lam" and
@@ -154,6 +157,6 @@ class Episodes:
         self.cmd[:] = self.orders(actions)
         act = self.active if active is None else active
         self._step(self.X, self.K, self.J, self.cmd, self.W, self.PS, self.PG, self.dt, self.nc, self.gd, self.GZ,
-                   self.REF, self.rpm_slot, self.lam, act, self.obs, self.rew, self.bad, self._work)
+                   self.REF, self.rpm_slot, self.lam, self.reward, act, self.obs, self.rew, self.bad, self._work)
         truncated = self.J >= self.n_env_steps
         return self.obs, self.rew, self.bad.copy(), truncated & ~self.bad

@@ -8,10 +8,13 @@ lane are computed by scalar code, so a lane's numbers do not depend on N or on t
 (the single environment is the same call with N = 1).
 
 Observation ``[e, r, delta]``: heading error ``e = wrap_to_pi(psi_ref - psi)`` [rad], yaw
-rate ``r`` [rad/s], rudder angle ``delta`` [rad]. Reward of the speed-loss criterion
-(Koyama; van Amerongen 1982 eq 3.1, ``J = mean(eps^2 + lambda delta^2)``) over the step::
+rate ``r`` [rad/s], rudder angle ``delta`` [rad]. Rewards (after the step, e and delta in rad,
+``t`` the time at the end of the step, ``dt_env`` the env step)::
 
-    reward = -(e^2 + lambda delta^2) * dt_env      (after the step, e and delta in rad)
+    "speed_loss"  -(e^2 + lambda delta^2) dt_env   Koyama's criterion (van Amerongen 1982 eq 3.1,
+                                                   J = mean(eps^2 + lambda delta^2))
+    "itae"        -t |e| dt_env                    ITAE (Morawski & Pomirski's design criterion)
+    "iae"         -|e| dt_env
 """
 
 from __future__ import annotations
@@ -27,12 +30,14 @@ from steerlab.guidance.reference_vector import REF_RPM
 from steerlab.sim.kernels import plant_step
 
 
+REWARDS = ("speed_loss", "itae", "iae")
+REWARD_SPEED_LOSS, REWARD_ITAE, REWARD_IAE = 0, 1, 2
 R_MAX = math.pi   #: |r| [rad/s] beyond which a ship counts as diverged (180 deg/s; the observation bound)
 
 
 @lru_cache(maxsize=None)
 def lane_stepper(ship_rhs, guide):
-    """``step_lanes(X, K, J, cmd, W, PS, PG, dt, nc, gd, GZ, REF, rpm_slot, lam, active, obs, rew, bad, work)``.
+    """``step_lanes(X, K, J, cmd, W, PS, PG, dt, nc, gd, GZ, REF, rpm_slot, lam, reward, active, obs, rew, bad, work)``.
 
     ``X`` (N, nx) plant states, ``K`` (N,) plant-step counters, ``J`` (N,) env-step counters,
     ``cmd`` (N,) rudder orders [rad], ``W`` (N, n_steps + 1, channels) disturbances, ``PS``,
@@ -40,14 +45,16 @@ def lane_stepper(ship_rhs, guide):
     states and ``REF`` (N, N_REF) reference vectors (advanced in place); after the plant steps
     the guidance kernel ``guide(t, x, gd, gz, ref, h)`` (the engines' one, e.g. the time-only
     course schedule or LOS) gives the new reference, and, as in the engines, a propeller-rate
-    order ``ref[REF_RPM] >= 0`` goes to ``PS[i, rpm_slot]`` when ``rpm_slot >= 0``. ``active``
+    order ``ref[REF_RPM] >= 0`` goes to ``PS[i, rpm_slot]`` when ``rpm_slot >= 0``. ``reward``
+    selects the criterion (:data:`REWARDS`), ``lam`` its rudder weight. ``active``
     (N,) lanes to step; writes ``obs`` (N, 3), ``rew`` (N,), ``bad`` (N,) diverged (a
     non-finite state or ``|r| > R_MAX``). ``work`` is a (5, nx) scratch array.
     """
     rk4_step = plant_step(ship_rhs)
 
     @numba.njit
-    def step_lanes(X, K, J, cmd, W, PS, PG, dt, nc, gd, GZ, REF, rpm_slot, lam, active, obs, rew, bad, work):
+    def step_lanes(X, K, J, cmd, W, PS, PG, dt, nc, gd, GZ, REF, rpm_slot, lam, reward, active, obs, rew, bad,
+                   work):
         nx = X.shape[1]
         h_env = nc * dt
         for i in range(X.shape[0]):
@@ -76,7 +83,12 @@ def lane_stepper(ship_rhs, guide):
                 obs[i, 0] = e
                 obs[i, 1] = x[5]
                 obs[i, 2] = d
-                rew[i] = -(e * e + lam * d * d) * h_env
+                if reward == REWARD_SPEED_LOSS:
+                    rew[i] = -(e * e + lam * d * d) * h_env
+                elif reward == REWARD_ITAE:
+                    rew[i] = -(K[i] * dt) * abs(e) * h_env
+                else:
+                    rew[i] = -abs(e) * h_env
             else:
                 obs[i, 0] = 0.0
                 obs[i, 1] = 0.0
