@@ -155,3 +155,17 @@ def test_sliding_mode_on_a_duck_typed_ship_without_state_names():
     ctx = DesignContext(Ship(), 5.0, SteeringGear(), 0.1, 0.1)
     design, p = spec.build(spec.config.model_validate({"type": "sliding_mode"}), ctx)
     assert np.all(np.isfinite(p))
+
+
+def test_a_law_reading_more_states_asks_for_step_state():
+    """b481 has an rdot state that sliding mode reads: step() does not guess it."""
+    c = controller("sliding_mode", ship="b481", speed_kn=10.0)
+    assert "rdot" in c.plant_state_names
+    with pytest.raises(InputError) as ei:
+        c.reset().step(0.0, 0.0, 0.001, rad(5.0))
+    assert ei.value.field == "step_state"
+    x = np.zeros(len(c.plant_state_names))
+    x[3] = c.speed
+    c.reset()
+    u = c.step_state(0.0, x, rad(5.0))
+    assert math.isfinite(u) and u > 0.0

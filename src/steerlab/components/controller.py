@@ -91,7 +91,9 @@ class Controller:
         self.context = ctx
         self.plant_state_names = tuple(ctx.ship.state_names) + ("delta",)
         self._nx = len(self.plant_state_names)
-        self._x = np.zeros(self._nx)
+        # states step() is not given (positions, sway, a model's extra states) are NaN: a law that
+        # reads one gives a NaN order, which step() turns into an error naming step_state()
+        self._x = np.full(self._nx, np.nan)
         self._ref = initial_reference()
         self._last = 0.0
         self.state = np.zeros(spec.n_state)
@@ -113,7 +115,7 @@ class Controller:
 
         ``heading_ref`` defaults to ``heading`` (hold the present course). Units as in :meth:`step`.
         """
-        x = np.zeros(self._nx)
+        x = np.full(self._nx, np.nan)
         self._last = 0.0
         self._fill(x, heading, yaw_rate, rudder, speed)
         psi_ref = x[2] if heading_ref is None else _finite("heading_ref", heading_ref)
@@ -129,7 +131,12 @@ class Controller:
         """One controller sample: the rudder order [rad] (see the module docstring for units)."""
         x = self._x
         self._fill(x, heading, yaw_rate, rudder, speed)
-        return self._update(t, x, heading_ref, yaw_rate_ref)
+        u = self._update(t, x, heading_ref, yaw_rate_ref)
+        if not math.isfinite(u):
+            raise InputError("step_state", f"controller {self.type!r} reads plant states other than heading, "
+                                           "yaw rate, speed and rudder; reset() and call step_state(t, x, heading_ref) "
+                                           f"with the whole plant state {self.plant_state_names}")
+        return u
 
     def step_state(self, t, x, heading_ref, yaw_rate_ref=0.0) -> float:
         """One sample from the whole plant state ``x`` (layout ``plant_state_names``, SI)."""

@@ -72,7 +72,7 @@ class ControllerVector:
         self.params = np.ascontiguousarray(np.stack([c.params for c in items]))
         self.state = np.ascontiguousarray(np.stack([c.state for c in items]))
         self._nx = len(self.plant_state_names)
-        self._X = np.zeros((n, self._nx))
+        self._X = np.full((n, self._nx), np.nan)     # states not given: NaN (see Controller.step)
         self._R = np.tile(initial_reference(), (n, 1))
         self._out = np.zeros(n)
         self._last = np.zeros(n)
@@ -113,6 +113,9 @@ class ControllerVector:
         if not np.isfinite(t):
             raise InputError("t", "must be finite")
         self._run(self.state, self.params, t, X, R, self.sample_time, self._out)
+        if not np.all(np.isfinite(self._out)):
+            raise InputError("step_state", f"controller {self.type!r} reads plant states other than heading, "
+                                           "yaw rate, speed and rudder: step single controllers with step_state()")
         self._last[:] = self._out
         return self._out.copy()
 
