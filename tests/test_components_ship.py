@@ -23,7 +23,8 @@ def test_ship_and_controller_objects_reproduce_the_engine_run(scenario):
     X = np.empty_like(res.states)
     for k in range(len(res.time)):
         X[k] = s.state
-        u = c.step(res.time[k], s.heading, s.yaw_rate, res.psi_ref[k], res.r_ref[k], rudder=s.rudder, speed=s["u"])
+        assert s.t == res.time[k]                         # t = k dt, as in the engine
+        u = c.step(s.t, s.heading, s.yaw_rate, res.psi_ref[k], res.r_ref[k], rudder=s.rudder, speed=s["u"])
         assert u == res.delta_cmd[k]
         if k < len(res.time) - 1:
             s.step(u, 0.1, res.disturbance[k])

@@ -98,6 +98,7 @@ class Ship:
         x[5] = require_finite_range("yaw_rate", yaw_rate)
         x[-1] = require_finite_range("rudder", rudder, -self.gear.delta_max, self.gear.delta_max)
         self.t = 0.0
+        self._t0, self._k, self._h = 0.0, 0, None
         return self
 
     def step(self, rudder_order, dt, disturbance=None) -> np.ndarray:
@@ -112,9 +113,12 @@ class Ship:
         h = float(dt)
         if not (math.isfinite(h) and 0.0 < h <= 10.0):
             raise InputError("dt", f"must be in (0, 10] s, got {dt!r}")
+        if h != self._h:                      # t = t0 + k h, as the engines' t = k dt for a fixed step
+            self._t0, self._k, self._h = self.t, 0, h
         self._rk4(self.t, self.state, cmd, disturbance_row(disturbance), self.params, self.gear_params, h,
                   self._work)
-        self.t += h
+        self._k += 1
+        self.t = self._t0 + self._k * h
         if not np.all(np.isfinite(self.state)):
             raise InputError("ship", f"the state of ship {self.name!r} is no longer finite at t = {self.t:g} s "
                                      "(the model diverged)")
