@@ -115,3 +115,17 @@ def test_cli_linearize_nomoto1_and_norrbin(tmp_path):
     r = subprocess.run([sys.executable, "-m", "steerlab", "linearize", "frigate-norrbin", "--speed-kn", "30"],
                        capture_output=True, text=True)
     assert r.returncode == 2 and "speed_kn" in r.stderr and "Traceback" not in r.stderr
+
+
+def test_margins_and_step_info_work_on_exported_systems():
+    K, T = 0.05, 80.0
+    c = controller("pid", nomoto=(K, T), Kp=1.0, Ki=0.001, Kd=30.0)
+    L = c.transfer_function() * linearize("nomoto1", 10.0, ship_options={"K": K, "T": T})[0, 0]
+    gm, pm, wg, wp = control.margin(L)
+    # L(jw) = K (Kd (jw)^2 + Kp jw + Ki) / ((jw)^2 (T jw + 1)): crossover where |L| = 1
+    w = wp
+    mag = abs(K * (c.params[2] * (1j * w) ** 2 + c.params[0] * 1j * w + c.params[1]) / ((1j * w) ** 2 * (T * 1j * w + 1)))
+    assert mag == pytest.approx(1.0, rel=1e-6)
+    assert 30.0 < pm < 90.0
+    info = control.step_info(control.feedback(L, 1))
+    assert info["SettlingTime"] > 0.0 and info["Overshoot"] < 50.0
