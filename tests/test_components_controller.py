@@ -169,3 +169,13 @@ def test_a_law_reading_more_states_asks_for_step_state():
     c.reset()
     u = c.step_state(0.0, x, rad(5.0))
     assert math.isfinite(u) and u > 0.0
+
+
+@pytest.mark.parametrize("law", ["adrc", "asa", "backstepping_a", "backstepping_b", "classic_autopilot",
+                                 "gain_shaping_pid", "itae_pid", "lq_pd", "nonlinear_adrc", "pid",
+                                 "sliding_mode", "pid+wf"])
+def test_every_law_designs_from_K_T_and_speed_and_steers_towards_the_reference(law):
+    c = controller(law, nomoto=(0.05, 80.0), speed_kn=10.0).reset(heading=0.0)
+    u = [c.step(0.1 * k, 0.0, 0.0, rad(10.0)) for k in range(5)]
+    assert all(math.isfinite(v) for v in u)
+    assert u[-1] > 0.0                    # a heading reference to starboard: starboard rudder

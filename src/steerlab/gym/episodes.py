@@ -18,7 +18,7 @@ import math
 
 import numpy as np
 
-from steerlab.errors import InputError
+from steerlab.errors import InputError, require_finite_range
 from steerlab.units import rad
 
 TASKS = ("course_keeping", "course_change", "track_following")
@@ -66,11 +66,13 @@ class Episodes:
         if reward not in REWARDS:
             raise InputError("reward", f"must be one of {REWARDS}, got {reward!r}")
         self.reward = REWARDS.index(reward)
-        for name, v, lo, hi in (("control_dt", control_dt, 0.0, 60.0), ("episode_s", episode_s, 0.0, 1e5),
-                                ("lam", lam, 0.0, 1e6), ("initial_offset_deg", initial_offset_deg, 0.0, 180.0)):
-            if not (isinstance(v, (int, float)) and math.isfinite(v) and lo <= v <= hi) or (name != "lam" and
-                                                                                           name != "initial_offset_deg" and v == 0):
-                raise InputError(name, f"must be in {'(' if name in ('control_dt', 'episode_s') else '['}{lo}, {hi}], got {v!r}")
+        require_finite_range("dt", dt, 0.0, 10.0, lo_open=True)
+        require_finite_range("control_dt", control_dt, 0.0, 60.0, lo_open=True)
+        require_finite_range("episode_s", episode_s, 0.0, 1e5, lo_open=True)
+        require_finite_range("lam", lam, 0.0, 1e6)
+        require_finite_range("initial_offset_deg", initial_offset_deg, 0.0, 180.0)
+        if int(n) < 1:
+            raise InputError("num_envs", f"must be >= 1, got {n}")
         nc = int(round(control_dt / dt))
         if nc < 1 or abs(nc * dt - control_dt) > 1e-9 * max(control_dt, 1.0):
             raise InputError("control_dt", f"must be a positive multiple of dt={dt} s, got {control_dt} s")
