@@ -179,3 +179,16 @@ def test_every_law_designs_from_K_T_and_speed_and_steers_towards_the_reference(l
     u = [c.step(0.1 * k, 0.0, 0.0, rad(10.0)) for k in range(5)]
     assert all(math.isfinite(v) for v in u)
     assert u[-1] > 0.0                    # a heading reference to starboard: starboard rudder
+
+
+def test_top_level_names_resolve_and_import_steerlab_stays_light():
+    import subprocess
+    import sys
+
+    code = ("import sys, steerlab as sl\n"
+            "heavy = [m for m in ('gymnasium', 'control', 'pandas', 'matplotlib') if m in sys.modules]\n"
+            "assert not heavy, heavy\n"
+            "for n in ('controller', 'controllers', 'ship', 'linearize', 'transfer_function'):\n"
+            "    assert callable(getattr(sl, n)), n\n"
+            "assert 'gymnasium' not in sys.modules\n")
+    subprocess.run([sys.executable, "-c", code], check=True)
