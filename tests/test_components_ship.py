@@ -65,3 +65,11 @@ def test_unknown_ship_and_speed():
     with pytest.raises(InputError) as ei:
         ship("esso", -1.0)
     assert ei.value.field == "speed_kn"
+
+
+def test_functional_step_equals_the_stateful_one():
+    s = ship("esso", 16.0).reset(heading=0.1, yaw_rate=0.001)
+    x0 = s.state.copy()
+    x1 = s.step_state(x0, rad(5.0), 0.1)
+    assert np.array_equal(s.state, x0)                      # untouched
+    assert np.array_equal(x1, s.step(rad(5.0), 0.1))

@@ -124,6 +124,21 @@ class Ship:
                                      "(the model diverged)")
         return self.state.copy()
 
+    def step_state(self, x, rudder_order, dt, disturbance=None, t=0.0) -> np.ndarray:
+        """The functional form: plant state ``x`` (layout ``state_names``) advanced by ``dt`` [s]
+        with ``rudder_order`` [rad] held, as a new array; the object's own state is untouched."""
+        x = np.array(x, dtype=np.float64)
+        if x.shape != self.state.shape or not np.all(np.isfinite(x)):
+            raise InputError("x", f"must be {self.state.shape[0]} finite values {self.state_names}")
+        cmd = float(rudder_order)
+        h = float(dt)
+        if not math.isfinite(cmd):
+            raise InputError("rudder_order", f"must be finite, got {rudder_order!r}")
+        if not (math.isfinite(h) and 0.0 < h <= 10.0):
+            raise InputError("dt", f"must be in (0, 10] s, got {dt!r}")
+        self._rk4(float(t), x, cmd, disturbance_row(disturbance), self.params, self.gear_params, h, self._work)
+        return x
+
     def __getitem__(self, name: str) -> float:
         try:
             return float(self.state[self.state_names.index(name)])
