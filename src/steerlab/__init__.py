@@ -32,6 +32,12 @@ _LAZY = {
     "simulate": "steerlab.sim.engine:simulate",
     "simulate_batch": "steerlab.sim.batch:simulate_batch",
     "vary": "steerlab.sim.vary:vary",
+    # components for other people's loops (steerlab.components)
+    "controller": "steerlab.components.controller:controller",
+    "controllers": "steerlab.components.controller_vector:controllers",
+    "linearize": "steerlab.components.linear:linearize",
+    "ship": "steerlab.components.ship:ship",
+    "transfer_function": "steerlab.components.linear:transfer_function",
 }
 
 

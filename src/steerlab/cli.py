@@ -97,6 +97,14 @@ def cmd_linearize(args) -> int:
 
     if not (math.isfinite(args.speed_kn) and 0.0 < args.speed_kn <= 40.0):
         raise InputError("--speed-kn", f"must be in (0, 40] kn, got {args.speed_kn}")
+    from steerlab.ships.registry import get_ship
+
+    if get_ship(args.ship).linearise is None:   # Nomoto/Norrbin/Bech ...: the model's own linear form
+        from steerlab.components.linear import print_summary, summary
+
+        s = summary(args.ship, args.speed_kn)
+        print(dump_json(s)) if args.json else print_summary(s)
+        return 0
     summary = linear_summary(args.ship, knots_to_ms(args.speed_kn))
     summary["speed_kn"] = args.speed_kn
     if args.json:

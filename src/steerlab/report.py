@@ -1,6 +1,8 @@
 """Figures and a static HTML report of one run; a plain-text metrics table for the terminal.
 
-Everything is drawn with matplotlib's Agg canvas (:class:`matplotlib.figure.Figure` +
+Each figure has a ``draw_*(ax, result, title)`` that draws into a given matplotlib Axes and
+returns it (for notebooks and your own layouts) and a ``plot_*(path, result, title)`` that
+writes it as a PNG. The files are drawn with matplotlib's Agg canvas (:class:`matplotlib.figure.Figure` +
 :class:`~matplotlib.backends.backend_agg.FigureCanvasAgg`), never through ``pyplot``: nothing
 depends on a display, no global figure registry grows, and a figure is freed as soon as it
 goes out of scope. Degrees appear only here (the edge); the :class:`~steerlab.sim.result.Result`
@@ -63,7 +65,6 @@ def _new_figure(figsize=TIME_SERIES_SIZE):
     fig = Figure(figsize=figsize, dpi=DPI, layout="constrained")
     FigureCanvasAgg(fig)
     ax = fig.add_subplot()
-    ax.grid(True, alpha=0.4)
     return fig, ax
 
 
@@ -114,46 +115,52 @@ def unwrapped_heading_deg(psi, psi_ref):
     return psi_u * R2D, ref_u * R2D
 
 
-def plot_heading(path: Path, result, title: str = "") -> Path:
-    """Heading and reference heading [deg] versus time.
+def draw_heading(ax, result, title: str = ""):
+    """Draw heading and reference heading [deg] versus time into ``ax``; returns ``ax``.
 
     Parameters
     ----------
-    path : pathlib.Path
-        PNG to write.
+    ax : matplotlib.axes.Axes
     result : steerlab.sim.result.Result
     title : str, optional
 
     Returns
     -------
-    pathlib.Path
+    matplotlib.axes.Axes
     """
     psi_deg, ref_deg = unwrapped_heading_deg(result.psi, result.psi_ref)
-    fig, ax = _new_figure()
+    ax.grid(True, alpha=0.4)
     ax.plot(result.time, ref_deg, "--", color="0.35", lw=1.2, label="psi_ref (set heading)")
     ax.plot(result.time, psi_deg, color="C0", lw=1.2, label="psi (heading)")
     ax.set_xlabel("time [s]")
     ax.set_ylabel("heading [deg]")
     ax.legend(loc="best")
     _title(ax, title, "heading")
+    return ax
+
+
+def plot_heading(path: Path, result, title: str = "") -> Path:
+    """Write :func:`draw_heading` as a PNG at ``path``; returns ``path``."""
+    fig, ax = _new_figure()
+    draw_heading(ax, result, title)
     return _save(fig, path)
 
 
-def plot_rudder(path: Path, result, title: str = "") -> Path:
-    """Rudder order, actual rudder angle and (if non-zero) the equivalent-rudder disturbance [deg].
+def draw_rudder(ax, result, title: str = ""):
+    """Draw rudder order, actual rudder angle and (if non-zero) the equivalent-rudder
+    disturbance [deg] versus time into ``ax``; returns ``ax``.
 
     Parameters
     ----------
-    path : pathlib.Path
-        PNG to write.
+    ax : matplotlib.axes.Axes
     result : steerlab.sim.result.Result
     title : str, optional
 
     Returns
     -------
-    pathlib.Path
+    matplotlib.axes.Axes
     """
-    fig, ax = _new_figure()
+    ax.grid(True, alpha=0.4)
     dist = np.asarray(result.disturbance)
     if dist.ndim == 2 and dist.shape[1] > W_RUDDER and np.any(dist[:, W_RUDDER] != 0.0):
         # drawn first and light: wave noise would otherwise hide the rudder curves
@@ -167,24 +174,30 @@ def plot_rudder(path: Path, result, title: str = "") -> Path:
     ax.set_ylabel("rudder angle [deg]")
     ax.legend(loc="best")
     _title(ax, title, "rudder")
+    return ax
+
+
+def plot_rudder(path: Path, result, title: str = "") -> Path:
+    """Write :func:`draw_rudder` as a PNG at ``path``; returns ``path``."""
+    fig, ax = _new_figure()
+    draw_rudder(ax, result, title)
     return _save(fig, path)
 
 
-def plot_yaw_rate(path: Path, result, title: str = "") -> Path:
-    """Yaw rate and reference rate [deg/s] versus time.
+def draw_yaw_rate(ax, result, title: str = ""):
+    """Draw yaw rate and reference rate [deg/s] versus time into ``ax``; returns ``ax``.
 
     Parameters
     ----------
-    path : pathlib.Path
-        PNG to write.
+    ax : matplotlib.axes.Axes
     result : steerlab.sim.result.Result
     title : str, optional
 
     Returns
     -------
-    pathlib.Path
+    matplotlib.axes.Axes
     """
-    fig, ax = _new_figure()
+    ax.grid(True, alpha=0.4)
     ax.plot(result.time, result.r_ref * R2D, "--", color="0.35", lw=1.2, label="r_ref (reference)")
     ax.plot(result.time, result.r * R2D, color="C0", lw=1.2, label="r (yaw rate)")
     ax.axhline(0.0, color="0.5", lw=0.6)
@@ -192,33 +205,40 @@ def plot_yaw_rate(path: Path, result, title: str = "") -> Path:
     ax.set_ylabel("yaw rate [deg/s]")
     ax.legend(loc="best")
     _title(ax, title, "yaw rate")
+    return ax
+
+
+def plot_yaw_rate(path: Path, result, title: str = "") -> Path:
+    """Write :func:`draw_yaw_rate` as a PNG at ``path``; returns ``path``."""
+    fig, ax = _new_figure()
+    draw_yaw_rate(ax, result, title)
     return _save(fig, path)
 
 
-def plot_track(path: Path, result, title: str = "") -> Path:
-    """Track: east (horizontal) versus north (vertical), equal aspect, start/end markers.
+def draw_track(ax, result, title: str = ""):
+    """Draw the track: east (horizontal) versus north (vertical), equal aspect, start/end
+    markers, into ``ax``; returns ``ax``.
 
     Metres for tracks up to 5 km across, kilometres beyond. A ship model without position
-    states (``x_n``, ``y_e``) gets a placeholder figure saying so, so the report's links hold.
+    states (``x_n``, ``y_e``) gets a placeholder saying so, so the report's links hold.
 
     Parameters
     ----------
-    path : pathlib.Path
-        PNG to write.
+    ax : matplotlib.axes.Axes
     result : steerlab.sim.result.Result
     title : str, optional
 
     Returns
     -------
-    pathlib.Path
+    matplotlib.axes.Axes
     """
-    fig, ax = _new_figure(TRACK_SIZE)
+    ax.grid(True, alpha=0.4)
     _title(ax, title, "track")
     if not {"x_n", "y_e"} <= set(result.state_names):
         ax.text(0.5, 0.5, "no position states (x_n, y_e) in this ship model",
                 ha="center", va="center", transform=ax.transAxes)
         ax.set_axis_off()
-        return _save(fig, path)
+        return ax
     north = result.col("x_n")
     east = result.col("y_e")
     extent = max(np.ptp(north), np.ptp(east)) if len(north) else 0.0
@@ -232,6 +252,13 @@ def plot_track(path: Path, result, title: str = "") -> Path:
     ax.set_xlabel(f"east y_e [{unit}]")
     ax.set_ylabel(f"north x_n [{unit}]")
     ax.legend(loc="best")
+    return ax
+
+
+def plot_track(path: Path, result, title: str = "") -> Path:
+    """Write :func:`draw_track` as a PNG at ``path``; returns ``path``."""
+    fig, ax = _new_figure(TRACK_SIZE)
+    draw_track(ax, result, title)
     return _save(fig, path)
 
 

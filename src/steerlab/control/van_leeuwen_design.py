@@ -37,10 +37,12 @@ from steerlab.ships import van_leeuwen as vl
 def design_model(ctx, design_loading: str | None, T2: float | None):
     """``(set7 packed (radian form), L [m], i_rdot)`` for a controller built in ``ctx``.
 
-    ``i_rdot`` is the index of ``rdot`` in the plant state, or ``-1`` (estimate it).
+    ``i_rdot`` is the index of ``rdot`` in the plant state, or ``-1`` (estimate it; also when the
+    ship has no ``state_names``, e.g. a duck-typed ship given by a user).
     """
     ship = ctx.ship
-    i_rdot = float(ship.state_names.index("rdot")) if "rdot" in ship.state_names else -1.0
+    names = tuple(getattr(ship, "state_names", ()))   # a duck-typed ship may have no names: estimate rdot
+    i_rdot = float(names.index("rdot")) if "rdot" in names else -1.0
     known = vl.ships()
     if ship.name in known:
         loadings = tuple(known[ship.name].loadings)

@@ -41,6 +41,12 @@ class BatchResult:
     ref: np.ndarray
     state_names: tuple
 
+    def to_pandas(self, lam: float = 0.1):
+        """One row per run: integral metrics and final states (:func:`steerlab.sim.frames.batch_frame`)."""
+        from steerlab.sim.frames import batch_frame
+
+        return batch_frame(self, lam)
+
 
 def _stack(arrays, field):
     shapes = {a.shape for a in arrays}

@@ -71,6 +71,28 @@ class Result:
             cols[f"{n} [{u}]"] = c
         return cols
 
+    def to_pandas(self):
+        """A ``pandas.DataFrame``: index ``time [s]``, columns ``name [unit]`` as in :meth:`columns`."""
+        from steerlab.sim.frames import result_frame
+
+        return result_frame(self)
+
+    def plot(self, axes=None, title: str = ""):
+        """Heading, rudder and yaw rate in three Axes (``axes``: three matplotlib Axes, or None
+        for a new pyplot figure); returns the Axes (:func:`steerlab.report.draw_heading` etc.)."""
+        from steerlab.report import draw_heading, draw_rudder, draw_yaw_rate
+
+        if axes is None:
+            import matplotlib.pyplot as plt
+
+            _, axes = plt.subplots(3, 1, sharex=True, figsize=(8.0, 8.0), layout="constrained")
+        if len(axes) != 3:
+            from steerlab.errors import InputError
+            raise InputError("axes", f"give three matplotlib Axes (heading, rudder, yaw rate), got {len(axes)}")
+        for draw, ax in zip((draw_heading, draw_rudder, draw_yaw_rate), axes):
+            draw(ax, self, title)
+        return axes
+
     def to_csv(self, path) -> Path:
         path = Path(path)
         cols = self.columns()

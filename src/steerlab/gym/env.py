@@ -1,0 +1,71 @@
+r"""Gymnasium environments on steerlab ships: one ship (:class:`SteeringEnv`).
+
+Observation (``Box``, float64, shape (3,)): ``[heading error e [rad] in [-pi, pi), yaw rate r
+[rad/s] in [-pi, pi], rudder angle delta [rad] in [-pi/2, pi/2]]``, ``e = wrap_to_pi(psi_ref - psi)``.
+Action (``Box``, float32, shape (1,), in [-1, 1]): the rudder order as a fraction of the gear's
+limit (``order = a * delta_max``), held for ``control_dt`` seconds. An action outside the
+space raises :class:`~steerlab.errors.InputError` (no silent clipping).
+Reward (``reward=``): ``"speed_loss"`` (default) ``-(e^2 + lam delta^2) * control_dt`` after
+the step - the speed-loss criterion (Koyama; van Amerongen 1982 eq 3.1), ``lam`` dimensionless
+(default 0.1, as steerlab.metrics.speed_loss_J); ``"itae"`` ``-t |e| control_dt``; ``"iae"``
+``-|e| control_dt`` (:mod:`steerlab.gym.plant_batch`).
+Episode: ``episode_s`` seconds (``truncated``); a diverged ship (non-finite state, or a yaw
+rate beyond the observation bound) ends it
+(``terminated``, ``info["reason"] == "diverged"``, observation zeros).
+Tasks: ``course_keeping`` (``steerlab/CourseKeeping-v0``: hold 0 deg from a seeded initial
+offset of up to ``initial_offset_deg``), ``course_change`` (``steerlab/CourseChange-v0``: a
+``change_deg`` step of the reference at ``change_t``), ``track_following``
+(``steerlab/TrackFollowing-v0``: LOS guidance along a route, ``guidance=`` a scenario
+``[guidance]`` table; the heading error is then the one to the LOS heading and
+``info["xte"]`` the cross-track error [m]), all in the scenario sea ``environment`` (default
+``{"waves": True}``, the coloured wave noise of eq 39).
+"""
+
+from __future__ import annotations
+
+import math
+
+import gymnasium as gym
+import numpy as np
+
+from steerlab.guidance.reference_vector import REF_XTE
+from steerlab.gym.episodes import Episodes
+
+
+def spaces():
+    """``(observation_space, action_space)`` of one ship."""
+    hi = np.array([math.pi, math.pi, math.pi / 2])   # e [rad], r [rad/s] (180 deg/s: no ship), delta [rad]
+    obs = gym.spaces.Box(low=-hi, high=hi, shape=(3,), dtype=np.float64)
+    act = gym.spaces.Box(low=-1.0, high=1.0, shape=(1,), dtype=np.float32)
+    return obs, act
+
+
+class SteeringEnv(gym.Env):
+    """One ship (keyword arguments: see :class:`steerlab.gym.episodes.Episodes`)."""
+
+    metadata = {"render_modes": []}
+
+    def __init__(self, task="course_keeping", render_mode=None, **kw):
+        self.core = Episodes(1, task=task, **kw)
+        self.observation_space, self.action_space = spaces()
+        self.render_mode = render_mode
+        self._done = True
+
+    def reset(self, *, seed=None, options=None):
+        super().reset(seed=seed)
+        info = self.core.reset_lanes([0], [seed])[0]
+        self._done = False
+        return self.core.obs[0].copy(), info
+
+    def step(self, action):
+        if self._done:
+            raise RuntimeError("episode over: call reset() first")
+        obs, rew, term, trunc = self.core.step(np.asarray(action).reshape(1))
+        info = {"t": float(self.core.J[0] * self.core.control_dt)}
+        xte = float(self.core.REF[0, REF_XTE])
+        if xte == xte:                                   # NaN without a route
+            info["xte"] = xte
+        if term[0]:
+            info["reason"] = "diverged"
+        self._done = bool(term[0] or trunc[0])
+        return obs[0].copy(), float(rew[0]), bool(term[0]), bool(trunc[0]), info
