@@ -26,7 +26,7 @@ from steerlab.errors import InputError, require_finite_range
 from steerlab.ships.registry import get_ship
 from steerlab.ships.state import PLANAR_NAMES, PLANAR_UNITS
 from steerlab.steering_gear import SteeringGear
-from steerlab.units import knots_to_ms, rad
+from steerlab.units import knots_to_ms
 
 
 @dataclass(frozen=True)
@@ -79,9 +79,9 @@ def make_gear(gear) -> SteeringGear:
         bad = sorted(set(gear) - known)
         if bad:
             raise InputError(f"gear.{bad[0]}", f"unknown key; allowed: {sorted(known)}")
-        g = GearConfig(**gear)
-        return SteeringGear(rad(g.delta_max_deg), rad(g.rate_max_deg_s), g.T_sg,
-                            rad(g.dead_zone_deg)).validated()
+        from steerlab.sim.setup import gear_from_config
+
+        return gear_from_config(GearConfig(**gear)).validated()
     raise InputError("gear", f"must be None, a SteeringGear or a dict of [gear] keys, got {type(gear).__name__}")
 
 

@@ -75,7 +75,11 @@ def controller_spec(name: str) -> ControllerSpec:
 
 def scenario_gear(s) -> SteeringGear:
     """The scenario's steering gear (SI) from its ``[gear]`` table."""
-    g = s.gear
+    return gear_from_config(s.gear)
+
+
+def gear_from_config(g) -> SteeringGear:
+    """A steering gear (SI) from a validated ``[gear]`` table (degrees at the edge)."""
     return SteeringGear(rad(g.delta_max_deg), rad(g.rate_max_deg_s), g.T_sg, rad(g.dead_zone_deg))
 
 
