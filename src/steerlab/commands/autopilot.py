@@ -62,6 +62,7 @@ def register(sub, formatter_class) -> None:
 
 def build_autopilot(args):
     """The :class:`~steerlab.runtime.autopilot.Autopilot` (and web bind) for parsed ``args``."""
+    from steerlab.commands.serve_ship import allowed_origins
     from steerlab.errors import InputError, require_finite_range
     from steerlab.runtime.autopilot import Autopilot, AutopilotConfig
     from steerlab.runtime.controller_runtime import ControllerRuntime
@@ -75,6 +76,7 @@ def build_autopilot(args):
     if connect[1] == 0:
         raise InputError("--connect", "port must be in [1, 65535]")
     key = load_key(args.key_file, args.key_env)
+    origins = allowed_origins(args)
     scenario = load_scenario(args.scenario) if args.scenario else default_scenario()
     ctrl = ControllerRuntime(scenario, args.controller, args.sample_time)
     if args.heading is not None:
@@ -101,7 +103,8 @@ def build_autopilot(args):
                    route=route, key=key, log_path=args.log, engaged=not args.standby,
                    nmea_listen=hp(args.nmea_listen, "--nmea-listen"), nmea_to=hp(args.nmea_to, "--nmea-to"),
                    signalk_listen=hp(args.signalk_listen, "--signalk-listen"),
-                   signalk_to=hp(args.signalk_to, "--signalk-to"), signalk_ws=signalk_ws)
+                   signalk_to=hp(args.signalk_to, "--signalk-to"), signalk_ws=signalk_ws,
+                   allow_origins=origins)
     return ap, web
 
 
@@ -111,7 +114,7 @@ async def run_with_web(ap, web, duration, started=None):
     if web is not None:
         from steerlab.runtime.web import BridgeServer
 
-        bridge = await BridgeServer(ap, web[0], web[1]).start()
+        bridge = await BridgeServer(ap, web[0], web[1], allow_origins=ap.allow_origins).start()
     try:
         await ap.run(duration, started=lambda a: started(a, bridge) if started else None)
     finally:
@@ -133,6 +136,11 @@ def run(args) -> int:
             print(f"autopilot: {a.ctrl.name} -> {a.connect[0]}:{a.connect[1]}, sample {a.config.sample_time:g} s, "
                   f"watchdog {a.config.watchdog_timeout:g} s ({a.config.safe_action}), log {args.log}{page}; "
                   "Ctrl-C stops", file=sys.stderr, flush=True)
+            if not a.key:
+                from steerlab.commands.serve_ship import no_key_warning
+
+                print(no_key_warning("autopilot", "any process can forge ship states to this autopilot and, "
+                                     "while it is silent, take the ship's rudder"), file=sys.stderr, flush=True)
 
     try:
         asyncio.run(run_with_web(ap, web, args.duration, started))

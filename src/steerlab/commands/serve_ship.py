@@ -23,6 +23,22 @@ def add_link_security(p) -> None:
     g.add_argument("--key-env", help="environment variable holding the key (e.g. STEERLAB_LINK_KEY)")
     g.add_argument("--max-age", type=float, default=0.5,
                    help="reject datagrams whose sender stamp is older than this [wall s]; 0: off (default 0.5)")
+    g.add_argument("--allow-origin", action="append", default=[], metavar="URL",
+                   help="also let browser pages of this origin (http[s]://HOST[:PORT]) use the WebSocket endpoints "
+                        "(repeatable; default: loopback pages only)")
+
+
+def allowed_origins(args) -> tuple:
+    """The ``--allow-origin`` values, normalised (InputError naming the option if one is not an origin)."""
+    from steerlab.runtime.access import normalise_origin
+
+    return tuple(normalise_origin(o) for o in args.allow_origin)
+
+
+def no_key_warning(prog: str, what: str) -> str:
+    """The loud warning printed when the link runs without a key (HMAC off)."""
+    return (f"{prog}: WARNING: HMAC off - no --key-file/--key-env, so {what}. "
+            "Give both ends the same key (>= 16 bytes): --key-file FILE or --key-env NAME (docs/runtime.md).")
 
 
 def register(sub, formatter_class) -> None:
@@ -48,6 +64,9 @@ def register(sub, formatter_class) -> None:
     p.add_argument("--signalk-ws", metavar="HOST:PORT",
                    help="serve the Signal K stream here (WebSocket ws://HOST:PORT/signalk/v1/stream, read-only)")
     p.add_argument("--nmea-period", type=float, default=0.2, help="NMEA / Signal K period [s] (default 0.2)")
+    p.add_argument("--session-lock", type=float, default=1.0,
+                   help="while the autopilot holding the rudder keeps sending, refuse commands of any other "
+                        "sender until it has been silent this long [s]; 0: off (default 1)")
     p.add_argument("--origin", default="54.5,18.9",
                    help="LAT,LON [deg] of the model origin for RMC (default 54.5,18.9: Gulf of Gdansk, at sea)")
     add_link_security(p)
@@ -83,15 +102,17 @@ def run(args) -> int:
     if signalk_ws is not None and not is_loopback(signalk_ws[0]) and not args.allow_remote:
         raise InputError("--signalk-ws", f"{signalk_ws[0]} is not a loopback address; add --allow-remote to expose it")
     key = load_key(args.key_file, args.key_env)
+    origins = allowed_origins(args)
     scenario = load_scenario(args.scenario) if args.scenario else default_scenario()
     cfg = ShipServerConfig(publish_period=args.publish_period, speedup=args.speedup,
                            cmd_timeout=args.cmd_timeout, centre_after=args.centre_after,
-                           duration=args.duration, max_age=args.max_age, nmea_period=args.nmea_period)
+                           duration=args.duration, max_age=args.max_age, nmea_period=args.nmea_period,
+                           session_lock=args.session_lock)
     server = ShipServer(scenario, cfg, key=key, bind=bind,
                         publish_to=[parse_hostport(a, "--publish") for a in args.publish],
                         nmea_to=parse_hostport(args.nmea_to, "--nmea-to") if args.nmea_to else None,
                         signalk_to=parse_hostport(args.signalk_to, "--signalk-to") if args.signalk_to else None,
-                        origin=_origin(args.origin), signalk_ws=signalk_ws)
+                        origin=_origin(args.origin), signalk_ws=signalk_ws, allow_origins=origins)
 
     def started(s):
         if not args.quiet:
@@ -102,6 +123,10 @@ def run(args) -> int:
             print(f"serve-ship: {scenario.ship.model} ({scenario.name}) on {host}:{port}, speedup {cfg.speedup:g}, "
                   f"state every {cfg.publish_period:g} s, HMAC {'on' if key else 'off'}{sk}; Ctrl-C stops",
                   file=sys.stderr, flush=True)
+            if not key:
+                print(no_key_warning("serve-ship", f"ANY process that can reach {host}:{port} can send rudder "
+                                     "orders (the first sender holds the rudder while it keeps sending: "
+                                     "--session-lock)"), file=sys.stderr, flush=True)
 
     try:
         stats = asyncio.run(server.run(started))

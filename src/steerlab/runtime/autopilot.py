@@ -118,12 +118,14 @@ class Autopilot:
     signalk_ws : (host, port) or None
         Serve the Signal K stream here (WebSocket, :mod:`steerlab.runtime.signalk_ws`): the
         ship state and autopilot paths each sample; PUT of the target heading and state.
+    allow_origins : sequence of str
+        Browser origins allowed on the Signal K stream besides loopback pages.
     """
 
     def __init__(self, controller, connect, config: AutopilotConfig = AutopilotConfig(),
                  heading=None, route=None, key=None, log_path=None, engaged=True,
                  nmea_listen=None, signalk_listen=None, signalk_to=None, nmea_to=None, bind=None,
-                 signalk_ws=None):
+                 signalk_ws=None, allow_origins=()):
         self.ctrl = controller
         self.connect = connect
         self.config = cfg = config.validate()
@@ -167,6 +169,7 @@ class Autopilot:
         self.nmea_to = nmea_to
         self.signalk_ws = signalk_ws
         self.signalk_stream = None
+        self.allow_origins = tuple(allow_origins)
         self.bind = bind or (LOOPBACK if connect[0] in (LOOPBACK, "localhost") else "0.0.0.0", 0)
         self.transport = None
         self._t0 = None
@@ -492,7 +495,8 @@ class Autopilot:
                 from steerlab.runtime.signalk_ws import SignalKStreamServer
 
                 self.signalk_stream = await SignalKStreamServer(
-                    *self.signalk_ws, on_put=lambda path, v: autopilot_put(self, path, v, self.clock())).start()
+                    *self.signalk_ws, on_put=lambda path, v: autopilot_put(self, path, v, self.clock()),
+                    allow_origins=self.allow_origins).start()
             self._t0 = time.monotonic()
             if started is not None:
                 started(self)

@@ -15,6 +15,13 @@ datagram, in this order (the first failing rule names the rejection; nothing rai
    a datagram of another session is accepted only if its stamp is newer than the last
    accepted one (the sender restarted), else ``replayed``.
 
+6. ``locked`` (only with ``lock_types``, the ship server's commands) - a session lock: while the
+   sender whose ``lock_types`` message was accepted last (the *holder*: its session and, without
+   a key, its source address) has sent one within ``lock_timeout`` wall seconds, such messages
+   from any other sender are refused, so a second process cannot take the rudder from a running
+   autopilot (and a restarted autopilot takes over once the lock has lapsed). Other messages of
+   other senders (a display's HELLO) are still accepted, but leave the holder's sequencing alone.
+
 Accepted datagrams are counted under ``accepted``. With a key, a replayed copy of a signed
 datagram is always rejected: by the sequence rules while fresh, by rule 4 once old.
 """
@@ -43,10 +50,14 @@ class LinkFilter:
         Freshness limit [s of wall clock] on the sender's stamp; ``<= 0``: off.
     rate, burst : float
         Token bucket per source address [datagrams/s], [datagrams]; ``rate <= 0``: off.
+    lock_types : tuple of int
+        Message types that take and need the session lock (rule 6); empty: no lock.
+    lock_timeout : float
+        The lock lapses after this long without a ``lock_types`` message from its holder [wall s].
     """
 
     def __init__(self, expect_type: int, key: bytes | None = None, max_age: float = 0.5,
-                 rate: float = 0.0, burst: float = 20.0):
+                 rate: float = 0.0, burst: float = 20.0, lock_types=(), lock_timeout: float = 0.0):
         self.expect_types = (expect_type,) if isinstance(expect_type, int) else tuple(expect_type)
         self.key = key or None
         self.max_age = float(max_age)
@@ -57,6 +68,10 @@ class LinkFilter:
         self.last_stamp = 0.0
         self._seen: deque = deque(maxlen=SEEN_WINDOW)
         self._seen_set: set = set()
+        self.lock_types = tuple(lock_types) if lock_timeout > 0.0 else ()
+        self.lock_timeout = float(lock_timeout)
+        self.holder = None           # (session, source or None) of the lock holder
+        self.holder_time = 0.0       # wall time of its last lock_types message [s]
 
     def _reject(self, reason: str):
         self.counts[reason] += 1
@@ -77,6 +92,12 @@ class LinkFilter:
                 return self._reject("stale")
             if h.stamp - now > self.max_age:
                 return self._reject("future")
+        if self.lock_types and self.holder is not None and now - self.holder_time < self.lock_timeout:
+            if (h.session, None if self.key else source) != self.holder:
+                if h.type in self.lock_types:
+                    return self._reject("locked")
+                self.counts["accepted"] += 1          # e.g. a display's HELLO: used, sequencing untouched
+                return msg, "ok"
         if h.session == self.session:
             if (h.session, h.seq) in self._seen_set:
                 return self._reject("replayed" if self.key else "duplicate")
@@ -94,6 +115,9 @@ class LinkFilter:
             self._seen_set.discard(self._seen[0])
         self._seen.append((h.session, h.seq))
         self._seen_set.add((h.session, h.seq))
+        if h.type in self.lock_types:
+            self.holder = (h.session, None if self.key else source)
+            self.holder_time = now
         self.counts["accepted"] += 1
         return msg, "ok"
 

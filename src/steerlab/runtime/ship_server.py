@@ -9,6 +9,10 @@ Rudder orders come from :data:`~steerlab.runtime.protocol.TYPE_COMMAND` datagram
 the :class:`~steerlab.runtime.link_filter.LinkFilter`. If none arrives in time the server
 **holds** the last order (status ``STATUS_CMD_HOLD`` after ``cmd_timeout``) and then
 **centres** the rudder (``STATUS_CMD_CENTRED`` after ``centre_after``): :func:`order_in_effect`.
+
+One sender at a time holds the rudder: while the autopilot session whose command was accepted
+last keeps sending (a gap shorter than ``session_lock``), commands of any other sender are
+refused (counted ``locked``), with or without a key; see :class:`~steerlab.runtime.link_filter.LinkFilter`.
 """
 
 from __future__ import annotations
@@ -40,6 +44,7 @@ class ShipServerConfig:
     burst: float = 20.0              #: token bucket size [datagrams]
     nmea_period: float = 0.2         #: NMEA 0183 / Signal K output period [s]
     max_subscribers: int = 8
+    session_lock: float = 1.0        #: commands of a second sender refused until the holder is silent this long; 0: off
 
     def validate(self) -> "ShipServerConfig":
         require_finite_range("--publish-period", self.publish_period, 0.001, 10.0)
@@ -49,6 +54,7 @@ class ShipServerConfig:
         require_finite_range("--duration", self.duration, 0.0, 1e7)
         require_finite_range("--max-age", self.max_age, 0.0, 3600.0)
         require_finite_range("--nmea-period", self.nmea_period, 0.01, 60.0)
+        require_finite_range("--session-lock", self.session_lock, 0.0, 3600.0)
         return self
 
 
@@ -98,11 +104,13 @@ class ShipServer:
     origin : (lat_deg, lon_deg)
         Geographic position of the model's origin (for RMC); None: at sea in the Gulf of Gdansk
         (:data:`steerlab.runtime.nmea.DEFAULT_ORIGIN`).
+    allow_origins : sequence of str
+        Browser origins allowed on the Signal K stream besides loopback pages.
     """
 
     def __init__(self, scenario, config: ShipServerConfig = ShipServerConfig(), key=None,
                  bind=(LOOPBACK, 0), publish_to=(), nmea_to=None, signalk_to=None,
-                 origin=None, signalk_ws=None):
+                 origin=None, signalk_ws=None, allow_origins=()):
         from steerlab.sim.kernels import plant_step
         from steerlab.sim.setup import build
         from steerlab.units import knots_to_ms
@@ -127,7 +135,8 @@ class ShipServer:
         self.key = key
         self.sender = P.Sender(key)
         self.filter = LinkFilter((P.TYPE_COMMAND, P.TYPE_HELLO), key=key, max_age=config.max_age,
-                                 rate=config.rate * config.speedup, burst=config.burst)
+                                 rate=config.rate * config.speedup, burst=config.burst,
+                                 lock_types=(P.TYPE_COMMAND,), lock_timeout=config.session_lock / config.speedup)
         self.bind = bind
         self.publish_to = list(publish_to)
         self.subscribers: dict = {}
@@ -135,6 +144,7 @@ class ShipServer:
         self.signalk_to = signalk_to
         self.signalk_ws = signalk_ws
         self.signalk_stream = None
+        self.allow_origins = tuple(allow_origins)
         if origin is None:
             from steerlab.runtime.nmea import DEFAULT_ORIGIN as origin
         self.origin = origin
@@ -241,7 +251,8 @@ class ShipServer:
             from steerlab.runtime.signalk_ws import SignalKStreamServer
 
             try:
-                self.signalk_stream = await SignalKStreamServer(*self.signalk_ws).start()
+                self.signalk_stream = await SignalKStreamServer(*self.signalk_ws,
+                                                         allow_origins=self.allow_origins).start()
             except InputError:
                 self.transport.close()
                 raise

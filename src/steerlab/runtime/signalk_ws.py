@@ -38,18 +38,18 @@ from __future__ import annotations
 
 import json
 import math
-import re
 import time
 from http import HTTPStatus
 
 from websockets.asyncio.server import broadcast, serve
 
 from steerlab.errors import InputError
+from steerlab.runtime.access import AccessPolicy, parse_json
 from steerlab.runtime.http_conn import HttpConnection
 from steerlab.runtime.rate_limit import RateLimiter
 from steerlab.runtime.signalk import MAX_DELTA_BYTES, SELF_ID, delta, is_self_context, iso_time
 from steerlab.runtime.signalk_rest import API_PATH, api_get
-from steerlab.runtime.web import _response, same_origin
+from steerlab.runtime.web import _response
 
 SIGNALK_VERSION = "1.7.0"
 STREAM_PATH = "/signalk/v1/stream"
@@ -57,39 +57,92 @@ SUBSCRIBE_MODES = ("self", "all", "none")
 CONTEXTS = ("vessels.self", "*")
 
 
-def path_pattern(pattern: str) -> re.Pattern:
-    """A Signal K path pattern (``*`` = any characters) as a compiled regular expression."""
-    return re.compile("".join(".*" if c == "*" else re.escape(c) for c in pattern))
+MAX_PATH = 256
+"""Longest subscription path pattern [characters]."""
+MAX_PATTERNS = 64
+"""Most path patterns one client may hold (a subscribe beyond is refused as a whole)."""
+
+
+class PathPattern:
+    """A Signal K path pattern: ``*`` matches any run of characters (dots included), the rest literally.
+
+    No regular expression: the pattern is split at its ``*`` into literal chunks; a path matches
+    when it starts with the first chunk, ends with the last, and the middle chunks occur in order
+    in between. Taking each middle chunk at its leftmost occurrence (``str.find``) is exact for
+    ``*``-only globs (a later occurrence never leaves more room for the rest), so a match costs one
+    left-to-right scan, O(len(path) + len(pattern)), whatever the number of ``*``; the regex
+    ``.*a.*a...`` used before backtracked exponentially (10 ``*`` froze the event loop for > 20 s).
+    """
+
+    __slots__ = ("text", "head", "mids", "tail", "star")
+
+    def __init__(self, text: str):
+        parts = text.split("*")
+        self.text = text
+        self.star = len(parts) > 1
+        self.head = parts[0]
+        self.tail = parts[-1] if self.star else ""
+        self.mids = tuple(p for p in parts[1:-1] if p)
+
+    def match(self, path: str) -> bool:
+        if not self.star:
+            return path == self.head
+        head, tail = self.head, self.tail
+        end = len(path) - len(tail)
+        if end < len(head) or not path.startswith(head) or not path.endswith(tail):
+            return False
+        i = len(head)
+        for m in self.mids:
+            j = path.find(m, i, end)
+            if j < 0:
+                return False
+            i = j + len(m)
+        return True
+
+
+def path_pattern(pattern: str) -> PathPattern:
+    """A Signal K path pattern (``*`` = any characters), matched in linear time (:class:`PathPattern`)."""
+    return PathPattern(pattern)
 
 
 class Subscriptions:
-    """The path patterns one client subscribed to (``all_paths``: everything)."""
+    """The path patterns one client subscribed to (at most :data:`MAX_PATTERNS`)."""
 
     def __init__(self, mode: str = "self"):
-        self.patterns: dict[str, re.Pattern] = {}
+        self.patterns: dict[str, PathPattern] = {}
+        self._wants: dict[str, bool] = {}      # path -> matched (the published paths are few)
         if mode in ("self", "all"):
             self.patterns["*"] = path_pattern("*")
 
     def wants(self, path: str) -> bool:
-        return any(p.fullmatch(path) for p in self.patterns.values())
+        hit = self._wants.get(path)
+        if hit is None:
+            hit = any(p.match(path) for p in self.patterns.values())
+            if len(self._wants) >= 4 * MAX_PATTERNS:
+                self._wants.clear()
+            self._wants[path] = hit
+        return hit
 
     def filter(self, values: dict) -> dict:
         return {p: v for p, v in values.items() if self.wants(p)}
 
     def apply(self, msg: dict) -> bool:
-        """Apply a subscribe / unsubscribe message; False if it is not a valid one."""
+        """Apply a subscribe / unsubscribe message; False (and nothing changed) if it is not a valid one."""
         if not is_self_context(msg.get("context", "vessels.self")):
             return False
         for key, add in (("subscribe", True), ("unsubscribe", False)):
             items = msg.get(key)
             if items is None:
                 continue
-            if not isinstance(items, list) or len(items) > 64:
+            if not isinstance(items, list) or len(items) > MAX_PATTERNS:
                 return False
-            for item in items:
-                path = item.get("path") if isinstance(item, dict) else None
-                if not isinstance(path, str) or not 0 < len(path) <= 256:
-                    return False
+            paths = [item.get("path") if isinstance(item, dict) else None for item in items]
+            if not all(isinstance(p, str) and 0 < len(p) <= MAX_PATH for p in paths):
+                return False
+            if add and len(self.patterns.keys() | set(paths)) > MAX_PATTERNS:
+                return False
+            self._wants.clear()
+            for path in paths:
                 if add:
                     self.patterns[path] = path_pattern(path)
                 elif path == "*":
@@ -109,11 +162,18 @@ class SignalKStreamServer:
         Applies a PUT request (None: read-only, every PUT is answered 405).
     field : str
         CLI option named in errors (binding failures).
+    msg_rate : float
+        Messages accepted per second per connection (bursts of twice that; the excess is dropped).
+    put_rate : float
+        PUT requests applied per second per connection (bursts of twice that) and, across all
+        connections, twice that (bursts of four times); the excess is answered 429, not applied.
+    allow_origins : sequence of str
+        Browser origins allowed besides loopback pages (:class:`~steerlab.runtime.access.AccessPolicy`).
     """
 
     def __init__(self, host: str = "127.0.0.1", port: int = 0, on_put=None, field: str = "--signalk-ws",
                  name: str = "steerlab", max_clients: int = 8, max_buffer: int = 256 * 1024,
-                 msg_rate: float = 20.0):
+                 msg_rate: float = 20.0, put_rate: float = 5.0, allow_origins=()):
         self.host, self.port = host, port
         self.on_put = on_put
         self.field = field
@@ -121,16 +181,24 @@ class SignalKStreamServer:
         self.max_clients = max_clients
         self.max_buffer = max_buffer
         self.limiter = RateLimiter(msg_rate, 2 * msg_rate, max_sources=4 * max_clients)
+        self.put_rate = put_rate
+        self.put_limiter = RateLimiter(put_rate, 2 * put_rate, max_sources=4 * max_clients)
+        self.put_limiter_all = RateLimiter(2 * put_rate, 4 * put_rate, max_sources=1)
+        self.access = AccessPolicy(host, allow_origins)
         self.cache: dict = {}
         self.cache_time: dict = {}       # path -> wall time of its last value [s]
         self.clients: dict = {}          # connection -> Subscriptions
         self.counts = {"clients": 0, "sent": 0, "skipped_slow": 0, "subscriptions": 0, "put_ok": 0,
-                       "put_refused": 0, "rejected": 0, "rate_limited": 0}
+                       "put_refused": 0, "rejected": 0, "rate_limited": 0, "put_rate_limited": 0, "refused_http": 0}
         self.server = None
 
     # ------------------------------------------------------------ HTTP side
     def _process_request(self, connection, request):
         path, _, query = request.path.partition("?")
+        why = self.access.refusal(request, websocket=path == STREAM_PATH)
+        if why is not None:
+            self.counts["refused_http"] += 1
+            return _response(HTTPStatus.FORBIDDEN, why.encode() + b"\n", "text/plain")
         if path in ("/signalk", "/signalk/"):
             host = request.headers.get("Host") or "%s:%d" % tuple(self.address)
             body = {"endpoints": {"v1": {"version": SIGNALK_VERSION, "signalk-ws": f"ws://{host}{STREAM_PATH}",
@@ -144,8 +212,6 @@ class SignalKStreamServer:
             return _response(status, json.dumps(body).encode(), "application/json")
         if path != STREAM_PATH:
             return _response(HTTPStatus.NOT_FOUND, b"not found\n", "text/plain")
-        if not same_origin(request):
-            return _response(HTTPStatus.FORBIDDEN, b"cross-origin WebSocket refused\n", "text/plain")
         opts = _query(query)
         if opts.get("subscribe", "self") not in SUBSCRIBE_MODES or \
                 opts.get("sendCachedValues", "true") not in ("true", "false"):
@@ -179,25 +245,19 @@ class SignalKStreamServer:
         if not self.limiter.allow(id(source), time.monotonic()):
             self.counts["rate_limited"] += 1
             return None
-        try:
-            if len(msg) > MAX_DELTA_BYTES:
-                raise ValueError
-            m = json.loads(msg)
-        except (ValueError, TypeError, RecursionError):
-            self.counts["rejected"] += 1
-            return None
+        m, _ = parse_json(msg, MAX_DELTA_BYTES)
         if not isinstance(m, dict):
             self.counts["rejected"] += 1
             return None
         if "put" in m:
-            return self._put(m)
+            return self._put(m, source)
         if ("subscribe" in m or "unsubscribe" in m) and subs.apply(m):
             self.counts["subscriptions"] += 1
             return None
         self.counts["rejected"] += 1
         return None
 
-    def _put(self, m: dict) -> dict:
+    def _put(self, m: dict, source=None) -> dict:
         rid = m.get("requestId")
         rid = rid if isinstance(rid, str) and len(rid) <= 128 else None
         put = m.get("put")
@@ -205,6 +265,10 @@ class SignalKStreamServer:
             code, text = 400, "expected put: {path, value}"
         elif self.on_put is None:
             code, text = 405, "this endpoint is read-only"
+        elif not (self.put_limiter.allow(id(source), time.monotonic())
+                  and self.put_limiter_all.allow(None, time.monotonic())):
+            self.counts["put_rate_limited"] += 1
+            code, text = 429, f"rate limited: at most {self.put_rate:g} PUTs per second; not applied"
         else:
             try:
                 code, text = self.on_put(put["path"], put["value"])

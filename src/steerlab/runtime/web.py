@@ -8,9 +8,13 @@ actions as JSON::
     {"action": "engage"}  {"action": "standby"}  {"action": "adjust", "deg": +1 | -1 | +10 | -10}
     {"action": "ack"}     {"action": "ack", "alarm": "link"}
 
-and answers each with ``{"type": "reply", "ok": true|false, "error": ...}``. A WebSocket whose
-``Origin`` is not this page's own (cross-site request) is refused with 403; messages are at
-most 4 KiB; unknown or malformed actions are answered ``ok: false`` and never crash the page.
+and answers each with ``{"type": "reply", "ok": true|false, "error": ...}``. Requests whose
+``Host`` does not name this server (DNS rebinding) and WebSockets from another site's page are
+refused with 403 (:class:`steerlab.runtime.access.AccessPolicy`; ``--allow-origin`` adds
+origins); messages are at most 4 KiB and 16 levels deep; at most ``action_rate`` actions per
+second per connection (and twice that over all connections) are applied, the excess is answered
+``ok: false`` ("rate limited") and not applied; unknown or malformed actions are answered
+``ok: false`` and never crash the page.
 """
 
 from __future__ import annotations
@@ -18,6 +22,7 @@ from __future__ import annotations
 import asyncio
 import json
 import math
+import time
 from http import HTTPStatus
 from importlib import resources
 
@@ -26,13 +31,16 @@ from websockets.datastructures import Headers
 from websockets.http11 import Response
 
 from steerlab.errors import InputError
+from steerlab.runtime.access import AccessPolicy, parse_json
 from steerlab.runtime.http_conn import HttpConnection
+from steerlab.runtime.rate_limit import RateLimiter
 
 STATIC = {"/": ("bridge.html", "text/html; charset=utf-8"),
           "/bridge.js": ("bridge.js", "text/javascript; charset=utf-8"),
           "/bridge.css": ("bridge.css", "text/css; charset=utf-8"),
           "/favicon.svg": ("favicon.svg", "image/svg+xml")}
 ADJUST_STEPS = (-10.0, -1.0, 1.0, 10.0)
+MAX_MESSAGE = 4096
 
 
 def _static(name: str) -> bytes:
@@ -56,19 +64,22 @@ def _response(status: HTTPStatus, body: bytes, ctype: str) -> Response:
     return Response(status.value, status.phrase, headers, body)
 
 
-def same_origin(request) -> bool:
-    """False for a browser's cross-site WebSocket (an ``Origin`` that is not this host's)."""
-    origin = request.headers.get("Origin")
-    host = request.headers.get("Host", "")
-    return origin is None or origin in (f"http://{host}", f"https://{host}")
+def same_origin(request, policy: AccessPolicy | None = None) -> bool:
+    """False for a request a browser page of another site (or a DNS-rebinding page) made.
+
+    ``policy`` defaults to a loopback server's (:class:`~steerlab.runtime.access.AccessPolicy`).
+    """
+    return (policy or AccessPolicy()).refusal(request, websocket=True) is None
 
 
 def handle_action(ap, msg, t: float) -> dict:
     """Apply one page action to the autopilot; the reply (never raises)."""
-    try:
-        m = json.loads(msg) if isinstance(msg, (str, bytes)) else msg
-    except (ValueError, TypeError):
-        return {"type": "reply", "ok": False, "error": "not JSON"}
+    if isinstance(msg, (str, bytes)):
+        m, why = parse_json(msg, MAX_MESSAGE)
+        if why is not None:
+            return {"type": "reply", "ok": False, "error": why}
+    else:
+        m = msg
     if not isinstance(m, dict):
         return {"type": "reply", "ok": False, "error": "expected an object"}
     action = m.get("action")
@@ -92,20 +103,35 @@ def handle_action(ap, msg, t: float) -> dict:
 
 
 class BridgeServer:
-    """Serves the bridge page of ``autopilot`` on ``(host, port)``."""
+    """Serves the bridge page of ``autopilot`` on ``(host, port)``.
 
-    def __init__(self, autopilot, host: str = "127.0.0.1", port: int = 8080, period: float = 0.2):
+    ``allow_origins``: browser origins allowed besides loopback pages; ``action_rate``: actions
+    applied per second per connection (bursts of twice that; over all connections twice the rate).
+    """
+
+    def __init__(self, autopilot, host: str = "127.0.0.1", port: int = 8080, period: float = 0.2,
+                 allow_origins=(), action_rate: float = 5.0, max_clients: int = 8):
         self.ap = autopilot
         self.host, self.port = host, port
         self.period = period
         self.server = None
         self.clients = 0
+        self.max_clients = max_clients
+        self.access = AccessPolicy(host, allow_origins)
+        self.action_rate = action_rate
+        self.limiter = RateLimiter(action_rate, 2 * action_rate, max_sources=4 * max_clients)
+        self.limiter_all = RateLimiter(2 * action_rate, 4 * action_rate, max_sources=1)
+        self.counts = {"refused_http": 0, "rate_limited": 0}
 
     def _process_request(self, connection, request):
         path = request.path.split("?", 1)[0]
+        why = self.access.refusal(request, websocket=path == "/ws")
+        if why is not None:
+            self.counts["refused_http"] += 1
+            return _response(HTTPStatus.FORBIDDEN, why.encode() + b"\n", "text/plain")
         if path == "/ws":
-            if not same_origin(request):
-                return _response(HTTPStatus.FORBIDDEN, b"cross-origin WebSocket refused\n", "text/plain")
+            if self.clients >= self.max_clients:
+                return _response(HTTPStatus.SERVICE_UNAVAILABLE, b"too many bridge pages\n", "text/plain")
             return None
         if path == "/status.json":
             body = json.dumps(_json_safe(self.ap.status())).encode()
@@ -126,12 +152,21 @@ class BridgeServer:
         pusher = asyncio.create_task(push())
         try:
             async for msg in ws:
-                await ws.send(json.dumps(handle_action(self.ap, msg, self.ap.clock())))
+                await ws.send(json.dumps(self.action(ws, msg)))
         except Exception:
             pass
         finally:
             pusher.cancel()
             self.clients -= 1
+
+    def action(self, source, msg) -> dict:
+        """The reply to one message of connection ``source``: applied unless over the rate limit."""
+        now = time.monotonic()
+        if not (self.limiter.allow(id(source), now) and self.limiter_all.allow(None, now)):
+            self.counts["rate_limited"] += 1
+            return {"type": "reply", "ok": False,
+                    "error": f"rate limited: at most {self.action_rate:g} actions per second; not applied"}
+        return handle_action(self.ap, msg, self.ap.clock())
 
     @property
     def address(self):
