@@ -65,7 +65,7 @@ MODE_SAFE = 0x02            #: the order is the autopilot's safe action (watchdo
 
 REJECT_REASONS = ("malformed", "bad_version", "wrong_type", "unauthenticated", "bad_mac",
                   "duplicate", "reordered", "stale", "future", "replayed", "rate_limited",
-                  "out_of_range")
+                  "out_of_range", "locked")
 """Why a datagram was rejected (the counters of :class:`~steerlab.runtime.link_filter.LinkFilter`)."""
 
 

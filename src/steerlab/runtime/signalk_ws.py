@@ -165,8 +165,9 @@ class SignalKStreamServer:
     msg_rate : float
         Messages accepted per second per connection (bursts of twice that; the excess is dropped).
     put_rate : float
-        PUT requests applied per second per connection (bursts of twice that) and, across all
-        connections, twice that (bursts of four times); the excess is answered 429, not applied.
+        PUT requests applied per second per connection (bursts of twice that); the excess is
+        answered 429 and not applied. No limit is shared between connections, so a flooding
+        client cannot lock the operator out (``max_clients`` bounds the total).
     allow_origins : sequence of str
         Browser origins allowed besides loopback pages (:class:`~steerlab.runtime.access.AccessPolicy`).
     """
@@ -183,7 +184,6 @@ class SignalKStreamServer:
         self.limiter = RateLimiter(msg_rate, 2 * msg_rate, max_sources=4 * max_clients)
         self.put_rate = put_rate
         self.put_limiter = RateLimiter(put_rate, 2 * put_rate, max_sources=4 * max_clients)
-        self.put_limiter_all = RateLimiter(2 * put_rate, 4 * put_rate, max_sources=1)
         self.access = AccessPolicy(host, allow_origins)
         self.cache: dict = {}
         self.cache_time: dict = {}       # path -> wall time of its last value [s]
@@ -265,8 +265,7 @@ class SignalKStreamServer:
             code, text = 400, "expected put: {path, value}"
         elif self.on_put is None:
             code, text = 405, "this endpoint is read-only"
-        elif not (self.put_limiter.allow(id(source), time.monotonic())
-                  and self.put_limiter_all.allow(None, time.monotonic())):
+        elif not self.put_limiter.allow(id(source), time.monotonic()):
             self.counts["put_rate_limited"] += 1
             code, text = 429, f"rate limited: at most {self.put_rate:g} PUTs per second; not applied"
         else:

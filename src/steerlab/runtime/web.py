@@ -12,7 +12,7 @@ and answers each with ``{"type": "reply", "ok": true|false, "error": ...}``. Req
 ``Host`` does not name this server (DNS rebinding) and WebSockets from another site's page are
 refused with 403 (:class:`steerlab.runtime.access.AccessPolicy`; ``--allow-origin`` adds
 origins); messages are at most 4 KiB and 16 levels deep; at most ``action_rate`` actions per
-second per connection (and twice that over all connections) are applied, the excess is answered
+second per connection are applied, the excess is answered
 ``ok: false`` ("rate limited") and not applied; unknown or malformed actions are answered
 ``ok: false`` and never crash the page.
 """
@@ -106,7 +106,8 @@ class BridgeServer:
     """Serves the bridge page of ``autopilot`` on ``(host, port)``.
 
     ``allow_origins``: browser origins allowed besides loopback pages; ``action_rate``: actions
-    applied per second per connection (bursts of twice that; over all connections twice the rate).
+    applied per second per connection (bursts of twice that; no shared limit, so a flooding page
+    cannot lock the operator out; ``max_clients`` pages at most).
     """
 
     def __init__(self, autopilot, host: str = "127.0.0.1", port: int = 8080, period: float = 0.2,
@@ -120,7 +121,6 @@ class BridgeServer:
         self.access = AccessPolicy(host, allow_origins)
         self.action_rate = action_rate
         self.limiter = RateLimiter(action_rate, 2 * action_rate, max_sources=4 * max_clients)
-        self.limiter_all = RateLimiter(2 * action_rate, 4 * action_rate, max_sources=1)
         self.counts = {"refused_http": 0, "rate_limited": 0}
 
     def _process_request(self, connection, request):
@@ -162,7 +162,7 @@ class BridgeServer:
     def action(self, source, msg) -> dict:
         """The reply to one message of connection ``source``: applied unless over the rate limit."""
         now = time.monotonic()
-        if not (self.limiter.allow(id(source), now) and self.limiter_all.allow(None, now)):
+        if not self.limiter.allow(id(source), now):
             self.counts["rate_limited"] += 1
             return {"type": "reply", "ok": False,
                     "error": f"rate limited: at most {self.action_rate:g} actions per second; not applied"}
