@@ -18,6 +18,9 @@ SCENARIO_TOML = runtime_scenario_toml("cli-runtime", 60.0, waves=False)
     (["serve-ship", "--key-env", "STEERLAB_TEST_UNSET_VAR"], "--key-env"),
     (["serve-ship", "--origin", "95,0"], "--origin"),
     (["serve-ship", "no-such-file.toml"], "scenario"),
+    (["serve-ship", "--allow-origin", "ftp://plotter"], "--allow-origin"),
+    (["serve-ship", "--session-lock", "-1"], "--session-lock"),
+    (["autopilot", "--connect", "127.0.0.1:47110", "--allow-origin", "plotter.local"], "--allow-origin"),
     (["autopilot", "--connect", "127.0.0.1:0"], "--connect"),
     (["autopilot", "--connect", "127.0.0.1:70000"], "--connect"),
     (["autopilot", "--connect", "127.0.0.1:47110", "--controller", "nope"], "controller.type"),
@@ -91,6 +94,8 @@ def test_serve_ship_and_autopilot_commands_run_together(tmp_path, capsys):
     err = capsys.readouterr().err
     m = re.search(r"autopilot: (\d+) samples, mode auto, (\d+) skipped after stalls", err)
     assert f"on 127.0.0.1:{port}" in err and m and int(m[1]) + int(m[2]) == 161
+    for prog in ("serve-ship", "autopilot"):                 # no key: a loud warning from both ends
+        assert f"{prog}: WARNING: HMAC off - no --key-file/--key-env" in err
     with open(log, newline="") as f:
         rows = list(csv.DictReader(f))
     assert len(rows) == int(m[1])

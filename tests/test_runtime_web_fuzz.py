@@ -154,8 +154,10 @@ def test_hostile_websocket_clients_do_not_stop_the_autopilot(controller):  # noq
             await asyncio.gather(_hostile(ap_url, random.Random(1), stop_at, stats[0]),
                                  _hostile(ap_url + "?subscribe=none", random.Random(2), stop_at, stats[1]),
                                  _hostile(ship_url, random.Random(3), stop_at, stats[2]),
-                                 _hostile(f"ws://{bh}:{bpn}/ws", random.Random(4), stop_at, stats[3], reply_each=True, max_size=4096),
-                                 _hostile(f"ws://{bh}:{bpn}/ws", random.Random(5), stop_at, stats[4], reply_each=True, max_size=4096))
+                                 _hostile(f"ws://{bh}:{bpn}/ws", random.Random(4), stop_at, stats[3],
+                                          reply_each=True, max_size=4096),
+                                 _hostile(f"ws://{bh}:{bpn}/ws", random.Random(5), stop_at, stats[4],
+                                          reply_each=True, max_size=4096))
             for ws in holders:
                 await ws.close()
             elapsed = time.monotonic() - t0
@@ -192,7 +194,8 @@ def test_hostile_websocket_clients_do_not_stop_the_autopilot(controller):  # noq
                 assert await _raw_http(bh, bpn, path, {"Host": f"evil.example:{bpn}"}) == 403
                 assert await _raw_http(bh, bpn, path, {"Host": f"127.0.0.1:{bpn}"}) == 200
             assert await _raw_http(bh, bpn, "/ws", {**_WS, **evil}) == 403
-            assert await _raw_http(bh, bpn, "/ws", {**_WS, "Host": f"127.0.0.1:{bpn}", "Origin": "http://evil.example"}) == 403
+            assert await _raw_http(bh, bpn, "/ws", {**_WS, "Host": f"127.0.0.1:{bpn}",
+                                                     "Origin": "http://evil.example"}) == 403
             assert await _raw_http(bh, bpn, "/ws", {**_WS, "Host": f"127.0.0.1:{bpn}",
                                                      "Origin": f"http://127.0.0.1:{bpn}"}) == 101
             for h, p in ((ah, apn), (sh, spn)):

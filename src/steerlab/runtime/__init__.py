@@ -4,7 +4,7 @@
 module                 concept
 =====================  ==========================================================
 ``protocol``           wire format v1 (datagrams with session, sequence, stamp, HMAC)
-``link_filter``        what may be used: duplicates, reordering, stale, replay, auth
+``link_filter``        what may be used: duplicates, reordering, stale, replay, auth, session lock
 ``rate_limit``         token bucket per source
 ``keys``               shared HMAC key from a file or an environment variable
 ``udp``                asyncio UDP endpoints, ``HOST:PORT`` parsing
@@ -17,6 +17,7 @@ module                 concept
 ``signalk``            Signal K delta messages (paths, SI units) and PUT on the autopilot
 ``signalk_ws``         Signal K over WebSocket (discovery, stream, subscriptions, PUT)
 ``web``                the bridge page (HTTP + WebSocket)
+``access``             who may use the web endpoints: Host / Origin allowlist, bounded JSON
 ``lossy_proxy``        loss, duplication, reordering and cuts, for tests
 =====================  ==========================================================
 

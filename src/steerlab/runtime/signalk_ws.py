@@ -17,19 +17,24 @@ The part of the Signal K specification (1.7, "Streaming API", "Subscription Prot
     ``none`` nothing until the client subscribes; another value is answered HTTP 501 as the
     specification asks.
 
-Messages from the client (JSON, at most 64 KiB, at most ``msg_rate`` per second per connection):
+Messages from the client (JSON, at most 64 KiB and 16 levels deep, at most ``msg_rate`` per
+second per connection):
 
 * ``{"context": "vessels.self" | SELF_ID | "vessels.*" | "*", "subscribe": [{"path": "navigation.*"}, ...]}``
   (a context pattern that matches the self vessel; another vessel's is refused) adds path
-  patterns (``*`` matches any characters); ``period``/``policy`` are accepted and ignored (every
-  update is sent as it is made: the "instant" policy).
+  patterns (``*`` matches any characters, matched in linear time by :class:`PathPattern`; at most
+  :data:`MAX_PATTERNS` per client of at most :data:`MAX_PATH` characters); ``period``/``policy``
+  are accepted and ignored (every update is sent as it is made: the "instant" policy).
 * ``{"context": ..., "unsubscribe": [{"path": "*"}]}`` removes patterns (``*``: all).
 * ``{"requestId": ..., "put": {"path": ..., "value": ...}}`` calls ``on_put(path, value)`` and is
-  answered ``{"requestId", "state": "COMPLETED", "statusCode": 200 | 400 | 405, "message"}``;
-  an endpoint without ``on_put`` (the ship server's: read-only) answers 405.
+  answered ``{"requestId", "state": "COMPLETED", "statusCode": 200 | 400 | 405 | 429, "message"}``;
+  an endpoint without ``on_put`` (the ship server's: read-only) answers 405; more than
+  ``put_rate`` PUTs per second on one connection are answered 429 and not applied.
 
 Anything else is counted as ``rejected`` and otherwise ignored; nothing a client sends closes
-the stream or raises. A WebSocket from a browser page of another origin is refused (403), more
+the stream or raises. A request whose ``Host`` does not name this server (DNS rebinding) or a
+WebSocket from a browser page of another origin is refused (403,
+:class:`steerlab.runtime.access.AccessPolicy`), more
 than ``max_clients`` connections are refused (503), and a client that does not read (its write
 buffer above ``max_buffer`` bytes) misses updates rather than growing the sender's memory.
 """
