@@ -12,6 +12,7 @@ and a second (unkeyed) sender cannot take the rudder from the running autopilot.
 from __future__ import annotations
 
 import asyncio
+import gc
 import json
 import math
 import random
@@ -68,16 +69,43 @@ def _fuzz_message(rng: random.Random):
     return "x" * rng.randrange(3000, 4000)
 
 
-def _cpu_timed(obj, name, worst: list):
-    """Wrap ``obj.name`` to record the largest thread CPU time one call took."""
+class _GcClock:
+    """Thread CPU time spent in the garbage collector so far [s].
+
+    A full collection of this test process (numba, websockets, pytest: ~170 000 objects) takes
+    ~0.1 s whatever the message; the commands freeze their start-up heap (``gc.freeze``) so it
+    does not happen there. Per-message times below are measured without it.
+    """
+
+    def __init__(self):
+        self.total, self._t = 0.0, None
+        gc.callbacks.append(self._cb)
+
+    def _cb(self, phase, info):
+        if phase == "start":
+            self._t = time.thread_time()
+        elif self._t is not None:
+            self.total += time.thread_time() - self._t
+            self._t = None
+
+    def now(self) -> float:
+        """Thread CPU time outside the collector [s]."""
+        return time.thread_time() - self.total
+
+    def close(self):
+        gc.callbacks.remove(self._cb)
+
+
+def _cpu_timed(obj, name, worst: list, clock: _GcClock):
+    """Wrap ``obj.name`` to record the largest thread CPU time (outside the GC) one call took."""
     orig = getattr(obj, name)
 
     def timed(*a, **k):
-        t = time.thread_time()
+        t = clock.now()
         try:
             return orig(*a, **k)
         finally:
-            worst[0] = max(worst[0], time.thread_time() - t)
+            worst[0] = max(worst[0], clock.now() - t)
 
     setattr(obj, name, timed)
 
@@ -127,9 +155,10 @@ def test_hostile_websocket_clients_do_not_stop_the_autopilot(controller):  # noq
         walls, cpu_sk, cpu_ship, cpu_bridge = [], [0.0], [0.0], [0.0]
         orig_sample = ap.sample
         ap.sample = lambda t, now=None: (walls.append(time.monotonic()), orig_sample(t, now))[1]
-        _cpu_timed(ap.signalk_stream, "handle_message", cpu_sk)
-        _cpu_timed(server.signalk_stream, "handle_message", cpu_ship)
-        _cpu_timed(bridge, "action", cpu_bridge)
+        clock = _GcClock()
+        _cpu_timed(ap.signalk_stream, "handle_message", cpu_sk, clock)
+        _cpu_timed(server.signalk_stream, "handle_message", cpu_ship, clock)
+        _cpu_timed(bridge, "action", cpu_bridge, clock)
         try:
             ah, apn = ap.signalk_stream.address
             sh, spn = server.signalk_stream.address
@@ -207,6 +236,7 @@ def test_hostile_websocket_clients_do_not_stop_the_autopilot(controller):  # noq
                 assert await _raw_http(h, p, "/signalk", {"Host": f"127.0.0.1:{p}"}) == 200
             out["ok"] = True
         finally:
+            clock.close()
             await bridge.close()
 
     asyncio.run(_with_streams(controller, client))
@@ -252,3 +282,45 @@ def test_second_unkeyed_sender_cannot_take_the_rudder(controller, tmp_path):  # 
     assert max(r["psi_deg"] for r in rows if r["link_ok"]) < 25.0          # the e2e course change's bound
     assert max(abs(r["psi_deg"] - 20.0) for r in rows if r["t"] > 16.0) < 1.5
     assert ap.alarms.first_raised(LINK) is None
+
+
+# ------------------------------------------------------------------ without sockets, many messages
+def test_ten_thousand_fuzzed_messages_each_handled_fast_and_never_raise():
+    """10 000 seeded hostile messages to a Signal K endpoint and to the bridge's action handler:
+    none raises, every PUT and every action gets a well-formed reply, none takes 50 ms of CPU."""
+    from steerlab.runtime.signalk_ws import SignalKStreamServer, Subscriptions
+
+    class Ap:
+        psi_set = 0.0
+
+        def clock(self):
+            return 0.0
+
+        def __getattr__(self, name):
+            return lambda *a, **k: None
+
+    rng = random.Random(15)
+    puts = []
+    srv = SignalKStreamServer(on_put=lambda p, v: (puts.append(p), (200, ""))[1], msg_rate=0.0)
+    bridge = BridgeServer(Ap(), "127.0.0.1", 0, action_rate=0.0)
+    subs = Subscriptions("none")
+    worst = 0.0
+    n = 10_000
+    clock = _GcClock()
+    try:
+        for i in range(n):
+            msg = _fuzz_message(rng)
+            t = clock.now()
+            reply = srv.handle_message(i % 7, subs, msg)
+            action = bridge.action(i % 7, msg)
+            srv.publish({"navigation.headingTrue": 1.0, "steering.autopilot.state": "auto"})
+            worst = max(worst, clock.now() - t)
+            assert reply is None or (reply["state"] == "COMPLETED" and reply["statusCode"] in (200, 400, 405, 429))
+            assert action["type"] == "reply" and isinstance(action["ok"], bool) and (action["ok"] or action["error"])
+    finally:
+        clock.close()
+    c = srv.counts
+    assert worst < MAX_CPU_PER_MESSAGE, worst
+    assert c["rejected"] + c["subscriptions"] + c["put_ok"] + c["put_refused"] == n
+    assert min(c["rejected"], c["subscriptions"], c["put_ok"], c["put_refused"]) > 50
+    assert len(subs.patterns) <= 64

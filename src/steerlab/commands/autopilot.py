@@ -126,7 +126,10 @@ async def run_with_web(ap, web, duration, started=None):
 def run(args) -> int:
     import asyncio
 
+    from steerlab.commands.serve_ship import freeze_startup_heap
+
     ap, web = build_autopilot(args)
+    freeze_startup_heap()
 
     def started(a, bridge):
         if not args.quiet:

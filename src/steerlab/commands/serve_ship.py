@@ -41,6 +41,19 @@ def no_key_warning(prog: str, what: str) -> str:
             "Give both ends the same key (>= 16 bytes): --key-file FILE or --key-env NAME (docs/runtime.md).")
 
 
+def freeze_startup_heap() -> None:
+    """Move everything alive after start-up (modules, numba, compiled kernels) out of the GC's reach.
+
+    A full collection of a runtime process walks ~170 000 such objects and blocks the event
+    loop for ~0.1 s (measured); after ``gc.freeze()`` it walks only what the loop allocates
+    since. Frozen objects are still freed by reference counting.
+    """
+    import gc
+
+    gc.collect()
+    gc.freeze()
+
+
 def register(sub, formatter_class) -> None:
     p = sub.add_parser("serve-ship", help="run a ship model in real time over UDP (state out, rudder orders in)",
                        description="Run the ship (+ steering gear, disturbances) of a scenario in real time "
@@ -113,6 +126,8 @@ def run(args) -> int:
                         nmea_to=parse_hostport(args.nmea_to, "--nmea-to") if args.nmea_to else None,
                         signalk_to=parse_hostport(args.signalk_to, "--signalk-to") if args.signalk_to else None,
                         origin=_origin(args.origin), signalk_ws=signalk_ws, allow_origins=origins)
+
+    freeze_startup_heap()
 
     def started(s):
         if not args.quiet:
