@@ -114,7 +114,7 @@ async def _hostile(url, rng, stop_at, stats, reply_each=False, max_size=65536):
     """Send fuzz messages of at most ``max_size`` bytes until ``stop_at`` (reconnecting if closed)."""
     while time.monotonic() < stop_at:
         try:
-            async with connect(url, max_size=2**20, open_timeout=5) as ws:
+            async with connect(url, max_size=2**20, open_timeout=5, close_timeout=1) as ws:
                 if reply_each:
                     await ws.recv()
                 while time.monotonic() < stop_at:
@@ -132,6 +132,20 @@ async def _hostile(url, rng, stop_at, stats, reply_each=False, max_size=65536):
                         await asyncio.sleep(0)
         except ConnectionClosed:
             stats["closed"] += 1
+
+
+async def _flood_actions(url, n, stats):
+    """The report's flood: ``n`` course changes as fast as the bridge answers; count those applied."""
+    t = time.monotonic()
+    async with connect(url, close_timeout=1) as ws:
+        for _ in range(n):
+            await ws.send('{"action": "adjust", "deg": 1}')
+        while stats["replies"] < n:
+            m = json.loads(await ws.recv())
+            if m["type"] == "reply":
+                stats["replies"] += 1
+                stats["ok"] += bool(m["ok"])
+    stats["seconds"] = time.monotonic() - t
 
 
 async def _raw_http(host, port, path, headers):
@@ -179,14 +193,15 @@ def test_hostile_websocket_clients_do_not_stop_the_autopilot(controller):  # noq
                 assert max(len(sub.patterns) for sub in stream.clients.values()) == 64
             samples0, skipped0, published0, t0 = ap.samples, ap.skipped, server.stats.published, time.monotonic()
             stop_at = t0 + FUZZ_SECONDS
-            stats = [{"sent": 0, "replies": 0, "ok": 0, "closed": 0} for _ in range(5)]
+            stats = [{"sent": 0, "replies": 0, "ok": 0, "closed": 0} for _ in range(6)]
             await asyncio.gather(_hostile(ap_url, random.Random(1), stop_at, stats[0]),
                                  _hostile(ap_url + "?subscribe=none", random.Random(2), stop_at, stats[1]),
                                  _hostile(ship_url, random.Random(3), stop_at, stats[2]),
                                  _hostile(f"ws://{bh}:{bpn}/ws", random.Random(4), stop_at, stats[3],
                                           reply_each=True, max_size=4096),
                                  _hostile(f"ws://{bh}:{bpn}/ws", random.Random(5), stop_at, stats[4],
-                                          reply_each=True, max_size=4096))
+                                          reply_each=True, max_size=4096),
+                                 _flood_actions(f"ws://{bh}:{bpn}/ws", 1000, stats[5]))
             for ws in holders:
                 await ws.close()
             elapsed = time.monotonic() - t0
@@ -250,8 +265,9 @@ def test_hostile_websocket_clients_do_not_stop_the_autopilot(controller):  # noq
     assert sum(x["sent"] for x in s) > 1000                              # the fuzz did happen
     assert s[3]["replies"] + s[4]["replies"] >= s[3]["sent"] + s[4]["sent"] - 2 and s[3]["closed"] + s[4]["closed"] == 0
     assert bridge["rate_limited"] > 0 and sk["put_rate_limited"] + sk["rate_limited"] > 0 and sk["rejected"] > 0
-    # 2 connections, each at most a burst of 10 actions + 5/s applied (the rest answered "rate limited")
-    assert 0 < s[3]["ok"] + s[4]["ok"] <= 2 * (10 + 5 * out["elapsed"]) + 2
+    # 1 000 course changes in a burst: 10 (the bucket) + 5/s applied, the rest answered "rate limited"
+    assert s[5]["replies"] == 1000 and 10 <= s[5]["ok"] <= 10 + 5 * s[5]["seconds"] + 1, s[5]
+    assert s[3]["ok"] + s[4]["ok"] <= 2 * (10 + 5 * out["elapsed"]) + 2
 
 
 def test_second_unkeyed_sender_cannot_take_the_rudder(controller, tmp_path):  # noqa: F811
