@@ -208,3 +208,32 @@ def test_session_lock_refuses_a_second_sender_until_the_holder_is_silent(key):
     assert flt.accept(ap.pack(P.Command(0.1), t + 0.01), t + 0.01, A)[1] == "locked"   # now evil holds it
     if key is None:                          # unsigned: the holder is also its address
         assert flt.accept(evil.pack(P.Command(0.6), t + 0.02), t + 0.02, A)[1] == "locked"
+
+
+# ------------------------------------------------------------------ property: any JSON message
+_json = st.recursive(st.none() | st.booleans() | st.floats(allow_nan=False) | st.integers() | st.text(max_size=20),
+                     lambda kids: st.lists(kids, max_size=4) | st.dictionaries(
+                         st.sampled_from(["put", "path", "value", "subscribe", "unsubscribe", "context", "requestId",
+                                          "action", "deg", "alarm", "x"]), kids, max_size=4), max_leaves=30)
+_json = _json | st.fixed_dictionaries({"action": st.sampled_from(["engage", "standby", "adjust", "ack", "x"]),
+                                       "deg": _json, "alarm": _json})
+_HYP_SK = SignalKStreamServer(on_put=lambda p, v: (200, ""), msg_rate=0.0)
+class _AnyAp(_Ap):
+    def __getattr__(self, name):                 # engage, standby, acknowledge: accepted, no effect
+        return lambda *a, **k: None
+
+
+_HYP_BRIDGE = BridgeServer(_AnyAp(), "127.0.0.1", 0, action_rate=0.0)
+
+
+@settings(max_examples=400, deadline=None, database=None, derandomize=True,
+          suppress_health_check=list(HealthCheck))
+@given(_json)
+def test_hypothesis_json_messages_never_raise(value):
+    text = json.dumps(value)
+    subs = Subscriptions("none")
+    reply = _HYP_SK.handle_message("h", subs, text)
+    assert reply is None or reply["statusCode"] in (200, 400, 405, 429)
+    assert len(subs.patterns) <= MAX_PATTERNS
+    action = _HYP_BRIDGE.action("h", text)
+    assert action["type"] == "reply" and (action["ok"] or isinstance(action["error"], str))
