@@ -19,7 +19,9 @@ from steerlab.errors import InputError
 from steerlab.runtime import protocol as P
 from steerlab.runtime.access import MAX_JSON_DEPTH, AccessPolicy, normalise_origin, parse_json
 from steerlab.runtime.link_filter import LinkFilter
-from steerlab.runtime.signalk_ws import MAX_PATTERNS, PathPattern, SignalKStreamServer, Subscriptions
+from steerlab.runtime.path_glob import PathPattern
+from steerlab.runtime.signalk import SELF_ID, is_self_context
+from steerlab.runtime.signalk_ws import MAX_PATTERNS, SignalKStreamServer, Subscriptions
 from steerlab.runtime.web import BridgeServer, handle_action
 
 T0 = 1_700_000_000.0
@@ -52,6 +54,16 @@ def test_worst_case_patterns_match_in_well_under_a_millisecond():
         per_match = (time.thread_time() - t) / (100 * (len(PATHS) + 2))
         assert per_match < 1e-4, (pat, per_match)              # < 0.1 ms each (measured ~0.3 us)
     assert PathPattern("*" * 10 + "x").match("steering.x") and not PathPattern("*" * 10 + "x").match("steering")
+
+
+def test_hostile_context_patterns_in_bounded_time():
+    """The subscription *context* is a pattern too (``vessels.*``): same matcher, same bound."""
+    for ctx in ("*" * 10 + "#", "*" * 200 + "#", "*v" * 120 + "#", ("*" + "vessels." * 3) * 8 + "#"):
+        t = time.thread_time()
+        assert not is_self_context(ctx)
+        assert time.thread_time() - t < 1e-3, ctx
+    assert all(is_self_context(c) for c in ("*", "vessels.*", "vessels.self", SELF_ID, "vessels.urn:*"))
+    assert not any(is_self_context(c) for c in ("vessels.other", "", "x" * 257, None, ["*"]))
 
 
 def test_subscriptions_are_bounded_and_atomic():

@@ -25,6 +25,7 @@ from websockets.exceptions import ConnectionClosed
 
 from steerlab.runtime import protocol as P
 from steerlab.runtime.alarms import LINK
+from steerlab.runtime.ship_server import ShipServerConfig
 from steerlab.runtime.signalk import AUTOPILOT_STATE, TARGET_HEADING
 from steerlab.runtime.web import BridgeServer
 from test_runtime_e2e import SPEEDUP, _course_change, _read_log, _session, controller  # noqa: F401  (fixture)
@@ -62,8 +63,9 @@ def _fuzz_message(rng: random.Random):
     if k == 8:
         return rng.choice(("", "null", "[]", "3", '"s"', "{", "}", '{"put": 5}', '{"subscribe": "*"}',
                            "NaN", "Infinity", '{"a": NaN}', "\x00", "{" * 3000))
-    if k == 9:
-        return json.dumps({"context": rng.choice((["x"], {"y": 1}, 7)), "subscribe": []})
+    if k == 9:       # the context is a pattern too
+        ctx = "".join(rng.choice(("*", "*", "v", "e", ".", "s")) for _ in range(rng.randrange(1, 256)))
+        return json.dumps({"context": rng.choice((["x"], {"y": 1}, 7, ctx, ctx + "#")), "subscribe": [{"path": "*"}]})
     if k == 10:
         return json.dumps({"x" * rng.randrange(1, 100): [rng.random() for _ in range(rng.randrange(0, 300))]})
     return "x" * rng.randrange(3000, 4000)
@@ -181,12 +183,14 @@ def test_hostile_websocket_clients_do_not_stop_the_autopilot(controller):  # noq
             await asyncio.sleep(0.3)
             # the 70-byte message of the report + 63 worst patterns, held open through the fuzz
             report_msg = '{"context":"vessels.self","subscribe":[{"path":"**********x"}]}'
+            context_msg = '{"context":"' + "*" * 40 + '#","subscribe":[{"path":"*"}]}'    # refused, fast
             holders = []
             for url in (ap_url, ship_url):
                 ws = await connect(url + "?subscribe=none")
                 holders.append(ws)
                 await ws.recv()
                 await ws.send(report_msg)
+                await ws.send(context_msg)
                 await ws.send(json.dumps({"subscribe": [{"path": "*e" * 120 + str(i)} for i in range(63)]}))
             await asyncio.sleep(0.2)
             for stream in (ap.signalk_stream, server.signalk_stream):
@@ -287,7 +291,11 @@ def test_second_unkeyed_sender_cannot_take_the_rudder(controller, tmp_path):  # 
             await asyncio.sleep(0.01)
 
     try:
-        ctx = asyncio.run(_session(controller, tmp_path / "ap.csv", 20.0, [(1.0, _course_change), (3.0, attack)]))
+        # the lock is in ship seconds: 5 s = 0.5 s wall at speedup 10, so a scheduling stall of this
+        # loaded test process (the autopilot silent for 0.1 s wall) does not hand the rudder over
+        cfg = ShipServerConfig(speedup=SPEEDUP, centre_after=2.0, session_lock=5.0)
+        ctx = asyncio.run(_session(controller, tmp_path / "ap.csv", 20.0, [(1.0, _course_change), (3.0, attack)],
+                                   server_cfg=cfg))
     finally:
         evil.close()
     server, ap = ctx["server"], ctx["ap"]

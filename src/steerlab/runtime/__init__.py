@@ -15,6 +15,7 @@ module                 concept
 ``route``              route following with the library's LOS guidance kernel
 ``nmea``               NMEA 0183 out (HDT, THS, ROT, RSA, RMC, VTG, HTD) and in (APB, RMB, HTC)
 ``signalk``            Signal K delta messages (paths, SI units) and PUT on the autopilot
+``path_glob``          Signal K path / context patterns matched in linear time (no regex)
 ``signalk_ws``         Signal K over WebSocket (discovery, stream, subscriptions, PUT)
 ``web``                the bridge page (HTTP + WebSocket)
 ``access``             who may use the web endpoints: Host / Origin allowlist, bounded JSON

@@ -21,11 +21,11 @@ from __future__ import annotations
 
 import json
 import math
-import re
 import time
 import uuid
 
 from steerlab.angles import wrap_to_2pi
+from steerlab.runtime.path_glob import PathPattern
 
 SOURCE = {"label": "steerlab", "type": "steerlab-runtime"}
 MAX_DELTA_BYTES = 65536
@@ -43,8 +43,8 @@ def is_self_context(ctx) -> bool:
     or a pattern matching one of them (``*`` = any characters: ``*``, ``vessels.*``)."""
     if not isinstance(ctx, str) or not 0 < len(ctx) <= 256:
         return False
-    pat = re.compile("".join(".*" if c == "*" else re.escape(c) for c in ctx))
-    return any(pat.fullmatch(a) for a in SELF_ALIASES)
+    pat = PathPattern(ctx)                   # linear time: no user-built regex
+    return any(pat.match(a) for a in SELF_ALIASES)
 
 
 def iso_time(wall: float) -> str:

@@ -51,6 +51,7 @@ from websockets.asyncio.server import broadcast, serve
 from steerlab.errors import InputError
 from steerlab.runtime.access import AccessPolicy, parse_json
 from steerlab.runtime.http_conn import HttpConnection
+from steerlab.runtime.path_glob import PathPattern
 from steerlab.runtime.rate_limit import RateLimiter
 from steerlab.runtime.signalk import MAX_DELTA_BYTES, SELF_ID, delta, is_self_context, iso_time
 from steerlab.runtime.signalk_rest import API_PATH, api_get
@@ -66,43 +67,6 @@ MAX_PATH = 256
 """Longest subscription path pattern [characters]."""
 MAX_PATTERNS = 64
 """Most path patterns one client may hold (a subscribe beyond is refused as a whole)."""
-
-
-class PathPattern:
-    """A Signal K path pattern: ``*`` matches any run of characters (dots included), the rest literally.
-
-    No regular expression: the pattern is split at its ``*`` into literal chunks; a path matches
-    when it starts with the first chunk, ends with the last, and the middle chunks occur in order
-    in between. Taking each middle chunk at its leftmost occurrence (``str.find``) is exact for
-    ``*``-only globs (a later occurrence never leaves more room for the rest), so a match costs one
-    left-to-right scan, O(len(path) + len(pattern)), whatever the number of ``*``; the regex
-    ``.*a.*a...`` used before backtracked exponentially (10 ``*`` froze the event loop for > 20 s).
-    """
-
-    __slots__ = ("text", "head", "mids", "tail", "star")
-
-    def __init__(self, text: str):
-        parts = text.split("*")
-        self.text = text
-        self.star = len(parts) > 1
-        self.head = parts[0]
-        self.tail = parts[-1] if self.star else ""
-        self.mids = tuple(p for p in parts[1:-1] if p)
-
-    def match(self, path: str) -> bool:
-        if not self.star:
-            return path == self.head
-        head, tail = self.head, self.tail
-        end = len(path) - len(tail)
-        if end < len(head) or not path.startswith(head) or not path.endswith(tail):
-            return False
-        i = len(head)
-        for m in self.mids:
-            j = path.find(m, i, end)
-            if j < 0:
-                return False
-            i = j + len(m)
-        return True
 
 
 def path_pattern(pattern: str) -> PathPattern:
