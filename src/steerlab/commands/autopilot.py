@@ -99,6 +99,11 @@ def build_autopilot(args):
     if signalk_ws is not None and not is_loopback(signalk_ws[0]):
         print(f"autopilot: warning: the Signal K stream on {signalk_ws[0]} accepts course/state PUTs from the "
               "network without authentication", file=sys.stderr)
+    for value, opt, what in ((args.nmea_listen, "--nmea-listen", "heading and course sentences"),
+                             (args.signalk_listen, "--signalk-listen", "course and engage/standby deltas")):
+        if value and not is_loopback(hp(value, opt)[0]):
+            print(f"autopilot: warning: {opt} on {hp(value, opt)[0]} takes {what} from the network "
+                  "without authentication", file=sys.stderr)
     ap = Autopilot(ctrl, connect, cfg, heading=None if args.heading is None else rad(args.heading),
                    route=route, key=key, log_path=args.log, engaged=not args.standby,
                    nmea_listen=hp(args.nmea_listen, "--nmea-listen"), nmea_to=hp(args.nmea_to, "--nmea-to"),

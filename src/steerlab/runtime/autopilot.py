@@ -50,7 +50,7 @@ from steerlab.guidance.reference_vector import REF_LEG, REF_PSI, REF_XTE, initia
 from steerlab.runtime import protocol as P
 from steerlab.runtime.alarms import ARRIVAL, LINK, OFF_COURSE, AlarmBoard
 from steerlab.runtime.link_filter import LinkFilter
-from steerlab.runtime.udp import LOOPBACK, open_udp, send
+from steerlab.runtime.udp import local_bind_for, open_udp, send
 from steerlab.units import deg, rad
 
 SAFE_ACTIONS = ("midships", "hold")
@@ -170,7 +170,7 @@ class Autopilot:
         self.signalk_ws = signalk_ws
         self.signalk_stream = None
         self.allow_origins = tuple(allow_origins)
-        self.bind = bind or (LOOPBACK if connect[0] in (LOOPBACK, "localhost") else "0.0.0.0", 0)
+        self.bind = bind or local_bind_for(connect[0])   # loopback peer: loopback socket, same family
         self.transport = None
         self._t0 = None
         self._stop = None

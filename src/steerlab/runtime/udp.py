@@ -38,6 +38,19 @@ def is_loopback(host: str) -> bool:
         return False
 
 
+def local_bind_for(remote_host: str) -> tuple[str, int]:
+    """The local address to send to ``remote_host`` from: loopback for a loopback peer (of the
+    same family: ``127.0.0.1`` for 127.0.0.0/8 and ``localhost``, ``::1`` for ``::1``), else the
+    wildcard of the peer's family (``0.0.0.0`` or ``::``); port 0 (any free one)."""
+    try:
+        ip = ipaddress.ip_address(remote_host)
+    except ValueError:
+        return (LOOPBACK if remote_host == "localhost" else "0.0.0.0"), 0
+    if ip.version == 6:
+        return ("::1" if ip.is_loopback else "::"), 0
+    return (LOOPBACK if ip.is_loopback else "0.0.0.0"), 0
+
+
 class _Protocol(asyncio.DatagramProtocol):
     def __init__(self, on_datagram):
         self.on_datagram = on_datagram
