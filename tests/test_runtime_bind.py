@@ -8,7 +8,10 @@ ship could not be reached at all (an IPv4 socket cannot send to ``::1``).
 from __future__ import annotations
 
 import asyncio
+import csv
+import re
 import socket
+import time
 
 import pytest
 
@@ -37,7 +40,8 @@ def _ipv6_loopback() -> bool:
 
 
 @pytest.mark.parametrize("ship_host, connect_host", [("::1", "::1"), ("127.0.0.2", "127.0.0.2")])
-def test_autopilot_steers_a_ship_on_another_loopback_address(controller, ship_host, connect_host):  # noqa: F811
+def test_autopilot_steers_a_ship_on_another_loopback_address(controller, ship_host, connect_host,  # noqa: F811
+                                                             tmp_path):
     if ":" in ship_host and not _ipv6_loopback():
         pytest.skip("no IPv6 loopback here")
 
@@ -49,7 +53,8 @@ def test_autopilot_steers_a_ship_on_another_loopback_address(controller, ship_ho
             if srv.done():
                 srv.result()
         ap = Autopilot(controller, (connect_host, server.address[1]),
-                       AutopilotConfig(speedup=SPEEDUP, watchdog_timeout=3.0), heading=0.0)
+                       AutopilotConfig(speedup=SPEEDUP, watchdog_timeout=3.0), heading=0.0,
+                       log_path=tmp_path / "ap.csv")
         try:
             await ap.run(3.0)
         finally:
@@ -61,3 +66,6 @@ def test_autopilot_steers_a_ship_on_another_loopback_address(controller, ship_ho
     local = ap.transport.get_extra_info("sockname")[0]
     assert local in ("::1", "127.0.0.1")                                   # never the wildcard
     assert ap.filter.counts["accepted"] > 20 and server.stats.commands > 10
+    with open(tmp_path / "ap.csv", newline="") as f:                    # the log's wall clock: to the ms
+        walls = [r["wall"] for r in csv.DictReader(f)]
+    assert all(re.fullmatch(r"\d{10}\.\d{3}", w) for w in walls) and abs(float(walls[-1]) - time.time()) < 60

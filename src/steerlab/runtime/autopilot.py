@@ -62,6 +62,12 @@ LOG_COLUMNS = ("t", "wall", "t_sim", "state_age", "link_ok", "mode", "psi_deg", 
 cross-track error [m], > 0 to starboard of the leg, and ``leg`` only with a route)."""
 
 
+def _csv_float(column: str, v: float) -> str:
+    """A log value: 6 significant digits, but the wall clock [s since 1970] to the millisecond
+    (``%.6g`` wrote ``1.79544e+09``, 10 s resolution)."""
+    return f"{v:.3f}" if column == "wall" else f"{v:.6g}"
+
+
 @dataclass(frozen=True)
 class AutopilotConfig:
     sample_time: float = 0.125          #: controller sample time [s]
@@ -455,7 +461,7 @@ class Autopilot:
 
     def _write_log(self, row: dict) -> None:
         if self._log is not None:
-            self._log.writerow({k: (f"{v:.6g}" if isinstance(v, float) else v) for k, v in row.items()})
+            self._log.writerow({k: (_csv_float(k, v) if isinstance(v, float) else v) for k, v in row.items()})
             if self.samples % 16 == 0:
                 self._log_file.flush()
 
