@@ -249,3 +249,32 @@ def test_hypothesis_json_messages_never_raise(value):
     assert len(subs.patterns) <= MAX_PATTERNS
     action = _HYP_BRIDGE.action("h", text)
     assert action["type"] == "reply" and (action["ok"] or isinstance(action["error"], str))
+
+
+# ------------------------------------------------------------------ rejections reported while running
+def test_rejections_are_reported_while_running():
+    import asyncio
+    import io
+
+    from steerlab.runtime.rejection_report import report_rejections
+
+    counts = {"accepted": 5, "locked": 0}
+    web = {"clients": 3, "refused_http": 0}
+    out = io.StringIO()
+
+    async def go():
+        task = asyncio.create_task(report_rejections("serve-ship", {"link": lambda: counts, "web": lambda: web},
+                                                     0.05, out))
+        await asyncio.sleep(0.07)                 # nothing rejected: nothing printed
+        counts.update(locked=12, rate_limited=3, accepted=50)
+        web["refused_http"] = 2
+        await asyncio.sleep(0.05)
+        counts["locked"] += 1
+        await asyncio.sleep(0.05)
+        task.cancel()
+
+    asyncio.run(go())
+    lines = out.getvalue().splitlines()
+    assert lines == ["serve-ship: link: rejected in the last 0.05 s: locked 12, rate_limited 3",
+                     "serve-ship: web: rejected in the last 0.05 s: refused_http 2",
+                     "serve-ship: link: rejected in the last 0.05 s: locked 1"]

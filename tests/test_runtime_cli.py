@@ -20,6 +20,7 @@ SCENARIO_TOML = runtime_scenario_toml("cli-runtime", 60.0, waves=False)
     (["serve-ship", "no-such-file.toml"], "scenario"),
     (["serve-ship", "--allow-origin", "ftp://plotter"], "--allow-origin"),
     (["serve-ship", "--session-lock", "-1"], "--session-lock"),
+    (["serve-ship", "--report-every", "nan"], "--report-every"),
     (["autopilot", "--connect", "127.0.0.1:47110", "--allow-origin", "plotter.local"], "--allow-origin"),
     (["autopilot", "--connect", "127.0.0.1:0"], "--connect"),
     (["autopilot", "--connect", "127.0.0.1:70000"], "--connect"),

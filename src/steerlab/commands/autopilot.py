@@ -62,7 +62,7 @@ def register(sub, formatter_class) -> None:
 
 def build_autopilot(args):
     """The :class:`~steerlab.runtime.autopilot.Autopilot` (and web bind) for parsed ``args``."""
-    from steerlab.commands.serve_ship import allowed_origins
+    from steerlab.commands.serve_ship import allowed_origins, check_report_every
     from steerlab.errors import InputError, require_finite_range
     from steerlab.runtime.autopilot import Autopilot, AutopilotConfig
     from steerlab.runtime.controller_runtime import ControllerRuntime
@@ -77,6 +77,7 @@ def build_autopilot(args):
         raise InputError("--connect", "port must be in [1, 65535]")
     key = load_key(args.key_file, args.key_env)
     origins = allowed_origins(args)
+    check_report_every(args)
     scenario = load_scenario(args.scenario) if args.scenario else default_scenario()
     ctrl = ControllerRuntime(scenario, args.controller, args.sample_time)
     if args.heading is not None:
@@ -149,6 +150,15 @@ def run(args) -> int:
 
                 print(no_key_warning("autopilot", "any process can forge ship states to this autopilot and, "
                                      "while it is silent, take the ship's rudder"), file=sys.stderr, flush=True)
+        from steerlab.commands.serve_ship import start_rejection_report
+
+        sources = {"link": lambda: a.filter.counts, "NMEA": lambda: a.nmea_counts,
+                   "Signal K UDP": lambda: a.signalk_counts}
+        if a.signalk_stream is not None:
+            sources["Signal K stream"] = lambda: a.signalk_stream.counts
+        if bridge is not None:
+            sources["bridge page"] = lambda: bridge.counts
+        start_rejection_report("autopilot", args, sources)
 
     try:
         asyncio.run(run_with_web(ap, web, args.duration, started))
