@@ -19,6 +19,7 @@ module                 concept
 ``signalk_ws``         Signal K over WebSocket (discovery, stream, subscriptions, PUT)
 ``web``                the bridge page (HTTP + WebSocket)
 ``access``             who may use the web endpoints: Host / Origin allowlist, bounded JSON
+``rejection_report``   rejected input reported while running, by source and reason
 ``lossy_proxy``        loss, duplication, reordering and cuts, for tests
 =====================  ==========================================================
 
