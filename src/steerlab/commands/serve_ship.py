@@ -7,6 +7,8 @@ import sys
 EXAMPLES = """examples:
   steerlab serve-ship                                  # bundled default scenario (Esso), 127.0.0.1:47110
   steerlab serve-ship my.toml --bind 127.0.0.1:47110 --speedup 5
+  python -c "import secrets; print(secrets.token_hex(32))" > link.key    # a key, once (chmod 600)
+  steerlab serve-ship my.toml --key-file link.key       # HMAC on (the autopilot gets the same --key-file)
   STEERLAB_LINK_KEY=$(cat key) steerlab serve-ship my.toml --key-env STEERLAB_LINK_KEY
   steerlab serve-ship my.toml --nmea-to 127.0.0.1:10110 --signalk-to 127.0.0.1:8375
   steerlab serve-ship my.toml --signalk-ws 127.0.0.1:3000       # Signal K WebSocket stream
