@@ -101,12 +101,13 @@ def test_signed_link_rejects_replays_and_counts_them():
     captured = [s.pack(P.Command(0.01 * i), T0 + 0.1 * i) for i in range(4)]
     for i, d in enumerate(captured):
         assert f.accept(d, T0 + 0.1 * i + 0.01)[1] == "ok"
-    for d in captured:                                      # replayed at once: seen
-        assert f.accept(d, T0 + 0.35)[1] == "replayed"
-    assert f.accept(captured[-1], T0 + 10.0)[1] == "stale"  # replayed later: too old
+    for d in captured:                                      # replayed at once by another host: seen
+        assert f.accept(d, T0 + 0.35, ("10.0.0.66", 4000))[1] == "replayed"
+    assert f.accept(captured[-1], T0 + 0.36)[1] == "duplicate"   # a copy from the sender's address:
+    assert f.accept(captured[-1], T0 + 10.0)[1] == "stale"  # the network duplicated it; later: too old
     forged = P.encode(P.Command(0.5), s.session, s.seq + 1, T0 + 0.4, b"not the key at all!")
     assert f.accept(forged, T0 + 0.4)[1] == "bad_mac"
-    assert f.counts["accepted"] == 4 and f.counts["replayed"] == 4
+    assert f.counts["accepted"] == 4 and f.counts["replayed"] == 4 and f.counts["duplicate"] == 1
 
 
 def test_rate_limit_per_source():

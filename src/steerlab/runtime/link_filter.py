@@ -10,7 +10,8 @@ datagram, in this order (the first failing rule names the rejection; nothing rai
 4. ``stale`` / ``future`` - the sender's stamp is more than ``max_age`` seconds before (after)
    the receiver's wall clock (``max_age <= 0`` turns this off, e.g. for unsynchronised clocks);
 5. sequencing within the current sender session:
-   ``duplicate`` (already accepted; on an authenticated link counted as ``replayed``),
+   ``duplicate`` (already accepted, a copy from the same source: the network duplicated it; on
+   an authenticated link a copy from another source is counted as ``replayed``),
    ``reordered`` (older than the newest accepted: it arrived late, a newer one is in use);
    a datagram of another session is accepted only if its stamp is newer than the last
    accepted one (the sender restarted), else ``replayed``.
@@ -64,6 +65,7 @@ class LinkFilter:
         self.limiter = RateLimiter(rate, burst)
         self.counts: Counter = Counter()
         self.session: int | None = None
+        self.session_source = None       # where the current session's accepted datagrams came from
         self.last_seq = -1
         self.last_stamp = 0.0
         self._seen: deque = deque(maxlen=SEEN_WINDOW)
@@ -100,7 +102,7 @@ class LinkFilter:
                 return msg, "ok"
         if h.session == self.session:
             if (h.session, h.seq) in self._seen_set:
-                return self._reject("replayed" if self.key else "duplicate")
+                return self._reject("replayed" if self.key and source != self.session_source else "duplicate")
             if h.seq < self.last_seq:
                 return self._reject("reordered")
         elif self.session is not None and h.stamp <= self.last_stamp:
@@ -109,6 +111,7 @@ class LinkFilter:
             self.session = h.session
             self._seen.clear()
             self._seen_set.clear()
+        self.session_source = source
         self.last_seq = h.seq
         self.last_stamp = max(self.last_stamp, h.stamp)
         if len(self._seen) == self._seen.maxlen:
