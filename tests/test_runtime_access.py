@@ -1,12 +1,13 @@
 """Web and link access, without sockets: path matching in bounded time, Host/Origin allowlist,
 bounded JSON, rate limits on bridge actions and Signal K PUTs, the ship's session lock.
 
-Timings are CPU time of this thread (``time.thread_time``), so a loaded machine does not make
-them fail; the regex matcher these tests replaced took > 20 s (CPU) for one 10-``*`` pattern.
+Timings are CPU time of this thread outside the garbage collector (``time.thread_time``), so a
+loaded machine does not make them fail; the regex matcher these tests replaced took > 20 s (CPU) for one 10-``*`` pattern.
 """
 
 from __future__ import annotations
 
+import gc
 import json
 import re
 import time
@@ -25,6 +26,26 @@ from steerlab.runtime.signalk_ws import MAX_PATTERNS, SignalKStreamServer, Subsc
 from steerlab.runtime.web import BridgeServer, handle_action
 
 T0 = 1_700_000_000.0
+
+
+def _cpu() -> float:
+    """Thread CPU time [s] outside the garbage collector (a full collection of the test process,
+    ~0.1 s, is not the code under test; the commands freeze their heap, docs/runtime.md)."""
+    return time.thread_time() - _GC_TIME[0]
+
+
+_GC_TIME = [0.0, None]
+
+
+def _gc_cb(phase, info):
+    if phase == "start":
+        _GC_TIME[1] = time.thread_time()
+    elif _GC_TIME[1] is not None:
+        _GC_TIME[0] += time.thread_time() - _GC_TIME[1]
+        _GC_TIME[1] = None
+
+
+gc.callbacks.append(_gc_cb)
 PATHS = ("navigation.headingTrue", "navigation.rateOfTurn", "steering.autopilot.target.headingTrue",
          "steering.rudderAngle", "navigation.position.latitude", "a.[b", "x")
 WORST = ["*" * 10 + "x", "*e" * 10 + "Z", "*a" * 10 + "*b", "*.*" * 12 + "q", ("*" + "e" * 20) * 12 + "*!"]
@@ -47,11 +68,11 @@ def test_worst_case_patterns_match_in_well_under_a_millisecond():
     long_path = "e" * 200 + ".headingTrue"
     for pat in WORST:
         p = PathPattern(pat)
-        t = time.thread_time()
+        t = _cpu()
         for path in (*PATHS, long_path, "e" * 256):
             for _ in range(100):
                 p.match(path)
-        per_match = (time.thread_time() - t) / (100 * (len(PATHS) + 2))
+        per_match = (_cpu() - t) / (100 * (len(PATHS) + 2))
         assert per_match < 1e-4, (pat, per_match)              # < 0.1 ms each (measured ~0.3 us)
     assert PathPattern("*" * 10 + "x").match("steering.x") and not PathPattern("*" * 10 + "x").match("steering")
 
@@ -59,9 +80,9 @@ def test_worst_case_patterns_match_in_well_under_a_millisecond():
 def test_hostile_context_patterns_in_bounded_time():
     """The subscription *context* is a pattern too (``vessels.*``): same matcher, same bound."""
     for ctx in ("*" * 10 + "#", "*" * 200 + "#", "*v" * 120 + "#", ("*" + "vessels." * 3) * 8 + "#"):
-        t = time.thread_time()
+        t = _cpu()
         assert not is_self_context(ctx)
-        assert time.thread_time() - t < 1e-3, ctx
+        assert _cpu() - t < 1e-3, ctx
     assert all(is_self_context(c) for c in ("*", "vessels.*", "vessels.self", SELF_ID, "vessels.urn:*"))
     assert not any(is_self_context(c) for c in ("vessels.other", "", "x" * 257, None, ["*"]))
 
@@ -91,14 +112,14 @@ def test_hostile_subscriptions_cost_microseconds_per_message():
     msgs = ['{"context":"vessels.self","subscribe":[{"path":"**********x"}]}',
             json.dumps({"subscribe": [{"path": ("*" + "e" * 20) * 12 + "*" + str(i)} for i in range(63)]})]
     assert len(msgs[0]) < 70
-    t = time.thread_time()
+    t = _cpu()
     for m in msgs:
         assert srv.handle_message("hostile", subs, m) is None
     srv.clients[_SlowConn()] = subs          # matched on every publish (then skipped: it does not read)
     for _ in range(100):
         srv.publish({p: 1.0 for p in (*PATHS, "e" * 200 + "x")})
     assert srv.counts["subscriptions"] == 2 and len(subs.patterns) == 64 and srv.counts["skipped_slow"] == 100
-    assert time.thread_time() - t < 0.05                              # 2 messages + 100 publishes
+    assert _cpu() - t < 0.05                              # 2 messages + 100 publishes
 
 
 # ------------------------------------------------------------------ Host / Origin
@@ -149,9 +170,9 @@ def test_parse_json_bounds_depth_and_size():
     nest = lambda n: "[" * n + "]" * n  # noqa: E731
     assert parse_json(nest(MAX_JSON_DEPTH), 10**6)[1] is None
     for text in (nest(MAX_JSON_DEPTH + 1), nest(100_000), '{"a":' * 5000 + "1" + "}" * 5000, "[" * 500_000):
-        t = time.thread_time()
+        t = _cpu()
         assert parse_json(text, 10**7) == (None, f"nested deeper than {MAX_JSON_DEPTH} levels")
-        assert time.thread_time() - t < 0.05
+        assert _cpu() - t < 0.05
     assert parse_json("x" * 5000, 4096) == (None, "message longer than 4096 bytes")
     assert parse_json(b"\xff", 10) == (None, "not UTF-8") and parse_json("{", 10) == (None, "not JSON")
 
@@ -183,9 +204,11 @@ class _Ap:
 def test_bridge_actions_are_rate_limited_per_connection():
     ap = _Ap()
     bridge = BridgeServer(ap, "127.0.0.1", 0)
+    t = time.monotonic()
     replies = [bridge.action("conn-1", '{"action": "adjust", "deg": 1}') for _ in range(1000)]
+    elapsed = time.monotonic() - t
     ok = sum(r["ok"] for r in replies)
-    assert 10 <= ok <= 12 and ap.calls == ok                          # a burst of 10 (+ refill), not 1 000
+    assert 10 <= ok <= 10 + 5 * elapsed + 1 and ap.calls == ok       # a burst of 10 (+ 5/s), not 1 000
     assert all("rate limited" in r["error"] for r in replies if not r["ok"])
     assert bridge.counts["rate_limited"] == 1000 - ok
     assert bridge.action("operator", '{"action": "adjust", "deg": -1}')["ok"]   # another page is not starved
@@ -195,9 +218,11 @@ def test_signalk_puts_are_rate_limited_and_answered_429():
     puts = []
     srv = SignalKStreamServer(on_put=lambda p, v: (puts.append(v), (200, ""))[1], msg_rate=1000.0)
     subs = Subscriptions("none")
+    t = time.monotonic()
     codes = [srv.handle_message("c1", subs, json.dumps({"requestId": str(i), "put": {
         "path": "steering.autopilot.target.headingTrue", "value": 0.1}}))["statusCode"] for i in range(200)]
-    assert 10 <= codes.count(200) <= 12 and codes.count(429) == 200 - codes.count(200)
+    elapsed = time.monotonic() - t
+    assert 10 <= codes.count(200) <= 10 + 5 * elapsed + 1 and codes.count(429) == 200 - codes.count(200)
     assert len(puts) == codes.count(200) and srv.counts["put_rate_limited"] == codes.count(429)
 
 
@@ -261,20 +286,24 @@ def test_rejections_are_reported_while_running():
     counts = {"accepted": 5, "locked": 0}
     web = {"clients": 3, "refused_http": 0}
     out = io.StringIO()
+    script = [lambda: None,                                       # period 1: nothing rejected, no line
+              lambda: (counts.update(locked=12, rate_limited=3, accepted=50), web.update(refused_http=2)),
+              lambda: counts.update(locked=13)]
+
+    async def one_period(seconds):            # the traffic of one period (no wall clock: deterministic)
+        assert seconds == 10.0
+        if not script:
+            raise asyncio.CancelledError
+        script.pop(0)()
 
     async def go():
-        task = asyncio.create_task(report_rejections("serve-ship", {"link": lambda: counts, "web": lambda: web},
-                                                     0.05, out))
-        await asyncio.sleep(0.07)                 # nothing rejected: nothing printed
-        counts.update(locked=12, rate_limited=3, accepted=50)
-        web["refused_http"] = 2
-        await asyncio.sleep(0.05)
-        counts["locked"] += 1
-        await asyncio.sleep(0.05)
-        task.cancel()
+        try:
+            await report_rejections("serve-ship", {"link": lambda: counts, "web": lambda: web}, 10.0, out,
+                                    sleep=one_period)
+        except asyncio.CancelledError:
+            pass
 
     asyncio.run(go())
-    lines = out.getvalue().splitlines()
-    assert lines == ["serve-ship: link: rejected in the last 0.05 s: locked 12, rate_limited 3",
-                     "serve-ship: web: rejected in the last 0.05 s: refused_http 2",
-                     "serve-ship: link: rejected in the last 0.05 s: locked 1"]
+    assert out.getvalue().splitlines() == ["serve-ship: link: rejected in the last 10 s: locked 12, rate_limited 3",
+                                           "serve-ship: web: rejected in the last 10 s: refused_http 2",
+                                           "serve-ship: link: rejected in the last 10 s: locked 1"]

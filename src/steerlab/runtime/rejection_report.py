@@ -21,12 +21,14 @@ def rejections(counts) -> Counter:
     return Counter({k: v for k, v in dict(counts).items() if k not in NOT_REJECTIONS and v})
 
 
-async def report_rejections(prog: str, sources: dict, period: float = 10.0, out=None) -> None:
+async def report_rejections(prog: str, sources: dict, period: float = 10.0, out=None, sleep=None) -> None:
     """Every ``period`` [wall s], one line per source with new rejections: ``sources`` maps a name
-    to a function returning its counters (e.g. ``lambda: server.filter.counts``). Runs until cancelled."""
+    to a function returning its counters (e.g. ``lambda: server.filter.counts``). Runs until
+    cancelled. ``sleep``: the coroutine function that waits a period (tests pass their own)."""
+    sleep = sleep or asyncio.sleep
     last = {name: rejections(get()) for name, get in sources.items()}
     while True:
-        await asyncio.sleep(period)
+        await sleep(period)
         for name, get in sources.items():
             now = rejections(get())
             new = now - last[name]
