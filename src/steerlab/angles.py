@@ -18,13 +18,16 @@ def wrap_to_pi(angle):
     return a % (2.0 * math.pi) - math.pi
 
 
-def wrap_to_2pi(angle: float) -> float:
-    """Wrap an angle [rad] to [0, 2*pi) (a compass heading), strictly.
+def wrap_to_2pi(angle):
+    """Wrap an angle [rad] (a float or a numpy array) to [0, 2*pi) (a compass heading), strictly.
 
     ``a % (2 pi)`` alone rounds a tiny negative angle (``-1e-17``) to exactly ``2 pi``; that
     value is north, so it is returned as 0.
     """
     a = angle % (2.0 * math.pi)
+    if hasattr(a, "shape") and getattr(a, "ndim", 0) > 0:       # a numpy array: elementwise
+        a[a >= 2.0 * math.pi] = 0.0
+        return a
     return 0.0 if a >= 2.0 * math.pi else a
 
 
