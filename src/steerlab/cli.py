@@ -202,7 +202,8 @@ def cmd_bench(args) -> int:
 EXAMPLES = {
     "run": """examples:
   steerlab run --out out/default            # bundled default: Esso tanker + ADRC, 20 deg change, waves
-  steerlab run my_scenario.toml --out out/mine --parquet
+  steerlab run examples/scenarios/esso-pid.toml --out out/esso-pid --parquet
+  steerlab run examples/scenarios/los-route.toml --out out/los        # route following: track figure with the route
   steerlab run --seed 7 --engine readable --out out/seed7""",
     "experiment": """examples:
   steerlab experiment zwierzewicz2021 --out out/zw2021

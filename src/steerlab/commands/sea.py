@@ -3,10 +3,10 @@
 from __future__ import annotations
 
 EXAMPLES = """examples:
-  steerlab sea my-scenario.toml --out out/sea       # sea_spectrum.png, wind_rose.png, sea_timeseries.png,
-                                                     # sea.csv, sea.json (variance, peak frequency:
-                                                     # target vs generated)
-  steerlab sea --out out/sea                        # the bundled default scenario (eq 39 waves)
+  steerlab sea examples/scenarios/sea-state-5.toml --out out/sea   # sea_spectrum.png, wind_rose.png, sea_timeseries.png,
+                                                           # sea.csv, sea.json (variance, peak frequency:
+                                                           # target vs generated)
+  steerlab sea --out out/sea-default                         # the bundled default scenario (eq 39 waves)
 
 A scenario's sea is chosen in [environment] (see docs/environment.md), e.g.
   [environment.wave]

@@ -6,10 +6,10 @@ import sys
 
 EXAMPLES = """examples:
   steerlab serve-ship                                  # bundled default scenario (Esso), 127.0.0.1:47110
-  steerlab serve-ship my.toml --bind 127.0.0.1:47110 --speedup 5
-  STEERLAB_LINK_KEY=$(cat key) steerlab serve-ship my.toml --key-env STEERLAB_LINK_KEY
-  steerlab serve-ship my.toml --nmea-to 127.0.0.1:10110 --signalk-to 127.0.0.1:8375
-  steerlab serve-ship my.toml --signalk-ws 127.0.0.1:3000       # Signal K WebSocket stream
+  steerlab serve-ship examples/scenarios/esso-pid.toml --bind 127.0.0.1:47110 --speedup 5
+  STEERLAB_LINK_KEY=$(cat examples/data/demo-link.key) steerlab serve-ship examples/scenarios/esso-pid.toml --key-env STEERLAB_LINK_KEY
+  steerlab serve-ship examples/scenarios/esso-pid.toml --nmea-to 127.0.0.1:10110 --signalk-to 127.0.0.1:8375
+  steerlab serve-ship examples/scenarios/esso-pid.toml --signalk-ws 127.0.0.1:3000       # Signal K WebSocket stream
 
 Then: steerlab autopilot --connect 127.0.0.1:47110 --controller pid --heading 20
 Protocol, safety behaviour and NMEA/Signal K mapping: docs/runtime.md"""
