@@ -186,6 +186,9 @@ def metric_arrays(acc: np.ndarray, lam: float, names, time=None, states=None, re
         mr = np.empty(n)
         for i in range(n):
             sm = step_metrics(time, states[i, :, 2], ref[i, :, 0])
+            if sm["overshoot_pct"] is None and names & {"overshoot", "settling"}:
+                raise InputError("--cost", "'overshoot' and 'settling' are measured from a set-point change; "
+                                 "the scenario's [guidance] has none (add changes = [...])")
             ov[i] = sm["overshoot_deg"] if sm["overshoot_deg"] is not None else 0.0
             s = sm["settling_time_1deg_s"]
             st[i] = s if s is not None else (duration if duration is not None else math.inf)
