@@ -48,3 +48,19 @@ def test_imo_report_condition_table_is_rounded(tmp_path):
               "trials": {}, "source": "test"}
     html = write_imo_html(tmp_path / "r.html", report, {}).read_text()
     assert "8.231<" in html and "8.231111" not in html and "0.7012<" in html
+
+
+def test_unknown_or_missing_controller_type_is_one_short_line():
+    import pytest
+
+    from steerlab.errors import InputError
+    from steerlab.sim.scenario import scenario_from_dict
+
+    for ctrl, start in (({"type": "pidd"}, "unknown type 'pidd'; known: adrc, asa,"),
+                        ({"Kp": 3.0}, "missing; give type = one of adrc, asa,")):
+        with pytest.raises(InputError) as e:
+            scenario_from_dict({"ship": {"model": "esso"}, "controller": ctrl})
+        text = str(e.value)
+        assert text.startswith("controller.type: " + start), text
+        assert len(text) < 260 and "\n" not in text and "pid+wf" not in text
+        assert "sliding_mode" in text and "'<type>+wf', except asa" in text
