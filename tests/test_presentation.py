@@ -64,3 +64,18 @@ def test_unknown_or_missing_controller_type_is_one_short_line():
         assert text.startswith("controller.type: " + start), text
         assert len(text) < 260 and "\n" not in text and "pid+wf" not in text
         assert "sliding_mode" in text and "'<type>+wf', except asa" in text
+
+
+def test_robustness_axes_and_colour_bar_carry_units():
+    import numpy as np
+
+    from steerlab.sweeps.robustness import Variation, _decade, metric_label, quantity_label
+
+    assert quantity_label(Variation("T", ("ship", "options", "T"), np.r_[30.0]), "nomoto1") == "T [s]"
+    assert quantity_label(Variation("K", ("ship", "options", "K"), np.r_[0.1]), "nomoto1") == "K [1/s]"
+    assert quantity_label(Variation("gear.rate_max_deg_s", ("gear", "rate_max_deg_s"), np.r_[2.0])) \
+        == "gear.rate_max_deg_s [deg/s]"
+    assert quantity_label(Variation("speed_kn", ("ship", "speed_kn"), np.r_[8.0])) == "speed_kn [kn]"
+    assert metric_label("itae", 3) == "itae [10^3 deg s^2]" and metric_label("J") == "J"
+    assert metric_label("itae + 0.5*travel") == "itae + 0.5*travel"
+    assert (_decade(71090.0), _decade(5.0), _decade(0.5), _decade(1.2e-4)) == (3, 0, 0, -6)

@@ -25,9 +25,10 @@ travel         deg         rudder travel sum |d delta|
 reversals      \-          rudder direction reversals
 mean_rudder    deg         mean |delta|
 max_error      deg         max |e|
-overshoot*     deg         overshoot past the last set-point change (0 if none)
+overshoot*     deg         overshoot past the last set-point change
 settling*      s           settling into +-1 deg after the last change (the run's duration
-                           if it never settles)
+                           if it never settles); both need a set-point change in the
+                           scenario's guidance (an InputError otherwise)
 max_rudder*    deg         max |delta|
 =============  ==========  ==========================================================
 
