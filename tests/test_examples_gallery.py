@@ -15,7 +15,7 @@ SCRIPTS = sorted((REPO / "examples").glob("[0-9][0-9]_*.py"))
 
 
 def test_the_gallery_has_scripts_and_a_readme_naming_each():
-    assert len(SCRIPTS) >= 5
+    assert len(SCRIPTS) >= 7
     readme = (REPO / "examples" / "README.md").read_text(encoding="utf-8")
     for s in SCRIPTS:
         assert s.name in readme, f"examples/README.md does not describe {s.name}"
