@@ -4,8 +4,6 @@ Teaches: a ``[guidance] type = "los"`` scenario with a route CSV, the track in t
 plane and the cross-track metrics. Scenario: ``examples/scenarios/los-route.toml``.
 """
 
-import numpy as np
-
 from _common import DATA, SCENARIOS, figure, parse_args, save
 from steerlab.guidance.los import read_route_csv
 from steerlab.metrics import compute_metrics

@@ -6,8 +6,6 @@ Equivalent command: ``steerlab robustness examples/scenarios/nomoto1-pid.toml --
 --vary K=0.07:0.2:0.01 --out out/robust`` (writes the same map as heatmap.png).
 """
 
-import numpy as np
-
 from _common import SCENARIOS, figure, parse_args, save
 from steerlab.sim.scenario import load_scenario
 from steerlab.sweeps.robustness import metric_label, parse_vary, quantity_label, run_robustness
