@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq
 
-from steerlab.metrics import (compute_metrics, integral_metrics, last_setpoint_change, speed_loss_J,
-                              step_metrics)
+from steerlab.metrics import (compute_metrics, integral_metrics, last_setpoint_change, settling_time,
+                              speed_loss_J, step_metrics)
 from steerlab.metrics_online import (M_ABS_DELTA, M_D2_DEG, M_DURATION, M_E2_DEG, M_IAE, M_ISE, M_ITAE,
                                      M_MAX_ABS_E, M_REVERSALS, M_TRAVEL, accumulate, new_accumulator)
 from steerlab.sim.engine import online_metrics_from_result, simulate_compiled, simulate_readable
@@ -188,9 +188,32 @@ def test_step_metrics_without_setpoint_change():
     e0 = math.radians(5.0)
     psi = -e0 * np.exp(-time / 10.0)                                   # e = 5 deg e^{-t/10}
     m = step_metrics(time, psi, np.zeros_like(time))
-    assert m["overshoot_pct"] is None and m["rise_time_s"] is None
-    assert m["settling_time_1deg_s"] == pytest.approx(10.0 * math.log(5.0), abs=dt + 1e-9)
-    assert step_metrics(time, np.zeros_like(time), np.zeros_like(time))["settling_time_1deg_s"] == 0.0
+    # nothing to measure a step response from: every step metric is n/a (not "from t = 0")
+    assert all(v is None for v in m.values()), m
+    assert all(v is None for v in step_metrics(time, np.zeros_like(time), np.zeros_like(time)).values())
+    # the rejection of a disturbance is timed explicitly from its onset
+    assert settling_time(time, psi, math.radians(1.0), t0=0.0) == pytest.approx(10.0 * math.log(5.0),
+                                                                                abs=dt + 1e-9)
+
+
+def test_step_metrics_of_the_default_run_agree_with_python_control_step_info():
+    """The default scenario (Esso + ADRC, 20 deg change at t = 100 s): overshoot, 10-90 % rise
+    and 2 % settling as python-control's ``step_info`` computes them on the same response
+    (10.80 %, 85.7 s, 306.3 s), measured from the change."""
+    import control
+
+    from steerlab.sim.engine import simulate
+    from steerlab.sim.scenario import default_scenario
+
+    res = simulate(default_scenario())
+    m = compute_metrics(res)
+    sel = res.time >= 100.0
+    info = control.step_info(res.psi[sel], T=res.time[sel] - 100.0, yfinal=math.radians(20.0))
+    assert m["overshoot_pct"] == pytest.approx(info["Overshoot"], rel=1e-9)
+    assert m["rise_time_s"] == pytest.approx(info["RiseTime"], abs=1e-9)
+    assert m["settling_time_2pct_s"] == pytest.approx(info["SettlingTime"], abs=1e-9)
+    assert (round(m["overshoot_pct"], 2), round(m["rise_time_s"], 1), round(m["settling_time_2pct_s"], 1)) \
+        == (10.80, 85.7, 306.3)
 
 
 def test_last_setpoint_change():

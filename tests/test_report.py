@@ -126,8 +126,9 @@ def test_format_metrics_table_missing_values():
     assert "n/a" in rows["iae_deg_s"]
     assert rows["rudder_reversals"].split()[1] == "7"
     # no set-point change: a missing 2 % settling time is not applicable rather than unsettled
-    table = format_metrics_table({"overshoot_pct": None, "settling_time_2pct_s": None})
-    assert "n/a" in table.splitlines()[1]
+    table = format_metrics_table({"overshoot_pct": None, "settling_time_2pct_s": None,
+                                  "settling_time_1deg_s": None})
+    assert "n/a" in table.splitlines()[1] and "n/a" in table.splitlines()[2]
     assert format_metrics_table({}) == ""
 
 

@@ -54,3 +54,11 @@ def test_sea_command_bad_input(tmp_path, capsys):
     assert main(["sea", str(toml), "--out", str(out), "--quiet"]) == 2
     assert "environment.wave.sea_state" in capsys.readouterr().err
     assert not out.exists()
+
+
+def test_sea_without_wind_writes_no_wind_rose(tmp_path, capsys):
+    """The default scenario (eq 39 waves, no wind): no empty wind rose, and it says why."""
+    out = tmp_path / "out"
+    assert main(["sea", "--out", str(out)]) == 0
+    assert not (out / "wind_rose.png").exists() and (out / "sea_spectrum.png").exists()
+    assert "no wind" in capsys.readouterr().err

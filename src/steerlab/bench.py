@@ -60,7 +60,7 @@ W1 = {
 
 C_REFERENCE_STEPS_PER_S = 13.8e6
 C_REFERENCE_NOTE = ("quoted figure of a plain C build of the Esso + PID loop on one core of "
-                    "this class of machine (docs: DESIGN.md); not measured here")
+                    "this class of machine (docs/architecture.md, speed reference); not measured here")
 PYTHON_REFERENCE_DURATION = 300.0
 SINGLE_REPEATS = 5
 """The single run is timed ``SINGLE_REPEATS * repeats`` times (it is short)."""

@@ -60,7 +60,7 @@ def cmd_run(args) -> int:
             result.to_parquet(stage / "timeseries.parquet")
         dump_json({"scenario": scenario.name, "seed": scenario.seed, "engine": args.engine,
                    "metrics": metrics, "units": {k: METRIC_UNITS.get(k, "") for k in metrics}},
-                  stage / "metrics.json")
+                  stage / "metrics.json", digits=None)
         (stage / "scenario.json").write_text(scenario.model_dump_json(indent=2) + "\n", encoding="utf-8")
         write_run_report(stage, result, metrics, scenario)
     print(format_metrics_table(metrics))
@@ -146,7 +146,8 @@ def cmd_bench(args) -> int:
 EXAMPLES = {
     "run": """examples:
   steerlab run --out out/default            # bundled default: Esso tanker + ADRC, 20 deg change, waves
-  steerlab run my_scenario.toml --out out/mine --parquet
+  steerlab run examples/scenarios/esso-pid.toml --out out/esso-pid --parquet
+  steerlab run examples/scenarios/los-route.toml --out out/los        # route following: track figure with the route
   steerlab run --seed 7 --engine readable --out out/seed7""",
     "experiment": """examples:
   steerlab experiment zwierzewicz2021 --out out/zw2021

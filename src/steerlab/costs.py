@@ -25,9 +25,10 @@ travel         deg         rudder travel sum |d delta|
 reversals      \-          rudder direction reversals
 mean_rudder    deg         mean |delta|
 max_error      deg         max |e|
-overshoot*     deg         overshoot past the last set-point change (0 if none)
+overshoot*     deg         overshoot past the last set-point change
 settling*      s           settling into +-1 deg after the last change (the run's duration
-                           if it never settles)
+                           if it never settles); both need a set-point change in the
+                           scenario's guidance (an InputError otherwise)
 max_rudder*    deg         max |delta|
 =============  ==========  ==========================================================
 
@@ -186,6 +187,9 @@ def metric_arrays(acc: np.ndarray, lam: float, names, time=None, states=None, re
         mr = np.empty(n)
         for i in range(n):
             sm = step_metrics(time, states[i, :, 2], ref[i, :, 0])
+            if sm["overshoot_pct"] is None and names & {"overshoot", "settling"}:
+                raise InputError("--cost", "'overshoot' and 'settling' are measured from a set-point change; "
+                                 "the scenario's [guidance] has none (add changes = [...])")
             ov[i] = sm["overshoot_deg"] if sm["overshoot_deg"] is not None else 0.0
             s = sm["settling_time_1deg_s"]
             st[i] = s if s is not None else (duration if duration is not None else math.inf)

@@ -59,19 +59,31 @@ def _json_default(o):
     raise TypeError(f"not JSON serialisable: {type(o)}")
 
 
-def _clean(o):
-    """NaN/inf -> None so the JSON is standard."""
-    if isinstance(o, float) and not math.isfinite(o):
-        return None
+JSON_DIGITS = 12
+"""Significant digits of floats in the JSON files and ``--json`` output (no float noise such
+as ``62.900000000000006``; far below any model's accuracy)."""
+
+
+def _clean(o, digits: int | None = JSON_DIGITS):
+    """NaN/inf -> None so the JSON is standard; floats to ``digits`` significant digits."""
+    if isinstance(o, float):
+        if not math.isfinite(o):
+            return None
+        return float(f"{o:.{digits}g}") if digits else o
     if isinstance(o, dict):
-        return {k: _clean(v) for k, v in o.items()}
+        return {k: _clean(v, digits) for k, v in o.items()}
     if isinstance(o, (list, tuple)):
-        return [_clean(v) for v in o]
+        return [_clean(v, digits) for v in o]
     return o
 
 
-def dump_json(obj, path: Path | None = None) -> str:
-    text = json.dumps(_clean(json.loads(json.dumps(obj, default=_json_default))), indent=2)
+def dump_json(obj, path: Path | None = None, digits: int | None = JSON_DIGITS) -> str:
+    """``obj`` as indented standard JSON (written to ``path`` when given).
+
+    Floats are rounded to ``digits`` significant digits (``None``: every bit kept, as for a
+    run's ``metrics.json``, the record other runs are compared with).
+    """
+    text = json.dumps(_clean(json.loads(json.dumps(obj, default=_json_default)), digits), indent=2)
     if path is not None:
         Path(path).write_text(text + "\n", encoding="utf-8")
     return text

@@ -299,12 +299,10 @@ def write_run_figures(out_dir: Path, result, title: str = "") -> list[Path]:
 def _missing_text(name: str, metrics: dict) -> str:
     """What a ``None`` / NaN metric means: ``"not settled"`` for a settling time, else ``"n/a"``.
 
-    ``settling_time_2pct_s`` is also ``None`` when the run has no set-point change (then the
-    step metrics such as ``rise_time_s`` / ``overshoot_pct`` are ``None`` too): that is "n/a".
+    The settling times are also ``None`` when the run has no set-point change (then the step
+    metrics such as ``rise_time_s`` / ``overshoot_pct`` are ``None`` too): that is "n/a".
     """
-    if name == "settling_time_1deg_s":
-        return "not settled"
-    if name == "settling_time_2pct_s":
+    if name in ("settling_time_1deg_s", "settling_time_2pct_s"):
         has_step = metrics.get("overshoot_pct") is not None
         return "not settled" if has_step else "n/a"
     return "n/a"

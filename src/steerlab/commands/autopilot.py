@@ -7,8 +7,8 @@ import sys
 
 EXAMPLES = """examples:
   steerlab autopilot --connect 127.0.0.1:47110 --controller pid --heading 20
-  steerlab autopilot --connect 127.0.0.1:47110 --controller adrc --scenario my.toml --route route.csv
-  steerlab autopilot --connect 127.0.0.1:47110 --controller pid --route route.csv --lookahead-L 5 --accept-radius 200
+  steerlab autopilot --connect 127.0.0.1:47110 --controller adrc --scenario examples/scenarios/los-route.toml --route examples/data/route.csv
+  steerlab autopilot --connect 127.0.0.1:47110 --controller pid --scenario examples/scenarios/los-route.toml --route examples/data/route.csv --lookahead-L 5 --accept-radius 200
   steerlab autopilot --connect 127.0.0.1:47110 --controller pid --heading 0 --web 127.0.0.1:8080
   steerlab autopilot --connect 127.0.0.1:47110 --controller pid --nmea-listen 127.0.0.1:10111   # follow OpenCPN APB/RMB
   steerlab autopilot --connect 127.0.0.1:47110 --controller pid --signalk-ws 127.0.0.1:3000      # Signal K WebSocket

@@ -3,9 +3,9 @@
 from __future__ import annotations
 
 EXAMPLES = """examples:
-  steerlab identify zigzag.csv --model nomoto1
-  steerlab identify trials.csv --model norrbin --json
-  steerlab identify out/run/timeseries.csv --model nomoto2 --out out/fit   # fit.json + fit.png
+  steerlab identify examples/data/zigzag.csv --model nomoto1
+  steerlab identify examples/data/trials.csv --model norrbin --json
+  steerlab identify examples/data/zigzag.csv --model nomoto2 --out out/fit   # fit.json + fit.png
 
 record columns (CSV with a header; see docs/ships.md):
   time [s] | rudder [deg] | heading [deg] and/or yaw_rate [deg/s] | speed [kn] or [m/s] (optional)

@@ -3,9 +3,9 @@
 from __future__ import annotations
 
 EXAMPLES = """examples:
-  steerlab montecarlo scen.toml --runs 500 --out out/mc
-  steerlab montecarlo scen.toml --runs 200 --record-every 10 --lambda 0.1 --out out/mc
-  steerlab montecarlo scen.toml --runs 2000 --dask local --out out/mc-dask
+  steerlab montecarlo examples/scenarios/sea-state-5.toml --runs 500 --out out/mc
+  steerlab montecarlo examples/scenarios/esso-pid.toml --runs 200 --record-every 10 --lambda 0.1 --out out/mc
+  steerlab montecarlo examples/scenarios/esso-pid.toml --runs 2000 --dask local --out out/mc-dask
 
 Seeds are scenario.seed + i. Writes montecarlo.json (mean, 95 % CI of the mean, std,
 percentiles of every metric), runs.csv/.parquet (one row per seed), bands.csv/.parquet and

@@ -4,9 +4,9 @@ from __future__ import annotations
 
 EXAMPLES = """examples:
   # ITAE of the scenario's autopilot (designed for the nominal ship) over Nomoto K and T
-  steerlab robustness scen.toml --vary T=30:70:5 --vary K=0.07:0.2:0.01 --out out/robust
+  steerlab robustness examples/scenarios/nomoto1-pid.toml --vary T=30:70:5 --vary K=0.07:0.2:0.01 --out out/robust
   # speed-loss J over speed and rudder rate, autopilot redesigned at every point
-  steerlab robustness scen.toml --vary ship.speed_kn=8:16:2 --vary gear.rate_max_deg_s=2:5:1 \\
+  steerlab robustness examples/scenarios/esso-pid.toml --vary ship.speed_kn=8:16:2 --vary gear.rate_max_deg_s=2:5:1 \\
       --metric J --redesign --out out/robust-J
 
 A bare name is a field of the ship's [ship.options] (nomoto1: K, T) or speed_kn; otherwise

@@ -3,10 +3,11 @@
 from __future__ import annotations
 
 EXAMPLES = """examples:
-  steerlab sea my-scenario.toml --out out/sea       # sea_spectrum.png, wind_rose.png, sea_timeseries.png,
-                                                     # sea.csv, sea.json (variance, peak frequency:
-                                                     # target vs generated)
-  steerlab sea --out out/sea                        # the bundled default scenario (eq 39 waves)
+  steerlab sea examples/scenarios/sea-state-5.toml --out out/sea   # JONSWAP, sea state 5
+  steerlab sea --out out/sea-default                               # the bundled default scenario (eq 39 waves)
+
+Writes sea_spectrum.png, sea_timeseries.png, wind_rose.png (when there is wind), sea.csv and
+sea.json (variance and peak frequency: target vs generated).
 
 A scenario's sea is chosen in [environment] (see docs/environment.md), e.g.
   [environment.wave]
@@ -33,7 +34,7 @@ def run(args) -> int:
 
     from steerlab.cli import _progress, dump_json, staged_output
     from steerlab.environment.channels import CHANNEL_NAMES, CHANNEL_UNITS
-    from steerlab.environment.sea_report import (spectrum_figure, timeseries_figure, wave_analysis,
+    from steerlab.environment.sea_report import (has_wind, spectrum_figure, timeseries_figure, wave_analysis,
                                                  wind_current_summary, wind_rose_figure)
     from steerlab.sim.scenario import default_scenario, load_scenario
     from steerlab.sim.setup import build
@@ -54,7 +55,10 @@ def run(args) -> int:
                    **wind_current_summary(setup.w)}
         if analysis:
             spectrum_figure(analysis, stage / "sea_spectrum.png", scenario.name)
-        wind_rose_figure(setup.w, stage / "wind_rose.png", scenario.name)
+        if has_wind(setup.w):
+            wind_rose_figure(setup.w, stage / "wind_rose.png", scenario.name)
+        else:
+            say("no wind in this scenario: wind_rose.png not written")
         timeseries_figure(t, setup.w, stage / "sea_timeseries.png", scenario.name)
         header = "time_s," + ",".join(f"{n}_{u.replace('/', '_per_').replace('^', '')}"
                                       for n, u in zip(CHANNEL_NAMES, CHANNEL_UNITS))

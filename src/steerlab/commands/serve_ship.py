@@ -6,12 +6,11 @@ import sys
 
 EXAMPLES = """examples:
   steerlab serve-ship                                  # bundled default scenario (Esso), 127.0.0.1:47110
-  steerlab serve-ship my.toml --bind 127.0.0.1:47110 --speedup 5
-  python -c "import secrets; print(secrets.token_hex(32))" > link.key    # a key, once (chmod 600)
-  steerlab serve-ship my.toml --key-file link.key       # HMAC on (the autopilot gets the same --key-file)
-  STEERLAB_LINK_KEY=$(cat key) steerlab serve-ship my.toml --key-env STEERLAB_LINK_KEY
-  steerlab serve-ship my.toml --nmea-to 127.0.0.1:10110 --signalk-to 127.0.0.1:8375
-  steerlab serve-ship my.toml --signalk-ws 127.0.0.1:3000       # Signal K WebSocket stream
+  steerlab serve-ship examples/scenarios/esso-pid.toml --bind 127.0.0.1:47110 --speedup 5
+  steerlab serve-ship examples/scenarios/esso-pid.toml --key-file examples/data/demo-link.key   # HMAC on (the autopilot gets the same --key-file; make your own key once: python -c "import secrets; print(secrets.token_hex(32))" > link.key, chmod 600)
+  STEERLAB_LINK_KEY=$(cat examples/data/demo-link.key) steerlab serve-ship examples/scenarios/esso-pid.toml --key-env STEERLAB_LINK_KEY
+  steerlab serve-ship examples/scenarios/esso-pid.toml --nmea-to 127.0.0.1:10110 --signalk-to 127.0.0.1:8375
+  steerlab serve-ship examples/scenarios/esso-pid.toml --signalk-ws 127.0.0.1:3000       # Signal K WebSocket stream
 
 Then: steerlab autopilot --connect 127.0.0.1:47110 --controller pid --heading 20
 Protocol, safety behaviour and NMEA/Signal K mapping: docs/runtime.md"""

@@ -4,16 +4,16 @@ from __future__ import annotations
 
 EXAMPLES = """examples:
   # PID on the scenario's ship: minimise ITAE + rudder travel over 4 sea realisations
-  steerlab tune scen.toml --controller pid --params kp,kd,ki --bounds 0.5:10,5:100,0:0.05 \\
+  steerlab tune examples/scenarios/esso-pid.toml --controller pid --params kp,kd,ki --bounds 0.5:10,5:100,0:0.05 \\
       --cost "itae + 0.5*travel" --seeds 4 --out out/tune-pid
   # the speed-loss criterion J (lambda 0.1) by a genetic algorithm (pymoo), resumable
-  steerlab tune scen.toml --params kp,kd --bounds 0.1:5,1:100 --cost J --method ga \\
+  steerlab tune examples/scenarios/esso-pid.toml --params kp,kd --bounds 0.1:5,1:100 --cost J --method ga \\
       --checkpoint out/ga.ckpt --out out/tune-ga
   # Pareto front ITAE vs rudder travel (NSGA-II), over two speeds and two sea states
-  steerlab tune scen.toml --params kp,kd --bounds 0.1:5,1:100 --cost itae --cost travel \\
+  steerlab tune examples/scenarios/esso-pid.toml --params kp,kd --bounds 0.1:5,1:100 --cost itae --cost travel \\
       --method nsga2 --speeds-kn 10,16 --wave-power 1e-4,4e-4 --out out/front
-  # the same on a dask cluster (or --dask local)
-  steerlab tune scen.toml --params kp,kd --bounds 0.1:5,1:100 --cost J --dask tcp://10.0.0.5:8786 --out out/d
+  # the same on a local dask cluster (a remote one: --dask tcp://HOST:8786)
+  steerlab tune examples/scenarios/esso-pid.toml --params kp,kd --bounds 0.1:5,1:100 --cost J --dask local --out out/d
 
 cost metrics: itae ise iae J e2 d2 travel reversals mean_rudder max_error (on-line) and
 overshoot settling max_rudder (need a recorded log); + - * / ** sqrt log exp abs min max.

@@ -216,6 +216,31 @@ def ranking(costs: dict) -> str:
     return " < ".join(sorted(costs, key=lambda k: costs[k]))
 
 
+PROGRESS_PERIOD = 5.0
+"""Seconds between two progress lines of the whole reproduction (and one at the end)."""
+_last_progress = [-math.inf]
+
+
+def _overall_progress(say, done: int, total: int, what: str):
+    """A tuning's progress callback that prints one overall bar (tunings done of ``total``) with
+    the current tuning's generation, at most every :data:`PROGRESS_PERIOD` seconds."""
+    import re
+    import time
+
+    from steerlab.progress import bar
+
+    def progress(msg: str) -> None:
+        now = time.perf_counter()
+        gen = re.search(r"gen (\d+)/(\d+)", msg)
+        last_gen = gen is not None and gen.group(1) == gen.group(2)
+        if now - _last_progress[0] >= PROGRESS_PERIOD or (last_gen and done + 1 == total):
+            _last_progress[0] = now
+            frac = done + (int(gen.group(1)) / int(gen.group(2)) if gen else 0.0)
+            say(f"{bar(frac, total)} {what}" + (f", generation {gen.group(1)}/{gen.group(2)}" if gen else ""))
+
+    return progress
+
+
 def run(out_dir: Path, progress: Optional[Callable[[str], None]] = None, quick: bool = False) -> list[dict]:
     """Tune every controller for every loading; write ``comparison.json``, ``tuning.json``, figures."""
     out_dir = Path(out_dir)
@@ -224,13 +249,18 @@ def run(out_dir: Path, progress: Optional[Callable[[str], None]] = None, quick: 
     pop, gens = (QUICK_POP, QUICK_GENERATIONS) if quick else (POP_SIZE, GENERATIONS)
     seeds = GA_SEEDS[:1] if quick else GA_SEEDS
     rows, details, histories = [], [], []
+    n_tunings = len(LOADINGS) * len(CONTROLLERS) * len(seeds)
+    done = 0
+    say(f"{n_tunings} GA tunings, population {pop} x {gens} generations each")
     for loading in LOADINGS:
         curves, tuned, published = [], {}, {}
         for label, (kind, fields, symbols) in CONTROLLERS.items():
             per_seed = []
             for seed in seeds:
-                say(f"{loading}: {label} ({kind}), GA seed {seed}, population {pop} x {gens} generations")
-                outcome, j_pub = tune_one(label, loading, pop, gens, progress, seed)
+                what = f"tuning {done + 1}/{n_tunings}: {loading}, {label} ({kind}), GA seed {seed}"
+                outcome, j_pub = tune_one(label, loading, pop, gens, _overall_progress(say, done, n_tunings, what),
+                                          seed)
+                done += 1
                 per_seed.append((outcome.summary["best"]["costs"][0], seed, outcome))
             j_best, seed_best, outcome = min(per_seed, key=lambda c: (c[0], c[1]))
             best = outcome.summary["best"]

@@ -173,6 +173,21 @@ def _is_union_member_tag(part) -> bool:
                                       or part.startswith("literal["))
 
 
+def _tag_message(error: dict) -> str:
+    """One short line for an unknown or missing discriminator (e.g. ``[controller] type``):
+    the base types, once, and the ``+wf`` rule instead of every wrapped variant."""
+    ctx = error.get("ctx") or {}
+    tags = [t.strip(" '") for t in str(ctx.get("expected_tags", "")).split(",") if t.strip(" '")] or list(CONTROLLERS)
+    base = sorted(t for t in tags if "+" not in t)
+    known = ", ".join(base)
+    for x in sorted({t.split("+", 1)[1] for t in tags if "+" in t}):
+        without = [b for b in base if f"{b}+{x}" not in tags]
+        known += f" (each also as '<type>+{x}'" + (f", except {', '.join(without)})" if without else ")")
+    if error["type"] == "union_tag_not_found":
+        return f"missing; give type = one of {known}"
+    return f"unknown type {ctx.get('tag')!r}; known: {known}"
+
+
 def _format_validation_error(err: ValidationError) -> InputError:
     first = err.errors()[0]
     loc = ".".join(str(p) for p in first["loc"] if not _is_union_member_tag(p))
@@ -183,6 +198,7 @@ def _format_validation_error(err: ValidationError) -> InputError:
         msg += f" (allowed: {', '.join(bounds)})"
     if first["type"] in ("union_tag_invalid", "union_tag_not_found"):
         loc = f"{loc}.type" if loc else "controller.type"
+        msg = _tag_message(first)
     more = len({tuple(x for x in e["loc"] if not _is_union_member_tag(x)) for e in err.errors()}) - 1
     if more:
         msg += f" [and {more} more problem{'s' if more > 1 else ''}]"

@@ -53,6 +53,7 @@ class RobustnessResult:
     table: dict                  # column -> (n_points,)
     nominal: dict                # the nominal point's metric values
     redesign: bool
+    ship: str = ""               # the scenario's ship model (for the units of its options)
 
 
 def parse_vary(text: str, scenario) -> Variation:
@@ -151,7 +152,8 @@ def run_robustness(scenario, variations: list[Variation], metric: str = "itae", 
     table["metric"] = values[:-1]
     table.update({k: m[k][:-1] for k in sorted(names)})
     nominal_row = {"metric": float(values[-1]), **{k: float(m[k][-1]) for k in sorted(names)}}
-    return RobustnessResult(variations, points, expr.text, values[:-1], table, nominal_row, redesign)
+    return RobustnessResult(variations, points, expr.text, values[:-1], table, nominal_row, redesign,
+                            scenario.ship.model)
 
 
 def write_robustness_outputs(stage, res: RobustnessResult, scenario_name: str) -> None:
@@ -183,19 +185,99 @@ def write_robustness_outputs(stage, res: RobustnessResult, scenario_name: str) -
     a, b = res.variations[0], res.variations[1]
     n_rest = len(res.points) // (len(a.values) * len(b.values))
     grid = res.metric_values.reshape(len(a.values), len(b.values), n_rest)[:, :, 0]
-    fig, (ax,) = new_figure((7.0, 5.5))
+    finite = grid[np.isfinite(grid)]
+    scale = _decade(np.max(np.abs(finite)) if finite.size else 1.0)
+    shown = grid / 10.0**scale
+    fig, (ax,) = new_figure((max(7.0, 2.5 + 0.62 * len(b.values)), max(5.0, 1.8 + 0.42 * len(a.values))))
     ax.grid(False)
-    im = ax.pcolormesh(_edges(b.values), _edges(a.values), grid, shading="flat", cmap="viridis")
-    fig.colorbar(im, ax=ax, label=res.metric)
-    ax.set_xlabel(b.name)
-    ax.set_ylabel(a.name)
+    im = ax.pcolormesh(_edges(b.values), _edges(a.values), shown, shading="flat", cmap="viridis")
+    fig.colorbar(im, ax=ax, label=metric_label(res.metric, scale))
+    ax.set_xlabel(quantity_label(b, res.ship), parse_math=False)
+    ax.set_ylabel(quantity_label(a, res.ship), parse_math=False)
+    _ticks(ax.set_xticks, b.values)
+    _ticks(ax.set_yticks, a.values)
     extra = f" (first value of {res.variations[2].name})" if len(res.variations) > 2 else ""
     ax.set_title(title + extra, parse_math=False)
-    if grid.size <= 150:
+    if grid.size <= 200:
+        lo, hi = (float(np.min(shown[np.isfinite(shown)])), float(np.max(shown[np.isfinite(shown)]))) \
+            if finite.size else (0.0, 1.0)
         for i, av in enumerate(a.values):
             for j, bv in enumerate(b.values):
-                ax.text(bv, av, f"{grid[i, j]:.3g}", ha="center", va="center", fontsize=7, color="w")
+                v = shown[i, j]
+                light = np.isfinite(v) and hi > lo and (v - lo) / (hi - lo) > 0.6     # viridis: yellow end
+                ax.text(bv, av, f"{v:.2f}" if np.isfinite(v) else "-", ha="center", va="center",
+                        fontsize=7, color="k" if light else "w")
     save_figure(fig, stage / "heatmap.png")
+
+
+def _decade(x: float) -> int:
+    """Power of ten (a multiple of 3 beyond +-2) that brings ``x`` near 1-999 for cell labels."""
+    if not (np.isfinite(x) and x > 0):
+        return 0
+    e = int(math.floor(math.log10(x)))
+    return 0 if -1 <= e <= 2 else 3 * (e // 3)
+
+
+def _ticks(set_ticks, values) -> None:
+    """A tick at every grid value, or at every k-th when there are more than 12."""
+    values = np.asarray(values)
+    step = max(1, int(math.ceil(len(values) / 12)))
+    set_ticks(values[::step], [f"{v:g}" for v in values[::step]])
+
+
+def quantity_label(v: Variation, ship: str = "") -> str:
+    """``name [unit]`` of a varied quantity: the unit from its field description (a ship option's
+    from the ship's options model), else from its name's suffix (``_deg``, ``_kn``, ...)."""
+    if v.path[:2] == ("ship", "options") and len(v.path) == 3:
+        from steerlab.ships.registry import get_ship
+
+        model = get_ship(ship).options_model if ship else None
+        field = model.model_fields.get(v.path[2]) if model is not None else None
+        unit = _unit_in(field.description if field is not None else "")
+    else:
+        unit = _unit_of_path(v.path)
+    return f"{v.name} [{unit}]" if unit else v.name
+
+
+def metric_label(metric: str, scale: int = 0) -> str:
+    """``itae [deg s^2]`` (with a ``10^k`` factor when the cell labels are scaled)."""
+    from steerlab.tuning.cost import LOGGED, ONLINE
+
+    unit = ONLINE[metric][1] if metric in ONLINE else LOGGED.get(metric)
+    factor = f"10^{scale} " if scale else ""
+    if unit and unit != "-":
+        return f"{metric} [{factor}{unit}]"
+    return f"{metric} [{factor.strip()}]" if factor else metric
+
+
+def _unit_in(text: str | None):
+    import re
+
+    m = re.search(r"\[([^\]]+)\]", text or "")
+    return m.group(1) if m else None
+
+
+_SUFFIX_UNITS = (("_deg_s", "deg/s"), ("_m_s", "m/s"), ("_kn", "kn"), ("_deg", "deg"), ("_rpm", "rpm"),
+                 ("_s", "s"), ("_m", "m"))
+
+
+def _unit_of_path(path: tuple):
+    """The unit of a scenario field: from its pydantic description, else from its name's suffix."""
+    from steerlab.sim.scenario import Scenario
+
+    model, field = Scenario, None
+    for part in path:
+        field = getattr(model, "model_fields", {}).get(part)
+        if field is None:
+            break
+        model = field.annotation
+    unit = _unit_in(field.description) if field is not None else None
+    if unit:
+        return unit
+    for suffix, u in _SUFFIX_UNITS:
+        if path[-1].endswith(suffix):
+            return u
+    return None
 
 
 def _edges(v):

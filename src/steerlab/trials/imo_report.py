@@ -6,7 +6,7 @@ import base64
 import html
 from pathlib import Path
 
-from steerlab.trials.tables import ROWS, imo_rows
+from steerlab.trials.tables import ROWS, _v, imo_rows
 
 _CSS = """body{font-family:sans-serif;max-width:60em;margin:1em auto;padding:0 1em;color:#222}
 table{border-collapse:collapse;margin:.5em 0 1em}td,th{border:1px solid #ccc;padding:.2em .5em;text-align:left}
@@ -44,7 +44,7 @@ def write_imo_html(path: Path, report: dict, figures: dict) -> Path:
              f"<style>{_CSS}</style></head><body>",
              f"<h1>IMO manoeuvring trials: {_e(report['ship'])}</h1>",
              f"<p>Overall: {_verdict(report['overall_pass'])} (every applicable criterion).</p>",
-             _table([(k, v, "") for k, v in c.items()], ("condition", "value", "")),
+             _table([(k, _v(v), "") for k, v in c.items()], ("condition", "value", "")),
              "<h2>Criteria</h2>"]
     rows = "".join(f"<tr><td>{_e(x['trial'])}</td><td>{_e(x['criterion'])}</td><td>{x['value']:.4g}</td>"
                    f"<td>{x['limit']:.4g}</td><td>{_e(x['unit'])}</td><td>{_verdict(x['pass'])}</td>"
@@ -57,7 +57,7 @@ def write_imo_html(path: Path, report: dict, figures: dict) -> Path:
     parts.append("<p>Not assessed: " + "; ".join(_e(x) for x in report["not_assessed"]) + "</p>")
     cs = report["course_stability"]
     parts.append("<h2>Course stability (information; no IMO limit)</h2>")
-    parts.append(_table([(k, v, "") for k, v in cs.items()], ("quantity", "value", "")))
+    parts.append(_table([(k, _v(v), "") for k, v in cs.items()], ("quantity", "value", "")))
     for label, m in report["trials"].items():
         kind = m.get("trial_kind")
         parts.append(f"<h2>{_e(label)}</h2>")

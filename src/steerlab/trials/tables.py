@@ -15,6 +15,12 @@ def _v(x, fmt="{:.4g}"):
     return str(x)
 
 
+def _first_of(values, n: int = 6) -> str:
+    """The first ``n`` values (2 decimals) and how many there are in all."""
+    text = ", ".join(_v(o, "{:.2f}") for o in values[:n])
+    return text + (f", ... ({len(values)} in all; --json lists every one)" if len(values) > n else "")
+
+
 def turning_rows(m: dict) -> list[tuple[str, str, str]]:
     rows = [("rudder", _v(m["rudder_deg"]) + " " + m["direction"], "deg")]
     for k, lab in (("advance", "advance"), ("transfer", "transfer"), ("tactical_diameter", "tactical diameter"),
@@ -32,7 +38,7 @@ def zigzag_rows(m: dict) -> list[tuple[str, str, str]]:
     return [("zig-zag", f"{_v(m['rudder_deg'])}/{_v(m['heading_deg'])}, first rudder {m['first_rudder']}", "deg"),
             ("first overshoot", _v(m["first_overshoot_deg"]), "deg"),
             ("second overshoot", _v(m["second_overshoot_deg"]), "deg"),
-            ("overshoots", ", ".join(_v(o, "{:.2f}") for o in m["overshoot_angles_deg"]), "deg"),
+            ("overshoots", _first_of(m["overshoot_angles_deg"]), "deg"),
             ("time to second execute", _v(m["time_to_second_execute_s"]), "s"),
             ("period (first cycle)", _v(m["period_s"]), "s"),
             ("initial turning distance", _v(m["initial_turning_distance_L"]), "L"),
@@ -70,11 +76,29 @@ def imo_rows(criteria: list[dict]) -> list[tuple[str, str, str]]:
     return out
 
 
-def format_table(rows, title: str = "") -> str:
+def format_table(rows, title: str = "", width: int | None = None) -> str:
+    """Rows ``(quantity, value, unit)`` as aligned text that fits ``width`` columns.
+
+    ``width`` defaults to the terminal's (100 when not a terminal); a value too long for its
+    column (e.g. the list of every zig-zag overshoot) is wrapped onto continuation lines.
+    """
+    import shutil
+    import textwrap
+
+    if width is None:
+        width = shutil.get_terminal_size((100, 24)).columns
     w0 = max(len(r[0]) for r in rows)
-    w1 = max(len(r[1]) for r in rows)
+    w2 = min(max(len(r[2]) for r in rows), 20)
+    w1 = min(max(len(r[1]) for r in rows), max(20, width - w0 - w2 - 4))
+    w2 = max(10, width - w0 - w1 - 4)
     lines = [title] if title else []
-    lines += [f"{a:<{w0}}  {b:<{w1}}  {c}".rstrip() for a, b, c in rows]
+    for a, b, c in rows:
+        vals = textwrap.wrap(b, w1, break_on_hyphens=False) or [""]
+        units = textwrap.wrap(c, w2, break_on_hyphens=False) or [""]
+        for i in range(max(len(vals), len(units))):
+            v = vals[i] if i < len(vals) else ""
+            u = units[i] if i < len(units) else ""
+            lines.append(f"{a if i == 0 else '':<{w0}}  {v:<{w1}}  {u}".rstrip())
     return "\n".join(lines)
 
 

@@ -1,0 +1,213 @@
+"""Every example command runs: the examples of every subcommand's ``--help`` and every command
+in a ```sh block of README.md and docs/*.md.
+
+Each command is run as printed from a copy of the repository's ``examples/`` folder (the files
+the examples name), with smaller sizes where the command offers them (``--quick``, fewer runs,
+generations, repeats; real-time commands for a few ship seconds, faster than real time, on free
+loopback ports; an autopilot gets a ship server of its own). It must exit with 0.
+"""
+
+from __future__ import annotations
+
+import re
+import shlex
+import shutil
+import socket
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+REPO = Path(__file__).resolve().parent.parent
+PREFIXES = (("steerlab",), ("python3", "-m", "steerlab"), ("python", "-m", "steerlab"))
+
+
+def _join_continuations(lines):
+    out, cur = [], ""
+    for line in lines:
+        s = line.rstrip()
+        if s.endswith("\\"):
+            cur += s[:-1] + " "
+            continue
+        out.append(cur + s)
+        cur = ""
+    if cur:
+        out.append(cur)
+    return out
+
+
+def _steerlab_argv(text: str):
+    """The argv after ``steerlab`` and the environment assignments before it, or None."""
+    text = re.sub(r"\$\(cat (\S+)\)", r"@cat:\1@", text)     # VAR=$(cat FILE): the file's text
+    for part in text.split("&&"):
+        try:
+            tokens = shlex.split(part, comments=True)
+        except ValueError:
+            continue
+        env = {}
+        while tokens and re.match(r"^[A-Za-z_]\w*=", tokens[0]):
+            k, v = tokens.pop(0).split("=", 1)
+            env[k] = v
+        for pre in PREFIXES:
+            if tuple(tokens[:len(pre)]) == pre and len(tokens) > len(pre):
+                return env, tokens[len(pre):]
+    return None
+
+
+def help_examples():
+    """(label, env, argv) of every example line in every command's and subcommand's --help."""
+    from steerlab.cli import build_parser
+
+    parser = build_parser()
+    epilogs = {"steerlab": parser.epilog}
+    sub = next(a for a in parser._actions if a.__class__.__name__ == "_SubParsersAction")
+    for name, p in sub.choices.items():
+        epilogs[name] = p.epilog or ""
+        for a in p._actions:
+            if a.__class__.__name__ == "_SubParsersAction":
+                for n2, p2 in a.choices.items():
+                    epilogs[f"{name} {n2}"] = p2.epilog or ""
+    out, seen = [], set()
+    for name, epilog in epilogs.items():
+        for line in _join_continuations(epilog.splitlines()):
+            if not line.strip().startswith(("steerlab ", "STEERLAB_")):
+                continue
+            cmd = _steerlab_argv(line.strip())
+            if cmd and tuple(cmd[1]) not in seen:
+                seen.add(tuple(cmd[1]))
+                out.append((f"--help of {name}: {line.strip()}", *cmd))
+    return out
+
+
+def doc_examples():
+    """(label, env, argv) of every steerlab command in a ```sh block of README.md and docs/*.md."""
+    out = []
+    for path in [REPO / "README.md", *sorted((REPO / "docs").glob("*.md"))]:
+        text = path.read_text(encoding="utf-8")
+        for block in re.findall(r"^[ \t]*```sh\n(.*?)^[ \t]*```", text, flags=re.S | re.M):
+            for line in _join_continuations(block.splitlines()):
+                cmd = _steerlab_argv(line.strip())
+                if cmd:
+                    out.append((f"{path.name}: {line.strip()}", *cmd))
+    return out
+
+
+def _free_port() -> int:
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def _set(argv, flag, value):
+    """``flag value`` in argv (replaced when present, appended otherwise)."""
+    if flag in argv:
+        i = argv.index(flag)
+        return argv[:i + 1] + [str(value)] + argv[i + 2:]
+    return argv + [flag, str(value)]
+
+
+def _smaller(argv):
+    """The same command with the small sizes it offers (see the module docstring)."""
+    argv = list(argv)
+    cmd = argv[0]
+    if cmd == "experiment" and "--quick" not in argv:
+        argv.append("--quick")
+    if cmd == "bench":
+        argv = _set(_set(argv, "--n-batch", 16), "--repeats", 1)
+    if cmd == "montecarlo":
+        argv = _set(argv, "--runs", 8)
+    if cmd == "tune":
+        argv = _set(_set(argv, "--generations", 2), "--pop-size", 6)
+    if cmd in ("serve-ship", "autopilot"):
+        argv = _set(_set(argv, "--duration", 3), "--speedup", 20)
+    return argv
+
+
+def _ports(argv, server_port=None):
+    """Every 127.0.0.1:PORT -> a free port (47110, the ship server's, -> ``server_port``)."""
+    mapping = {}
+
+    def sub(m):
+        port = m.group(1)
+        if port == "47110" and server_port:
+            return f"127.0.0.1:{server_port}"
+        mapping.setdefault(port, _free_port())
+        return f"127.0.0.1:{mapping[port]}"
+
+    return [re.sub(r"127\.0\.0\.1:(\d+)", sub, a) for a in argv]
+
+
+def _env(env_assign, workdir):
+    import os
+
+    env = dict(os.environ, MPLBACKEND="Agg")
+    for k, v in env_assign.items():
+        m = re.fullmatch(r"@cat:(\S+)@", v)
+        env[k] = (workdir / m.group(1)).read_text().strip() if m else v
+    return env
+
+
+def _run(label, env_assign, argv, workdir):
+    env = _env(env_assign, workdir)
+    argv = _smaller(argv)
+    server = None
+    if argv[0] == "autopilot":
+        port = _free_port()
+        scen = [argv[argv.index("--scenario") + 1]] if "--scenario" in argv else []
+        server = subprocess.Popen([sys.executable, "-m", "steerlab", "serve-ship", *scen, "--bind",
+                                   f"127.0.0.1:{port}", "--speedup", "20", "--duration", "2000", "--quiet"],
+                                  cwd=workdir, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+        argv = _ports(argv, port)
+        time.sleep(1.0)
+    else:
+        argv = _ports(argv)
+    try:
+        proc = subprocess.run([sys.executable, "-m", "steerlab", *argv], cwd=workdir, env=env,
+                              capture_output=True, text=True, timeout=600, stdin=subprocess.DEVNULL)
+    finally:
+        if server is not None:
+            server.terminate()
+            server.wait(timeout=30)
+    assert proc.returncode == 0, f"{label}\n  ran: steerlab {shlex.join(argv)}\n{proc.stderr[-2000:]}"
+
+
+def test_the_example_files_exist_and_the_parsers_find_the_examples():
+    helps, docs = help_examples(), doc_examples()
+    cmds = {a[0] for _, _, a in helps}
+    # every command with an epilog contributes; the docs contribute their command blocks
+    assert {"run", "tune", "montecarlo", "robustness", "sea", "identify", "serve-ship", "autopilot",
+            "trial", "imo", "ships"} <= cmds
+    assert len(docs) >= 10
+    for label, _, argv in helps + docs:
+        for a in argv:
+            if a.startswith("examples/") and not a.endswith("/"):
+                assert (REPO / a).exists(), f"{label}: {a} does not exist"
+        for stale in ("scen.toml", "my.toml", "my_scenario.toml", "my-scenario.toml", "SCENARIO.toml"):
+            assert stale not in argv, f"{label}: names {stale}, which is not shipped"
+
+
+@pytest.fixture(scope="module")
+def workdir(tmp_path_factory):
+    d = tmp_path_factory.mktemp("examples-cwd")
+    shutil.copytree(REPO / "examples", d / "examples")
+    return d
+
+
+def all_examples():
+    """Help and doc examples, each distinct command once."""
+    out, seen = [], set()
+    for label, env, argv in help_examples() + doc_examples():
+        key = (tuple(sorted(env.items())), tuple(argv))
+        if key not in seen:
+            seen.add(key)
+            out.append((label, env, argv))
+    return out
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("label,env,argv", all_examples(),
+                         ids=lambda v: v if isinstance(v, str) else None)
+def test_example_command_runs(label, env, argv, workdir):
+    _run(label, env, argv, workdir)
