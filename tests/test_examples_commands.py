@@ -122,6 +122,8 @@ def _smaller(argv):
         argv = _set(_set(argv, "--generations", 2), "--pop-size", 6)
     if cmd in ("serve-ship", "autopilot"):
         argv = _set(_set(argv, "--duration", 3), "--speedup", 20)
+    if cmd == "cache" and "warm" in argv:
+        argv = _set(_set(argv, "--ships", "nomoto1"), "--controllers", "pid")
     return argv
 
 
@@ -151,6 +153,9 @@ def _env(env_assign, workdir):
 
 def _run(label, env_assign, argv, workdir):
     env = _env(env_assign, workdir)
+    if argv[0] == "cache" and "STEERLAB_CACHE_DIR" not in env_assign:
+        # never clear or fill the cache the rest of the suite (and the user) runs on
+        env["STEERLAB_CACHE_DIR"] = str(workdir / "private-cache")
     argv = _smaller(argv)
     server = None
     if argv[0] == "autopilot":
