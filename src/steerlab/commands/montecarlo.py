@@ -41,6 +41,9 @@ def cmd_montecarlo(args) -> int:
 
     say = _progress(args.quiet)
     scenario = load_scenario(args.scenario)
+    from steerlab.commands._guard import design_checked
+
+    design_checked(scenario)
     executor = executor_from_args(args)
     try:
         res = run_montecarlo(scenario, args.runs, args.lam, args.record_every, executor, say)

@@ -49,6 +49,9 @@ def cmd_robustness(args) -> int:
 
     say = _progress(args.quiet)
     scenario = with_controller(load_scenario(args.scenario), args.controller)
+    from steerlab.commands._guard import design_checked
+
+    design_checked(scenario)
     variations = [parse_vary(v, scenario) for v in args.vary]
     executor = executor_from_args(args)
     try:
