@@ -179,6 +179,8 @@ def _structural(rng: random.Random, d: dict) -> None:
         tables = [d] + [v for v in d.values() if isinstance(v, dict)]
         rng.choice(tables)["unknwon_key"] = 1.0
     elif kind == "ship":
+        if not isinstance(d.get("ship", {}), dict):
+            return
         d.setdefault("ship", {})["model"] = rng.choice(SHIPS)
         if rng.random() < 0.5:
             d["ship"].pop("speed_kn", None)

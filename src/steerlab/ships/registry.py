@@ -159,4 +159,6 @@ def get_ship(name: str) -> ShipSpec:
     try:
         return _discover()[name]
     except KeyError:
-        raise InputError("ship.model", f"unknown ship {name!r}; known ships: {sorted(_discover())}") from None
+        known = sorted(_discover())
+        raise InputError("ship.model", f"unknown ship {str(name)[:60]!r}; {len(known)} known ('steerlab ships' "
+                                       f"lists them): {', '.join(known)}") from None

@@ -51,7 +51,7 @@ _Frozen = FrozenConfig
 
 class ShipConfig(_Frozen):
     model: str = "esso"
-    speed_kn: float = Field(16.0, gt=0.0, le=40.0, description="approach speed [kn]")
+    speed_kn: float = Field(16.0, ge=0.01, le=40.0, description="approach speed [kn], 0.01-40 kn")
     rpm: Optional[float] = Field(None, gt=0.0, le=1000.0,
                                  description="propeller rate [rpm]; default: the rate that holds speed_kn")
     options: dict[str, Any] = Field(
