@@ -3,7 +3,8 @@
 Every command accepts ``--help`` with examples. Bad input (unknown ship or controller,
 out-of-range or NaN fields, malformed TOML) prints one line naming the field and the allowed
 range and exits with code 2, leaving nothing in ``--out``: outputs are written to a staging
-directory first and moved into place only when everything succeeded.
+directory first and moved into place only when everything succeeded. A run that diverged
+(non-finite state) or spun exits with code 3 and writes nothing (docs/errors.md).
 """
 
 from __future__ import annotations
