@@ -124,8 +124,8 @@ class SlidingModeConfig(FrozenConfig):
     poles: Optional[tuple[float, float, float]] = Field(
         None, description="[rad/s] closed-loop poles on s = 0; default (-0.05, -1/T2, -1/T_R)")
     design_loading: Optional[str] = None
-    design_T2: Optional[float] = Field(None, ge=0.01, le=1e3,
-                                      description="[s], 0.01-1000 s, other ships; default gear T_sg")
+    design_T2: Optional[float] = Field(None, ge=0.001, le=1e3,
+                                      description="[s], 0.001-1000 s, other ships; default gear T_sg")
     u_max_deg: Optional[float] = Field(None, gt=0.0, le=90.0, description="default: gear limit")
     sample_time: Optional[float] = Field(None, gt=0.0, le=60.0, description="default: dt")
 

@@ -61,7 +61,7 @@ class ShipConfig(_Frozen):
 class GearConfig(_Frozen):
     delta_max_deg: float = Field(35.0, gt=0.0, le=90.0)
     rate_max_deg_s: float = Field(2.33, gt=0.0, le=100.0)
-    T_sg: float = Field(1.0, ge=0.01, le=100.0, description="servo time constant [s], 0.01-100 s")
+    T_sg: float = Field(1.0, ge=0.001, le=100.0, description="servo time constant [s], 0.001-100 s")
     dead_zone_deg: float = Field(0.0, ge=0.0, le=10.0)
 
 
