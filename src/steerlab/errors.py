@@ -42,11 +42,12 @@ class DivergedError(RuntimeError):
     ``hint`` the likely cause.
     """
 
-    def __init__(self, time: float, what: str, hint: str):
+    def __init__(self, time: float | None, what: str, hint: str):
         self.time = time
         self.what = what
         self.hint = hint
-        super().__init__(f"the run diverged at t = {time:g} s ({what}); {hint}")
+        at = "" if time is None else f" at t = {time:g} s"
+        super().__init__(f"the run diverged{at} ({what}); {hint}")
 
 
 EXIT_BAD_INPUT = 2      #: bad input: one line naming the field (InputError)

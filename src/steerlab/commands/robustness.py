@@ -58,6 +58,11 @@ def cmd_robustness(args) -> int:
         res = run_robustness(scenario, variations, args.metric, args.lam, args.redesign, executor, say)
     finally:
         executor.close()
+    if "diverged" in res.table:
+        from steerlab.commands._guard import warn
+
+        warn([f"grid: {int(res.table['diverged'].sum())} of {len(res.points)} points diverged (non-finite "
+              "state): metric inf, flagged in table.csv (column diverged)"])
     with staged_output(Path(args.out)) as stage:
         write_robustness_outputs(stage, res, scenario.name)
     names = [v.name for v in res.variations]
