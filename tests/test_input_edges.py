@@ -271,3 +271,26 @@ def test_identify_marks_a_bad_fit_and_poorly_determined_parameters(tmp_path, cap
     assert set(s["quality"]["poorly_determined"]) == {"K", "T"}
     assert all(p["poorly_determined"] for p in s["parameters"])
     assert "BAD FIT" in cap.err and "poorly determined" in cap.err
+
+
+def test_montecarlo_leaves_diverged_runs_out_and_flags_them():
+    """A fake executor returns one diverged run of three: its metrics are NaN, the others count."""
+    from steerlab.metrics_online import N_ACC
+    from steerlab.sweeps.montecarlo import run_montecarlo
+    from steerlab.sweeps.packed import BatchOutput
+
+    class Fake:
+        def run(self, batch, record_every, progress=None):
+            n, nx = batch.X.shape
+            n_rec = batch.n_steps // record_every + 1
+            acc = np.ones((n, N_ACC))
+            fs = np.zeros((n, nx))
+            fs[1, 4] = np.nan
+            states = np.zeros((n, n_rec, nx))
+            return BatchOutput(acc, fs, np.arange(n_rec) * record_every * batch.dt, states,
+                               np.zeros((n, n_rec)), np.zeros((n, n_rec, 2)))
+
+    res = run_montecarlo(make_scenario(duration=50.0), 3, record_every=10, executor=Fake())
+    assert res.diverged.tolist() == [False, True, False] and res.n_diverged == 1
+    assert np.isnan(res.per_run["iae_deg_s"][1]) and np.isfinite(res.per_run["iae_deg_s"][[0, 2]]).all()
+    assert res.stats["iae_deg_s"]["n"] == 2 and res.stats["iae_deg_s"]["n_undefined"] == 1
