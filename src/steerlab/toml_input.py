@@ -53,6 +53,9 @@ def _scan(text: str, field: str, name: str) -> None:
                     break
                 j += 1
             line += text.count("\n", i, j)
+            if j < n and not triple and text[j] == "\n":   # an unterminated string: the parser reports it
+                i = j
+                continue
             i = j + len(end)
             continue
         elif c in "[{":
