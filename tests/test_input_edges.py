@@ -4,7 +4,6 @@ divergence and spin checks, diverged batch runs, tuning and identification warni
 from __future__ import annotations
 
 import json
-import math
 import subprocess
 import sys
 
@@ -220,7 +219,7 @@ def test_batch_flags_diverged_runs():
     assert br.diverged.tolist() == [False, True, True]
 
 
-def test_population_evaluator_gives_diverged_runs_an_infinite_cost():
+def test_population_evaluator_gives_diverged_runs_the_penalty():
     from steerlab.tuning import evaluator as ev_mod
 
     ev = ev_mod.PopulationEvaluator.__new__(ev_mod.PopulationEvaluator)
@@ -233,8 +232,8 @@ def test_population_evaluator_gives_diverged_runs_an_infinite_cost():
     ev.costs = [lambda m: m["itae"]]
     ev.aggregate = "mean"
     pc = ev.per_condition_costs(np.zeros((1, 1)))
-    assert pc[0, 0, 0] == 1.0 and math.isinf(pc[0, 0, 1])
-    assert ev(np.zeros((1, 1)))[0, 0] == ev_mod.PENALTY
+    assert pc[0, 0, 0] == 1.0 and pc[0, 0, 1] == ev_mod.PENALTY
+    assert ev(np.zeros((1, 1)))[0, 0] == pytest.approx(0.5 * (1.0 + ev_mod.PENALTY))
 
 
 def test_tuning_warns_of_an_optimum_on_its_bound():

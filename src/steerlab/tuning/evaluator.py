@@ -95,7 +95,8 @@ class PopulationEvaluator:
         """Costs (P, n_objectives, C)."""
         m = self.metrics(X)
         costs = np.stack([np.asarray(c(m), dtype=float) for c in self.costs], axis=1)
-        return np.where(self.last_diverged[:, None, :], np.inf, costs)   # -> PENALTY when aggregated
+        # a diverged run failed: the penalty of any non-finite cost, whatever its metrics say
+        return np.where(self.last_diverged[:, None, :], PENALTY, costs)
 
     def __call__(self, X) -> np.ndarray:
         """Aggregated costs (P, n_objectives); non-finite -> PENALTY."""
