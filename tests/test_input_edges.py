@@ -142,10 +142,10 @@ def test_design_guard_turns_an_unexpected_exception_into_one_line(tmp_path, caps
     """The last-resort net: an exception the bounds missed, in the design, is exit 2 naming the stage."""
     import steerlab.sim.setup as setup_mod
 
-    def broken(cfg, ctx):
+    def broken(scenario):
         raise ZeroDivisionError("float division by zero")
 
-    monkeypatch.setattr(setup_mod, "controller_params", broken)
+    monkeypatch.setattr(setup_mod, "build", broken)     # the design (called by the guarded preflight)
     p = _write(tmp_path, '[controller]\ntype = "pid"\n')
     assert main(["run", str(p), "--out", str(tmp_path / "o"), "--quiet"]) == 2
     err = capsys.readouterr().err
