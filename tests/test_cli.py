@@ -83,7 +83,7 @@ def test_dt_out_of_range_names_bound(tmp_path, capsys):
     p.write_text('dt = 0.0\n[controller]\ntype = "pid"\n')
     assert main(["run", str(p), "--out", str(tmp_path / "o")]) == 2
     err = capsys.readouterr().err
-    assert "dt" in err and "greater than 0" in err
+    assert "dt" in err and "greater than or equal to 0.0001" in err   # the lower bound 1e-4 s (issue 15)
 
 
 def test_malformed_toml(tmp_path, capsys):

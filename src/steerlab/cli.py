@@ -3,7 +3,8 @@
 Every command accepts ``--help`` with examples. Bad input (unknown ship or controller,
 out-of-range or NaN fields, malformed TOML) prints one line naming the field and the allowed
 range and exits with code 2, leaving nothing in ``--out``: outputs are written to a staging
-directory first and moved into place only when everything succeeded.
+directory first and moved into place only when everything succeeded. A run that diverged
+(non-finite state) or spun exits with code 3 and writes nothing (docs/errors.md).
 """
 
 from __future__ import annotations
@@ -14,10 +15,17 @@ import sys
 import time
 from pathlib import Path
 
-from steerlab.errors import InputError
+from steerlab.errors import EXIT_BAD_INPUT, EXIT_DIVERGED, DivergedError, InputError
 from steerlab.outputs import _clean, _json_default, dump_json, staged_output  # noqa: F401 (re-exported)
 
-EXIT_BAD_INPUT = 2
+MAX_MESSAGE = 300   #: longest error or warning line [characters]
+
+
+def one_line(text: str, limit: int = MAX_MESSAGE) -> str:
+    """``text`` as one printable line of at most ``limit`` characters (control characters,
+    newlines and terminal escapes shown escaped; the rest cut with "...")."""
+    out = "".join(c if c.isprintable() else c.encode("unicode_escape").decode("ascii") for c in str(text))
+    return out if len(out) <= limit else out[:limit - 3] + "..."
 
 
 def _progress(quiet: bool):
@@ -37,8 +45,9 @@ def cmd_run(args) -> int:
     from steerlab.metrics import METRIC_UNITS, compute_metrics
     from steerlab.report import format_metrics_table, write_run_report
     from steerlab.sim.engine import simulate
+    from steerlab.commands._guard import design_checked
+    from steerlab.sim.divergence import check_run
     from steerlab.sim.scenario import default_scenario, default_scenario_path, load_scenario
-    from steerlab.sim.setup import build
 
     say = _progress(args.quiet)
     path = Path(args.scenario) if args.scenario else default_scenario_path()
@@ -47,19 +56,21 @@ def cmd_run(args) -> int:
         scenario = scenario.replace(seed=args.seed)
     if not (args.lam >= 0.0 and math.isfinite(args.lam)):
         raise InputError("--lambda", f"must be a finite number >= 0, got {args.lam}")
-    say(f"scenario {scenario.name!r} from {path}")
-    setup = build(scenario)
+    say(f"scenario {one_line(scenario.name, 80)!r} from {path}")
+    setup, warnings = design_checked(scenario)
     say(f"simulating {setup.n_steps} steps of {setup.dt} s with the {args.engine} engine "
         f"({setup.ship.name} + {setup.controller.name})")
     result = simulate(setup, engine=args.engine)
+    check_run(result, setup)                  # a diverged run or a spin: exit 3, no metrics
     metrics = compute_metrics(result, lam=args.lam)
     say("writing time series, metrics, figures and report")
     with staged_output(Path(args.out)) as stage:
         result.to_csv(stage / "timeseries.csv")
         if args.parquet:
             result.to_parquet(stage / "timeseries.parquet")
+        extra = {"warnings": warnings} if warnings else {}
         dump_json({"scenario": scenario.name, "seed": scenario.seed, "engine": args.engine,
-                   "metrics": metrics, "units": {k: METRIC_UNITS.get(k, "") for k in metrics}},
+                   "metrics": metrics, "units": {k: METRIC_UNITS.get(k, "") for k in metrics}, **extra},
                   stage / "metrics.json", digits=None)
         (stage / "scenario.json").write_text(scenario.model_dump_json(indent=2) + "\n", encoding="utf-8")
         write_run_report(stage, result, metrics, scenario)
@@ -235,8 +246,11 @@ def main(argv=None) -> int:
     try:
         return args.func(args)
     except InputError as err:
-        print(f"steerlab: error: {err}", file=sys.stderr)
+        print(f"steerlab: error: {one_line(err)}", file=sys.stderr)
         return EXIT_BAD_INPUT
+    except DivergedError as err:
+        print(f"steerlab: error: {one_line(err, 2 * MAX_MESSAGE)}", file=sys.stderr)
+        return EXIT_DIVERGED
     except KeyboardInterrupt:
         print("steerlab: interrupted", file=sys.stderr)
         return 130

@@ -32,3 +32,23 @@ def require_finite_range(field: str, value, lo=None, hi=None, lo_open=False, hi_
     if hi is not None and (v > hi or (hi_open and v == hi)):
         raise InputError(field, f"{v!r} is out of range; allowed range {rng}")
     return v
+
+
+class DivergedError(RuntimeError):
+    """A run whose state left the finite numbers (or whose ship spun away from its reference).
+
+    The CLI prints it as one line and exits with code 3 (:data:`EXIT_DIVERGED`); no metrics
+    are reported for it. ``time`` [s] is when it happened, ``what`` the state or check,
+    ``hint`` the likely cause.
+    """
+
+    def __init__(self, time: float | None, what: str, hint: str):
+        self.time = time
+        self.what = what
+        self.hint = hint
+        at = "" if time is None else f" at t = {time:g} s"
+        super().__init__(f"the run diverged{at} ({what}); {hint}")
+
+
+EXIT_BAD_INPUT = 2      #: bad input: one line naming the field (InputError)
+EXIT_DIVERGED = 3       #: the run diverged or the ship spun (DivergedError)

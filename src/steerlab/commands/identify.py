@@ -78,11 +78,26 @@ def run(args) -> int:
     else:
         print(f"model {fit.model}, fitted on {fit.fitted_on}; RMS yaw rate {fit.rms_yaw_rate_deg_s:.4g} deg/s"
               + (f", heading {fit.rms_heading_deg:.4g} deg" if fit.rms_heading_deg == fit.rms_heading_deg else ""))
+        q = summary["quality"]
         for p in summary["parameters"]:
             ci = f"+- {p['ci95']:.4g}" if p["ci95"] is not None else f"(fixed: {p['fixed_by']})"
-            print(f"  {p['name']:<3} = {p['value']:<12.6g} {ci:<22} [{p['unit']}]")
+            flag = ""
+            if p["fixed_by"] is None and q["fit"] == "bad":
+                flag = "  NOT MEANINGFUL (bad fit)"
+            elif p.get("poorly_determined"):
+                flag = "  POORLY DETERMINED"
+            print(f"  {p['name']:<3} = {p['value']:<12.6g} {ci:<22} [{p['unit']}]{flag}")
         if fit.spiral is not None:
             print(f"  spiral from {len(fit.spiral.points)} steady turns, rudder RMS "
                   f"{fit.spiral.rms * 57.29577951308232:.3g} deg")
         print(f"  ({summary['ci_note']})")
+    from steerlab.commands._guard import warn
+
+    q = summary["quality"]
+    if q["fit"] == "bad":
+        warn([f"fit: BAD FIT ({'; '.join(q['reasons'])}): the model does not describe the record, its "
+              "intervals mean nothing"])
+    if q["poorly_determined"]:
+        warn([f"parameters: {', '.join(q['poorly_determined'])} poorly determined (95 % interval wider than "
+              f"{q['thresholds']['max_relative_ci95']:.0%} of the value): the record does not excite them"])
     return 0

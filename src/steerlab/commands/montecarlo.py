@@ -41,11 +41,25 @@ def cmd_montecarlo(args) -> int:
 
     say = _progress(args.quiet)
     scenario = load_scenario(args.scenario)
+    from steerlab.commands._guard import design_checked
+
+    design_checked(scenario)
     executor = executor_from_args(args)
     try:
         res = run_montecarlo(scenario, args.runs, args.lam, args.record_every, executor, say)
     finally:
         executor.close()
+    if res.n_diverged:
+        from steerlab.commands._guard import warn
+        from steerlab.errors import DivergedError
+        from steerlab.sim.divergence import likely_cause
+        from steerlab.sim.setup import build
+
+        if res.n_diverged == len(res.seeds):
+            raise DivergedError(None, f"all {len(res.seeds)} runs left the finite numbers",
+                                likely_cause(build(scenario)))
+        warn([f"runs: {res.n_diverged} of {len(res.seeds)} runs diverged (non-finite state); left out of the "
+              "statistics and the bands, flagged in runs.csv (column diverged)"])
     with staged_output(Path(args.out)) as stage:
         write_montecarlo_outputs(stage, res, scenario.name)
     print(f"{len(res.seeds)} runs, seeds {res.seeds[0]}..{res.seeds[-1]}")

@@ -49,12 +49,20 @@ def cmd_robustness(args) -> int:
 
     say = _progress(args.quiet)
     scenario = with_controller(load_scenario(args.scenario), args.controller)
+    from steerlab.commands._guard import design_checked
+
+    design_checked(scenario)
     variations = [parse_vary(v, scenario) for v in args.vary]
     executor = executor_from_args(args)
     try:
         res = run_robustness(scenario, variations, args.metric, args.lam, args.redesign, executor, say)
     finally:
         executor.close()
+    if "diverged" in res.table:
+        from steerlab.commands._guard import warn
+
+        warn([f"grid: {int(res.table['diverged'].sum())} of {len(res.points)} points diverged (non-finite "
+              "state): metric inf, flagged in table.csv (column diverged)"])
     with staged_output(Path(args.out)) as stage:
         write_robustness_outputs(stage, res, scenario.name)
     names = [v.name for v in res.variations]

@@ -36,12 +36,12 @@ def run(args) -> int:
     from steerlab.environment.channels import CHANNEL_NAMES, CHANNEL_UNITS
     from steerlab.environment.sea_report import (has_wind, spectrum_figure, timeseries_figure, wave_analysis,
                                                  wind_current_summary, wind_rose_figure)
+    from steerlab.commands._guard import design_checked
     from steerlab.sim.scenario import default_scenario, load_scenario
-    from steerlab.sim.setup import build
 
     say = _progress(args.quiet)
     scenario = load_scenario(args.scenario) if args.scenario else default_scenario()
-    setup = build(scenario)
+    setup, _ = design_checked(scenario)
     say(f"sampled {setup.n_steps + 1} steps of the sea of {scenario.name!r} (seed {scenario.seed})")
     analysis = wave_analysis(scenario, setup)
     t = np.arange(setup.n_steps + 1) * setup.dt

@@ -65,6 +65,10 @@ def cmd_tune(args) -> int:
 
     say = _progress(args.quiet)
     scenario = load_scenario(args.scenario)
+    from steerlab.commands._guard import design_checked
+    from steerlab.tuning.session import with_controller
+
+    design_checked(with_controller(scenario, args.controller))
     names = [n.strip() for n in args.params.split(",") if n.strip()]
     if not names:
         raise InputError("--params", "needs at least one parameter name")
@@ -92,5 +96,8 @@ def cmd_tune(args) -> int:
         print(f"  cost {c!r}: {v:.6g}")
     if "front" in s:
         print(f"  Pareto front: {len(s['front'])} points (front.csv, pareto_front.png)")
+    from steerlab.commands._guard import warn
+
+    warn(s.get("warnings", ()))
     say(f"wrote {args.out}/result.json")
     return 0

@@ -121,7 +121,7 @@ class ADRCConfig(FrozenConfig):
     """``[controller] type = "adrc"`` in a scenario."""
 
     type: Literal["adrc"]
-    T_settle: float = Field(150.0, gt=0.0, le=1e5, description="settling time of (38) [s]")
+    T_settle: float = Field(150.0, ge=1.0, le=1e5, description="settling time of (38) [s], 1-1e5 s")
     c0: Union[float, Literal["estimate", "exact"]] = "estimate"
     observer: Literal["paper", "bandwidth", "lqr"] = "paper"
     observer_bandwidth: float = Field(0.5, gt=0.0, le=100.0, description="[rad/s] for observer='bandwidth'")

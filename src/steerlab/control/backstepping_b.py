@@ -86,7 +86,8 @@ class BacksteppingBConfig(FrozenConfig):
     k3: float = Field(0.001, gt=0.0, le=1e6)
     k4: float = Field(0.001, gt=0.0, le=1e6)
     design_loading: Optional[str] = Field(None, description="Van Leeuwen ships: loading of the design model")
-    design_T2: Optional[float] = Field(None, gt=0.0, le=1e3, description="[s] other ships; default gear T_sg")
+    design_T2: Optional[float] = Field(None, ge=0.001, le=1e3,
+                                      description="[s], 0.001-1000 s, other ships; default gear T_sg")
     gain_time: Literal["s", "ship"] = Field("s", description="time unit of the gains: 1 s or L/U")
     u_max_deg: Optional[float] = Field(None, gt=0.0, le=90.0, description="default: gear limit")
     sample_time: Optional[float] = Field(None, gt=0.0, le=60.0, description="default: dt")

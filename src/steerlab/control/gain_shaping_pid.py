@@ -59,7 +59,7 @@ class GainShapingPIDConfig(FrozenConfig):
     """``[controller] type = "gain_shaping_pid"``."""
 
     type: Literal["gain_shaping_pid"]
-    T01: float = Field(20.0, gt=0.0, le=1e5, description="closed-loop time constant of (18) [s]")
+    T01: float = Field(20.0, ge=0.1, le=1e5, description="closed-loop time constant of (18) [s], 0.1-1e5 s")
     K: Optional[float] = Field(None, gt=0.0, le=100.0, description="design K [1/s]; default: ship's Nomoto K")
     T: Optional[float] = Field(None, gt=0.0, le=1e5, description="design T [s]; default: ship's Nomoto T")
     u_max_deg: Optional[float] = Field(None, gt=0.0, le=90.0, description="default: gear limit")

@@ -191,10 +191,10 @@ class ItaePIDConfig(FrozenConfig):
     """``[controller] type = "itae_pid"`` (degrees and knots only at this edge)."""
 
     type: Literal["itae_pid"]
-    t_r: float = Field(53.0, gt=0.0, le=1e5, description="2 % settling time [s] (paper: 38, 48, 53 s)")
+    t_r: float = Field(53.0, ge=1.0, le=1e5, description="2 % settling time [s], 1-1e5 s (paper: 38, 48, 53 s)")
     K: Optional[float] = Field(None, gt=0.0, le=100.0, description="design k_m [1/s]; default: ship's Nomoto K")
     T: Optional[float] = Field(None, gt=0.0, le=1e5, description="design T_m [s]; default: ship's Nomoto T")
-    design_speed_kn: Optional[float] = Field(None, gt=0.0, le=40.0,
+    design_speed_kn: Optional[float] = Field(None, ge=0.01, le=40.0,
                                              description="V_m of eq (2) [kn]; default: ship.speed_kn")
     schedule: bool = True
     v_min_fraction: float = Field(0.3, gt=0.0, le=1.0, description="scheduling speed floor / V_m")

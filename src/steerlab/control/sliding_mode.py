@@ -57,7 +57,18 @@ def sliding_surface_design(A, b, poles):
     b = np.asarray(b, dtype=float).reshape(-1, 1)
     import control
 
-    k = np.asarray(control.acker(A, b, [0.0, *poles]), dtype=float).ravel()
+    if not (np.all(np.isfinite(A)) and np.all(np.isfinite(b))):
+        raise InputError("controller.poles", "the design model is not finite (a time constant, gain or speed "
+                                             "too small or too large for the sliding-mode design)")
+    try:
+        k = np.asarray(control.acker(A, b, [0.0, *poles]), dtype=float).ravel()
+    except (ValueError, np.linalg.LinAlgError):
+        raise InputError("controller.poles", "pole placement failed: the design model is not controllable in "
+                                             "floating point (a time constant, gain or speed too small or "
+                                             "too large)") from None
+    if not np.all(np.isfinite(k)):
+        raise InputError("controller.poles", "pole placement gave non-finite gains (a time constant, gain or "
+                                             "speed too small or too large)")
     Ac = A - b @ k.reshape(1, -1)
     w, V = np.linalg.eig(Ac.T)
     i = int(np.argmin(np.abs(w)))
@@ -114,7 +125,8 @@ class SlidingModeConfig(FrozenConfig):
     poles: Optional[tuple[float, float, float]] = Field(
         None, description="[rad/s] closed-loop poles on s = 0; default (-0.05, -1/T2, -1/T_R)")
     design_loading: Optional[str] = None
-    design_T2: Optional[float] = Field(None, gt=0.0, le=1e3, description="[s] other ships; default gear T_sg")
+    design_T2: Optional[float] = Field(None, ge=0.001, le=1e3,
+                                      description="[s], 0.001-1000 s, other ships; default gear T_sg")
     u_max_deg: Optional[float] = Field(None, gt=0.0, le=90.0, description="default: gear limit")
     sample_time: Optional[float] = Field(None, gt=0.0, le=60.0, description="default: dt")
 

@@ -73,11 +73,10 @@ def check_route(route, field: str = "guidance.route") -> np.ndarray:
 
 def read_route_csv(path) -> np.ndarray:
     """Waypoints from a CSV file: two columns ``x_n, y_e`` [m]; an optional header line; ``#`` comments."""
+    from steerlab.textfile import read_user_text
+
     p = Path(path)
-    try:
-        text = p.read_text(encoding="utf-8")
-    except OSError as err:
-        raise InputError("guidance.route_file", f"cannot read {str(p)!r}: {err.strerror}") from None
+    text = read_user_text(p, "guidance.route_file", 16 << 20)
     rows = []
     for n, row in enumerate(csv.reader(line for line in text.splitlines()
                                        if line.strip() and not line.lstrip().startswith("#"))):
@@ -86,7 +85,7 @@ def read_route_csv(path) -> np.ndarray:
         except ValueError:
             if n == 0 and not rows:
                 continue          # header
-            raise InputError("guidance.route_file", f"{p.name}: row {n + 1} is not two numbers: {row}") from None
+            raise InputError("guidance.route_file", f"{p.name}: row {n + 1} is not two numbers: {str(row)[:80]}") from None
         if len(vals) != 2:
             raise InputError("guidance.route_file", f"{p.name}: row {n + 1} needs 2 columns (x_n, y_e), got {len(vals)}")
         rows.append(vals)

@@ -38,6 +38,14 @@ UNITS = {"K": "1/s", "T": "s", "T1": "s", "T2": "s", "T3": "s", "n0": "rad/s", "
          "c2": "s^2/rad", "c3": "s^3/rad^2"}
 
 
+MAX_NRMSE = 0.3
+"""A fit whose RMS residual exceeds this fraction of the fitted signal's standard deviation is bad."""
+MAX_HEADING_RMS_DEG = 10.0
+"""A fit whose heading RMS error exceeds this [deg] is bad."""
+MAX_REL_CI = 0.5
+"""A parameter whose 95 % half-width exceeds this fraction of its magnitude is poorly determined."""
+
+
 @dataclass
 class FitResult:
     """Identified parameters (SI) with 95 % intervals, the fit quality and the responses."""
@@ -55,6 +63,30 @@ class FitResult:
     psi_model: np.ndarray = field(repr=False)
     r_model: np.ndarray = field(repr=False)
     packed: np.ndarray = field(repr=False)
+    target_std: float = math.nan       # standard deviation of the fitted signal [rad/s or rad]
+
+    def quality(self) -> dict:
+        """How far the numbers can be trusted (thresholds :data:`MAX_REL_CI`, :data:`MAX_NRMSE`,
+        :data:`MAX_HEADING_RMS_DEG`).
+
+        ``nrmse`` = RMS residual / standard deviation of the fitted signal; the fit is ``bad``
+        when ``nrmse > MAX_NRMSE`` or the heading RMS error exceeds ``MAX_HEADING_RMS_DEG``:
+        the model does not describe the record, so its intervals (which assume white residuals)
+        mean nothing. A fitted parameter is ``poorly determined`` when its 95 % half-width
+        exceeds ``MAX_REL_CI`` of its magnitude (or is not finite).
+        """
+        nrmse = self.rms / self.target_std if self.target_std > 0 else math.nan
+        reasons = []
+        if math.isfinite(nrmse) and nrmse > MAX_NRMSE:
+            reasons.append(f"RMS residual is {nrmse:.2f} of the signal's spread (> {MAX_NRMSE:g})")
+        if math.isfinite(self.rms_heading_deg) and self.rms_heading_deg > MAX_HEADING_RMS_DEG:
+            reasons.append(f"heading RMS error {self.rms_heading_deg:.3g} deg (> {MAX_HEADING_RMS_DEG:g} deg)")
+        poor = [k for k, h in self.ci95.items()
+                if not (math.isfinite(h) and abs(h) <= MAX_REL_CI * abs(self.params.get(k, math.nan)))]
+        return {"fit": "bad" if reasons else "ok", "nrmse": nrmse, "reasons": reasons,
+                "poorly_determined": poor,
+                "thresholds": {"max_nrmse": MAX_NRMSE, "max_heading_rms_deg": MAX_HEADING_RMS_DEG,
+                               "max_relative_ci95": MAX_REL_CI}}
 
     def summary(self) -> dict:
         out = {"model": self.model, "fitted_on": self.fitted_on,
@@ -64,7 +96,12 @@ class FitResult:
                                "ci95": self.ci95.get(k), "fixed_by": self.fixed.get(k)}
                               for k, v in self.params.items()],
                "ci_note": "95 % intervals from the Jacobian, white-noise assumption (optimistic "
-                          "for coloured noise)"}
+                          "for coloured noise)",
+               "quality": self.quality()}
+        q = out["quality"]
+        for p in out["parameters"]:
+            if p["fixed_by"] is None:
+                p["poorly_determined"] = p["name"] in q["poorly_determined"]
         if self.spiral is not None:
             out["spiral"] = {"coef": self.spiral.coef, "stderr": self.spiral.stderr,
                              "n_points": int(len(self.spiral.points)), "rms_rad": self.spiral.rms}
@@ -245,4 +282,5 @@ def identify(rec: Record, model: str, use_spiral: bool | None = None, settle: fl
                      fixed=fixed.get("by", {}), fitted_on="yaw_rate" if on_rate else "heading",
                      rms=float(np.sqrt(2.0 * sol.cost / n)), rms_heading_deg=rms_psi,
                      rms_yaw_rate_deg_s=math.degrees(float(np.sqrt(np.mean((r_m - r_meas) ** 2)))),
-                     spiral=spiral, t=rec.t, psi_model=psi_m, r_model=r_m, packed=ps)
+                     spiral=spiral, t=rec.t, psi_model=psi_m, r_model=r_m, packed=ps,
+                     target_std=float(np.std(target)))

@@ -109,12 +109,12 @@ def make_record(t, delta, psi=None, r=None, speed=None) -> Record:
 
 def load_record(path) -> Record:
     """Read a CSV record (see the module docstring for the columns)."""
+    import io
+
+    from steerlab.textfile import read_user_text
+
     p = Path(path)
-    try:
-        with p.open(newline="", encoding="utf-8") as f:
-            rows = list(csv.reader(f))
-    except OSError as err:
-        raise InputError("record", f"cannot read {str(p)!r}: {err.strerror}") from None
+    rows = list(csv.reader(io.StringIO(read_user_text(p, "record", 1 << 30), newline="")))
     if len(rows) < 2:
         raise InputError("record", f"{p.name} has no data rows")
     header = [h.strip().lower() for h in rows[0]]

@@ -73,7 +73,7 @@ class Nomoto2Options(FrozenConfig):
 
     K: float = Field(0.1, gt=0.0, le=100.0, description="gain [1/s]")
     T1: float = Field(60.0, ge=-1e4, le=1e4, description="time constant [s]; < 0: course-unstable")
-    T2: float = Field(8.0, gt=0.0, le=1e4, description="time constant [s]")
+    T2: float = Field(8.0, ge=0.01, le=1e4, description="time constant [s], 0.01-1e4 s")
     T3: float = Field(12.0, ge=0.0, le=1e4, description="zero time constant [s]")
     L: float = Field(100.0, gt=0.0, le=1000.0, description="ship length [m]")
 

@@ -70,7 +70,7 @@ class NorrbinOptions(FrozenConfig):
     """``[ship.options]`` of ``norrbin`` (SI, r in rad/s; defaults: the nomoto1 defaults)."""
 
     K: float = Field(0.1, gt=0.0, le=100.0, description="gain [1/s]")
-    T: float = Field(50.0, gt=0.0, le=1e4, description="time constant [s]")
+    T: float = Field(50.0, ge=0.01, le=1e4, description="time constant [s], 0.01-1e4 s")
     n0: float = Field(0.0, ge=-1.0, le=1.0, description="[rad/s]")
     n1: float = Field(1.0, ge=-1.0, le=1.0, description="+1 course-stable, -1 unstable [-]")
     n2: float = Field(0.0, ge=-1e6, le=1e6, description="r^2 coefficient [s/rad]")

@@ -27,7 +27,8 @@ class BatchResult:
     """Outcome of a batch. Axis 0 is the run.
 
     ``acc``: (n, N_ACC) integral metrics (see :mod:`steerlab.metrics_online`);
-    ``final_states``: (n, nx); ``time``/``states``/``delta_cmd``/``ref``: decimated logs
+    ``final_states``: (n, nx); ``diverged``: (n,) bool, a non-finite final state or metric;
+    ``time``/``states``/``delta_cmd``/``ref``: decimated logs
     (time axis 1) when ``record_every`` was given, else only the initial row. ``ref`` has 2
     columns ``[psi_ref, r_ref]``, or with state-dependent guidance the 6 of
     :mod:`steerlab.guidance.reference_vector`.
@@ -46,6 +47,14 @@ class BatchResult:
         from steerlab.sim.frames import batch_frame
 
         return batch_frame(self, lam)
+
+    @property
+    def diverged(self) -> np.ndarray:
+        """Boolean (n,): runs whose final state or on-line metrics are not finite (NaN/inf);
+        their metrics mean nothing (:mod:`steerlab.sim.divergence`)."""
+        from steerlab.sim.divergence import diverged_rows
+
+        return diverged_rows(self.final_states, self.acc)
 
 
 def _stack(arrays, field):

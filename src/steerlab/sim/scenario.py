@@ -31,7 +31,6 @@ scenario into SI arrays for the engines. Example (the bundled default)::
 from __future__ import annotations
 
 import math
-import tomllib
 from pathlib import Path
 from typing import Annotated, Any, Literal, Optional, Union
 
@@ -52,7 +51,7 @@ _Frozen = FrozenConfig
 
 class ShipConfig(_Frozen):
     model: str = "esso"
-    speed_kn: float = Field(16.0, gt=0.0, le=40.0, description="approach speed [kn]")
+    speed_kn: float = Field(16.0, ge=0.01, le=40.0, description="approach speed [kn], 0.01-40 kn")
     rpm: Optional[float] = Field(None, gt=0.0, le=1000.0,
                                  description="propeller rate [rpm]; default: the rate that holds speed_kn")
     options: dict[str, Any] = Field(
@@ -62,7 +61,7 @@ class ShipConfig(_Frozen):
 class GearConfig(_Frozen):
     delta_max_deg: float = Field(35.0, gt=0.0, le=90.0)
     rate_max_deg_s: float = Field(2.33, gt=0.0, le=100.0)
-    T_sg: float = Field(1.0, gt=0.0, le=100.0, description="servo time constant [s]")
+    T_sg: float = Field(1.0, ge=0.001, le=100.0, description="servo time constant [s], 0.001-100 s")
     dead_zone_deg: float = Field(0.0, ge=0.0, le=10.0)
 
 
@@ -142,7 +141,7 @@ class Scenario(_Frozen):
     name: str = "scenario"
     description: str = ""
     seed: int = Field(0, ge=0, le=2**63 - 1)
-    dt: float = Field(0.1, gt=0.0, le=10.0, description="integration step [s]")
+    dt: float = Field(0.1, ge=1e-4, le=10.0, description="integration step [s], 1e-4-10 s")
     duration: float = Field(3000.0, gt=0.0, le=1e6, description="[s]")
     ship: ShipConfig = ShipConfig()
     gear: GearConfig = GearConfig()
@@ -213,17 +212,21 @@ def scenario_from_dict(data: dict) -> Scenario:
         raise _format_validation_error(err) from None
 
 
+MAX_SCENARIO_BYTES = 16 << 20   #: largest scenario file [bytes]
+
+
 def load_scenario(path) -> Scenario:
-    """Load and validate a scenario TOML file; raises :class:`InputError` on any problem."""
+    """Load and validate a scenario TOML file; raises :class:`InputError` on any problem.
+
+    The file is read as bytes and decoded strictly (:func:`steerlab.textfile.read_user_text`:
+    regular file, at most 16 MiB, no NUL, valid UTF-8) and parsed with bounded nesting
+    (:func:`steerlab.toml_input.parse_toml`).
+    """
+    from steerlab.textfile import read_user_text
+    from steerlab.toml_input import parse_toml
+
     p = Path(path)
-    try:
-        text = p.read_text(encoding="utf-8")
-    except OSError as err:
-        raise InputError("scenario", f"cannot read {str(p)!r}: {err.strerror}") from None
-    try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as err:
-        raise InputError("scenario", f"malformed TOML in {p.name}: {err}") from None
+    data = parse_toml(read_user_text(p, "scenario", MAX_SCENARIO_BYTES), "scenario", p.name)
     g = data.get("guidance") if isinstance(data, dict) else None
     if isinstance(g, dict) and isinstance(g.get("route_file"), str) and not Path(g["route_file"]).is_absolute():
         g["route_file"] = str(p.parent / g["route_file"])     # relative to the scenario file

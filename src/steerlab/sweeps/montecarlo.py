@@ -51,6 +51,11 @@ class MonteCarloResult:
     record_every: int
     n_steps: int
     dt: float
+    diverged: np.ndarray | None = None   # (n,) bool: runs that left the finite numbers (no metrics)
+
+    @property
+    def n_diverged(self) -> int:
+        return 0 if self.diverged is None else int(np.count_nonzero(self.diverged))
 
 
 def confidence_interval(values, level: float = 0.95) -> tuple[float, float, float]:
@@ -110,6 +115,7 @@ def run_montecarlo(scenario, n_runs: int, lam: float = 0.1, record_every: int | 
     per_run: dict = {}
     err = rud = time = None
     n_steps = dt = None
+    diverged = np.zeros(n_runs, dtype=bool)
     for start in range(0, n_runs, CHUNK_RUNS):
         m = min(CHUNK_RUNS, n_runs - start)
         chunk = scenario if start == 0 else scenario.model_copy(update={"seed": scenario.seed + start})
@@ -125,6 +131,7 @@ def run_montecarlo(scenario, n_runs: int, lam: float = 0.1, record_every: int | 
                 "compiles the loop")
         out = executor.run(batch, record_every, lambda done, _n, s0=start: report(s0 + done, n_runs))
         nd = batch.X.shape[1] - 1
+        diverged[start:start + m] = out.diverged
         if err is None:
             time = out.time
             err = np.empty((n_runs, len(time)))
@@ -138,12 +145,20 @@ def run_montecarlo(scenario, n_runs: int, lam: float = 0.1, record_every: int | 
             mt["final_error_deg"] = float(err[start + i, -1])
             mt["max_abs_rudder_deg"] = float(np.max(np.abs(rud[start + i])))
             for k, v in mt.items():
-                per_run.setdefault(k, np.full(n_runs, np.nan))[start + i] = math.nan if v is None else float(v)
+                ok = v is not None and not diverged[start + i]     # a diverged run has no metrics
+                per_run.setdefault(k, np.full(n_runs, np.nan))[start + i] = float(v) if ok else math.nan
     seeds = scenario.seed + np.arange(n_runs)
     stats = {k: {**summarise(v), "unit": METRIC_UNITS.get(k, "")} for k, v in per_run.items()}
+    if diverged.any():
+        say(f"warning: {int(diverged.sum())} of {n_runs} runs diverged (non-finite state): left out of the "
+            "statistics and the bands, flagged in runs.csv (column diverged)")
+        if diverged.all():
+            err = rud = np.full_like(err, np.nan)
+        else:
+            err, rud = err[~diverged], rud[~diverged]
     eb = {p: np.percentile(err, p, axis=0) for p in PERCENTILES}
     rb = {p: np.percentile(rud, p, axis=0) for p in PERCENTILES}
-    return MonteCarloResult(seeds, per_run, stats, time, eb, rb, record_every, n_steps, dt)
+    return MonteCarloResult(seeds, per_run, stats, time, eb, rb, record_every, n_steps, dt, diverged)
 
 
 def write_montecarlo_outputs(stage, res: MonteCarloResult, scenario_name: str) -> None:
@@ -159,8 +174,10 @@ def write_montecarlo_outputs(stage, res: MonteCarloResult, scenario_name: str) -
                "log_resolution_s": res.record_every * res.dt,
                "note": "integral metrics exact (on-line); step metrics, final error and max rudder "
                        "from the log at log_resolution_s",
-               "metrics": res.stats}, stage / "montecarlo.json")
-    write_table(stage, "runs", {"seed": res.seeds, **res.per_run})
+               "metrics": res.stats, **({"n_diverged": res.n_diverged} if res.n_diverged else {})},
+              stage / "montecarlo.json")
+    flag = {} if res.diverged is None or not res.n_diverged else {"diverged": res.diverged.astype(np.int8)}
+    write_table(stage, "runs", {"seed": res.seeds, **res.per_run, **flag})
     cols = {"t_s": res.time}
     cols.update({f"error_p{p}_deg": v for p, v in res.error_bands_deg.items()})
     cols.update({f"rudder_p{p}_deg": v for p, v in res.rudder_bands_deg.items()})

@@ -44,6 +44,13 @@ class BatchOutput:
     delta_cmd: np.ndarray | None = None
     ref: np.ndarray | None = None
 
+    @property
+    def diverged(self) -> np.ndarray:
+        """Boolean (n,): runs whose final state or on-line metrics are not finite (failed runs)."""
+        from steerlab.sim.divergence import diverged_rows
+
+        return diverged_rows(self.final_states, self.acc)
+
     @staticmethod
     def concatenate(parts: list["BatchOutput"]) -> "BatchOutput":
         def cat(name):

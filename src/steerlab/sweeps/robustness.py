@@ -147,10 +147,19 @@ def run_robustness(scenario, variations: list[Variation], metric: str = "itae", 
     out = (executor or LocalExecutor()).run(batch, None, runs_progress(say))
     names = set(ONLINE)
     m = metric_arrays(out.acc, lam, names)
-    values = expr(metric_arrays(out.acc, lam, expr.names))
+    values = np.asarray(expr(metric_arrays(out.acc, lam, expr.names)), dtype=float)
+    bad = out.diverged                     # a diverged point failed: infinite metric, not a number
+    if bad.any():
+        values = np.where(bad, np.inf, values)
+        m = {k: np.where(bad, np.nan, v) for k, v in m.items()}
+        say(f"warning: {int(bad[:-1].sum())} of {len(points)} grid points diverged (non-finite state): "
+            "metric inf, flagged in table.csv (column diverged)"
+            + ("; the NOMINAL scenario diverged too" if bad[-1] else ""))
     table = {v.name: np.array([pt[j] for pt in points]) for j, v in enumerate(variations)}
     table["metric"] = values[:-1]
     table.update({k: m[k][:-1] for k in sorted(names)})
+    if bad.any():
+        table["diverged"] = bad[:-1].astype(np.int8)
     nominal_row = {"metric": float(values[-1]), **{k: float(m[k][-1]) for k in sorted(names)}}
     return RobustnessResult(variations, points, expr.text, values[:-1], table, nominal_row, redesign,
                             scenario.ship.model)

@@ -74,6 +74,7 @@ class PopulationEvaluator:
         PC = PC.reshape(P, C, -1)
         Z = Z.reshape(P, C, -1)
         out = {n: np.empty((P, C)) for n in self.names}
+        diverged = np.zeros((P, C), dtype=bool)
         for idx, batch in self.groups:
             b = batch.tile(P).with_pc(PC[:, idx].reshape(P * len(idx), -1), Z[:, idx].reshape(P * len(idx), -1))
             rec = None
@@ -82,15 +83,20 @@ class PopulationEvaluator:
             res = self.executor.run(b, rec)
             duration = batch.n_steps * batch.dt
             m = metric_arrays(res.acc, self.lam, self.names, res.time, res.states, res.ref, duration)
+            bad = res.diverged.reshape(P, len(idx))     # diverged: a failed run, not a number
             for n in self.names:
                 out[n][:, idx] = m[n].reshape(P, len(idx))
+            diverged[:, idx] = bad
             self.n_sims += b.n
+        self.last_diverged = diverged
         return out
 
     def per_condition_costs(self, X) -> np.ndarray:
         """Costs (P, n_objectives, C)."""
         m = self.metrics(X)
-        return np.stack([c(m) for c in self.costs], axis=1)
+        costs = np.stack([np.asarray(c(m), dtype=float) for c in self.costs], axis=1)
+        # a diverged run failed: the penalty of any non-finite cost, whatever its metrics say
+        return np.where(self.last_diverged[:, None, :], PENALTY, costs)
 
     def __call__(self, X) -> np.ndarray:
         """Aggregated costs (P, n_objectives); non-finite -> PENALTY."""

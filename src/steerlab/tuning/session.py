@@ -22,7 +22,7 @@ import numpy as np
 from steerlab.metrics import METRIC_UNITS
 from steerlab.sweeps.conditions import condition_set
 from steerlab.sweeps.executors import LocalExecutor
-from steerlab.costs import ONLINE, parse_cost
+from steerlab.costs import ONLINE, PENALTY, parse_cost
 from steerlab.tuning.evaluator import PopulationEvaluator
 from steerlab.tuning.optimisers import TuningResult, run_optimiser
 from steerlab.tuning.params import build_param_map
@@ -113,6 +113,25 @@ def _best_metrics(ev: PopulationEvaluator, x) -> list[dict]:
             for i, c in enumerate(ev.conditions)]
 
 
+BOUND_TOLERANCE = 1e-3
+"""A best parameter within this fraction of its range from a bound is reported as on the bound."""
+
+
+def tuning_warnings(pm, r: TuningResult) -> list[str]:
+    """Warnings about the result: a best parameter on a bound of its range (the optimum may lie
+    outside: widen the bounds), and a best cost of :data:`PENALTY` or more (every candidate failed)."""
+    out = []
+    for name, (lo, hi), v in zip(pm.names, pm.bounds, np.asarray(r.x, dtype=float)):
+        tol = BOUND_TOLERANCE * (hi - lo)
+        if hi > lo and (v - lo <= tol or hi - v <= tol):
+            side, b = ("lower", lo) if v - lo <= tol else ("upper", hi)
+            out.append(f"{name}: the optimum {v:.6g} is on its {side} bound {b:g}; the best value may lie "
+                       "outside the bounds (widen them)")
+    if r.front_x is None and np.any(np.asarray(r.f, dtype=float) >= PENALTY):
+        out.append("cost: every candidate failed (diverged or undefined cost); the result means nothing")
+    return out
+
+
 def _summary(spec, conditions, ev, r: TuningResult, wall) -> dict:
     pm = ev.param_map
     out = {
@@ -138,6 +157,9 @@ def _summary(spec, conditions, ev, r: TuningResult, wall) -> dict:
         "metric_units": {k: (METRIC_UNITS.get(v[0], v[1]) if v[0] else v[1]) for k, v in ONLINE.items()},
         "history": r.history,
     }
+    warnings = tuning_warnings(pm, r)
+    if warnings:
+        out["warnings"] = warnings
     if r.front_x is not None:
         out["front"] = [{**pm.values_dict(x), **{f"cost{j}": float(v) for j, v in enumerate(f)}}
                         for x, f in zip(r.front_x, r.front_f)]

@@ -1,0 +1,49 @@
+"""The command layer's checks around scenario design: refusals, warnings, and a last-resort guard.
+
+:func:`design_guard` is a safety net, not the fix: the real fixes are the bounds of the
+scenario schema and the checks of the design functions (each an ``InputError`` naming its
+field). Should a design still fail with an unexpected exception (``ZeroDivisionError``,
+``LinAlgError``, ...), the command prints one line naming the stage and exits 2 instead of
+a traceback. Only the design stage is guarded; library code raises as it does.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import sys
+
+from steerlab.errors import InputError
+
+
+@contextlib.contextmanager
+def design_guard(stage: str = "scenario design"):
+    """Turn an unexpected exception inside the block into an :class:`InputError` naming ``stage``."""
+    try:
+        yield
+    except InputError:
+        raise
+    except Exception as err:  # noqa: BLE001 - the last-resort net of the CLI (see the module docstring)
+        raise InputError(stage, f"failed with {type(err).__name__}: {err}; the scenario's values are outside "
+                                "what the design can handle (please report it if they are sensible)") from None
+
+
+def warn(lines) -> None:
+    """Print each warning as one ``steerlab: warning: ...`` line on stderr."""
+    from steerlab.cli import one_line
+
+    for line in lines:
+        print(f"steerlab: warning: {one_line(line)}", file=sys.stderr, flush=True)
+
+
+def design_checked(scenario):
+    """``(setup, warnings)``: the scenario refused if impossible, built under :func:`design_guard`,
+    its warnings printed (see :mod:`steerlab.sim.sanity`)."""
+    from steerlab.sim.sanity import check_scenario, scenario_warnings
+    from steerlab.sim.setup import build
+
+    with design_guard():
+        check_scenario(scenario)
+        setup = build(scenario)
+        warnings = scenario_warnings(scenario)
+    warn(warnings)
+    return setup, warnings

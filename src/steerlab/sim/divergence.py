@@ -1,0 +1,64 @@
+r"""Finite-state and spin checks of finished runs: a diverged run is never reported as good.
+
+The engines integrate whatever they are given; a model driven outside its validity range or
+integrated with too large a step can leave the finite numbers (NaN/inf), after which every
+metric is meaningless. These checks look at a run's outputs only (the compiled loops are not
+touched), so they cost one pass over the log of a single run and one over the final states
+and on-line accumulators of a batch:
+
+* :func:`check_run` (single runs, both engines): the first non-finite sample of the log
+  (time and state) raises :class:`~steerlab.errors.DivergedError`; so does a *spin*, the
+  heading leaving its reference by more than a full turn,
+  ``max_t |unwrap(psi - psi_ref)| > 2 pi`` (a closed loop that is unstable on this ship: the
+  heading error wraps, so its metrics would look bounded);
+* :func:`diverged_rows` (batches): a run whose final state or on-line accumulator is not
+  finite. Sweeps treat such runs as failed (no metrics, infinite cost).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from steerlab.errors import DivergedError
+from steerlab.units import KNOT
+
+SPIN_LIMIT = 2.0 * math.pi   #: heading away from its reference by more than this [rad]: a spin
+
+
+def diverged_rows(final_states, acc=None) -> np.ndarray:
+    """Boolean (n,): runs whose final state (or on-line accumulator) has a NaN or an inf."""
+    bad = ~np.all(np.isfinite(np.asarray(final_states)), axis=1)
+    if acc is not None:
+        bad |= ~np.all(np.isfinite(np.asarray(acc)), axis=1)
+    return bad
+
+
+def likely_cause(setup) -> str:
+    """A hint naming the scenario's speed against the ship's validity range and its step."""
+    lo, hi = setup.ship.speed_range
+    speed = float(setup.x0[3]) if setup.x0.shape[0] > 3 else math.nan
+    parts = []
+    if math.isfinite(speed) and not (lo <= speed <= hi):
+        parts.append(f"the speed {speed / KNOT:.3g} kn is outside the validity range of {setup.ship.name!r}: "
+                     f"{lo / KNOT:.3g}-{hi / KNOT:.3g} kn")
+    parts.append(f"dt = {setup.dt:g} s may be too large for the model (try a smaller dt)")
+    return "likely cause: " + "; or ".join(parts)
+
+
+def check_run(result, setup) -> None:
+    """Raise :class:`DivergedError` if ``result`` (of ``setup``) left the finite numbers or spun."""
+    X = result.states
+    bad = ~np.isfinite(X)
+    if bad.any():
+        k, j = np.argwhere(bad)[0]
+        name = result.state_names[j] if j < len(result.state_names) else f"state {j}"
+        raise DivergedError(float(result.time[k]), f"{name} = {float(X[k, j])!r}", likely_cause(setup))
+    off = np.abs(np.unwrap(result.psi - result.psi_ref))
+    if off.size and float(off.max()) > SPIN_LIMIT:
+        k = int(np.argmax(off > SPIN_LIMIT))
+        raise DivergedError(float(result.time[k]), "the ship spun: its heading left the reference by more "
+                            "than a full turn", "the closed loop is unstable: the controller does not suit "
+                            "this ship (check its design model and gains); for open-loop turns use "
+                            "'steerlab trial'")

@@ -1,0 +1,59 @@
+r"""Scenario checks beyond field ranges: refusals of the impossible, warnings of the likely mistake.
+
+Field ranges (pydantic) cannot see combinations or units typed wrong. Here:
+
+* :func:`check_scenario` refuses (``InputError``) what cannot be meant: a course change after
+  the end of the run (``guidance.changes[i].t > duration``);
+* :func:`scenario_warnings` lists what is allowed but probably a mistake, each
+  ``"field: message"``; the CLI prints them as ``steerlab: warning: ...`` lines and writes
+  them into the run's ``metrics.json`` (``warnings``):
+
+  - the speed outside the ship's validity range (``ShipSpec.speed_range``; catalogue tables
+    already refuse): the model is extrapolated and may diverge (which the finite-state
+    check of :mod:`steerlab.sim.divergence` then reports);
+  - a rudder limit below :data:`MIN_RUDDER_DEG` degrees or a rudder rate below
+    :data:`MIN_RUDDER_RATE_DEG_S` deg/s in a degree field: "did you type radians?"
+    (35 deg = 0.61 rad; 2.33 deg/s = 0.041 rad/s).
+"""
+
+from __future__ import annotations
+
+from steerlab.errors import InputError
+from steerlab.units import KNOT, knots_to_ms
+
+MIN_RUDDER_DEG = 2.0          #: smaller rudder limits [deg] are probably radians
+MIN_RUDDER_RATE_DEG_S = 0.2   #: smaller rudder rates [deg/s] are probably radians per second
+
+
+def check_scenario(s) -> None:
+    """Refuse a course change after the end of the run (``InputError`` naming it)."""
+    for i, ch in enumerate(s.guidance.changes):
+        if ch.t > s.duration:
+            raise InputError(f"guidance.changes[{i}].t", f"{ch.t:g} s is after the end of the run "
+                                                         f"(duration {s.duration:g} s); allowed [0, {s.duration:g}]")
+
+
+def scenario_warnings(s) -> list[str]:
+    """``"field: message"`` for each likely mistake in scenario ``s`` (see the module docstring)."""
+    from steerlab.ships.registry import get_ship
+
+    out = []
+    ship = get_ship(s.ship.model)
+    lo, hi = ship.speed_range
+    v = knots_to_ms(s.ship.speed_kn)
+    if not (lo <= v <= hi):
+        out.append(f"ship.speed_kn: {s.ship.speed_kn:g} kn is outside the validity range of {ship.name!r} "
+                   f"({lo / KNOT:.3g}-{hi / KNOT:.3g} kn); the model is extrapolated")
+    limits = [("gear.delta_max_deg", s.gear.delta_max_deg)]
+    u_max = getattr(s.controller, "u_max_deg", None)
+    if u_max is not None:
+        limits.append(("controller.u_max_deg", u_max))
+    for field, val in limits:
+        if val < MIN_RUDDER_DEG:
+            out.append(f"{field}: a rudder limit of {val:g} deg is below {MIN_RUDDER_DEG:g} deg; did you type "
+                       f"radians? ({val:g} rad = {val * 57.29577951308232:.3g} deg)")
+    if s.gear.rate_max_deg_s < MIN_RUDDER_RATE_DEG_S:
+        val = s.gear.rate_max_deg_s
+        out.append(f"gear.rate_max_deg_s: a rudder rate of {val:g} deg/s is below {MIN_RUDDER_RATE_DEG_S:g} deg/s; "
+                   f"did you type radians? ({val:g} rad/s = {val * 57.29577951308232:.3g} deg/s)")
+    return out

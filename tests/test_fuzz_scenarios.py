@@ -1,0 +1,120 @@
+"""Fuzz: mutated scenario files give exit 0 or a one-line exit 2, never a traceback (issue 15).
+
+300 seeded mutants (:mod:`scenario_mutator`) of the bundled default and four other scenarios
+go through ``steerlab run`` in process up to the simulation (the engine is replaced by a
+stub, so the test measures loading, validation and design, not integration): every file
+either reaches the simulation (stderr: warnings only) or is rejected with exit code 2, one
+line ``steerlab: error: FIELD: ...`` of at most 300 characters after the prefix, and nothing
+in ``--out`` (no staging leftovers either). ``benchmarks/fuzz_scenarios.py`` runs the same
+check over any number of mutants.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+import scenario_mutator  # noqa: E402
+
+from steerlab.cli import MAX_MESSAGE, main  # noqa: E402
+
+PREFIX = "steerlab: error: "
+
+
+class _Reached(Exception):
+    """Raised by the stub engine: the scenario was accepted and designed."""
+
+
+def _stub_simulate(setup, engine="compiled"):
+    raise _Reached(setup.n_steps)
+
+
+def check_one(path: Path, out: Path) -> str:
+    """Run ``steerlab run path --out out`` up to the engine; assert the contract; return the outcome."""
+    err = io.StringIO()
+    t0 = time.perf_counter()
+    with contextlib.redirect_stderr(err), contextlib.redirect_stdout(io.StringIO()):
+        try:
+            rc = main(["run", str(path), "--out", str(out), "--quiet"])
+        except _Reached:
+            rc = None
+    elapsed = time.perf_counter() - t0
+    lines = err.getvalue().splitlines()
+    assert elapsed < 30.0, f"{path.name}: {elapsed:.1f} s"
+    if rc is None:
+        assert all(line.startswith("steerlab: warning: ") for line in lines), (path.name, lines)
+        return "accepted"
+    assert rc == 2, (path.name, rc, lines)
+    assert len(lines) == 1 and lines[0].startswith(PREFIX), (path.name, lines)
+    assert len(lines[0]) <= len(PREFIX) + MAX_MESSAGE, (path.name, lines[0])
+    assert ": " in lines[0][len(PREFIX):], lines[0]          # names a field
+    assert not out.exists(), path.name
+    assert not list(out.parent.glob(f".{out.name}.partial-*")), path.name
+    return "rejected"
+
+
+def test_mutated_scenarios_exit_0_or_one_line_2(tmp_path, monkeypatch):
+    import steerlab.sim.engine as engine
+
+    monkeypatch.setattr(engine, "simulate", _stub_simulate)
+    outcomes = {"accepted": 0, "rejected": 0}
+    t0 = time.perf_counter()
+    for i, path in enumerate(scenario_mutator.mutants(300, seed=15, folder=tmp_path / "in")):
+        outcomes[check_one(path, tmp_path / f"out{i}")] += 1
+    # both outcomes occur (a mutator that only breaks files, or never does, tests little)
+    assert outcomes["accepted"] >= 30 and outcomes["rejected"] >= 150, outcomes
+    assert time.perf_counter() - t0 < 120.0
+
+
+def _issue_case(tmp_path, kind) -> Path:
+    base = scenario_mutator.to_toml(scenario_mutator.BASES["los"]).encode()
+    (tmp_path / "route.csv").write_text(scenario_mutator.ROUTE_CSV)
+    if kind == "utf8":
+        data = base.replace(b'name = "los"', b'name = "l\xffs"')
+    elif kind == "deep":
+        data = b"x = " + b"[" * 400 + b"]" * 400 + b"\n" + base
+    elif kind == "dotted":
+        data = b"x" + b".a" * 100_000 + b" = 1\n" + base
+    else:
+        (tmp_path / "route.csv").write_bytes(bytes(range(256)))
+        data = base
+    p = tmp_path / "s.toml"
+    p.write_bytes(data)
+    return p
+
+
+EXPECTED = {"utf8": "scenario: s.toml: not valid UTF-8 at byte 9 (line 1)",
+            "deep": "scenario: s.toml: nesting deeper than 32 levels at line 1",
+            "dotted": "scenario: s.toml: nesting deeper than 32 levels at line 1",
+            "route": "guidance.route_file: route.csv: binary file (NUL byte at byte 0"}
+
+
+@pytest.mark.parametrize("kind", sorted(EXPECTED))
+def test_classes_of_the_issue_give_one_line(tmp_path, capsys, kind):
+    """Invalid UTF-8, ~400 levels of arrays (RecursionError before), 10^5 dotted keys (a
+    minute, then MemoryError before) and a binary route file: exit 2, one line, at once."""
+    t0 = time.perf_counter()
+    assert main(["run", str(_issue_case(tmp_path, kind)), "--out", str(tmp_path / "out"), "--quiet"]) == 2
+    assert time.perf_counter() - t0 < 5.0
+    err = capsys.readouterr().err
+    assert err.startswith(PREFIX + EXPECTED[kind]) and len(err.splitlines()) == 1, err
+    assert not (tmp_path / "out").exists()
+
+
+def test_deep_nesting_through_the_real_command_line(tmp_path):
+    """The RecursionError class through a real process: exit 2, no traceback."""
+    out = tmp_path / "out"
+    proc = subprocess.run([sys.executable, "-m", "steerlab", "run", str(_issue_case(tmp_path, "deep")),
+                           "--out", str(out), "--quiet"], capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 2, proc.stderr
+    assert "Traceback" not in proc.stderr and len(proc.stderr.splitlines()) == 1
+    assert EXPECTED["deep"] in proc.stderr
+    assert not out.exists()
