@@ -2,13 +2,14 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
+import numba
 import numpy as np
 
 from steerlab.environment.channels import (N_CHANNELS, W_RUDDER, W_WIND_DIR, W_WIND_SPEED,
                                            set_current)
-from steerlab.environment.waves import coloured_noise
+from steerlab.environment.waves import coloured_noise, coloured_noise_rows
 from steerlab.errors import require_finite_range
 
 
@@ -78,3 +79,39 @@ def build_disturbance(dist: Disturbance, n_steps: int, dt: float, seed: int) -> 
         rng = np.random.default_rng(seed)
         w[:, W_RUDDER] += coloured_noise(n_steps, dt, rng, dist.wave_sample_time, dist.wave_power)
     return w
+
+
+def build_disturbances(dist: Disturbance, n_steps: int, dt: float, seeds, out=None, rows=None) -> np.ndarray:
+    """:func:`build_disturbance` for many seeds at once (the Gymnasium vector environment's
+    resets): the seed-free channels are built once, the seeds' wave sequences in one compiled
+    filter call (:func:`~steerlab.environment.waves.coloured_noise_rows`).
+
+    Returns ``out`` (default a new ``(len(seeds), n_steps + 1, N_CHANNELS)`` array) with
+    ``out[rows[q]]`` bit-identical to ``build_disturbance(dist, n_steps, dt, seeds[q])``
+    (``rows`` default ``0 .. len(seeds) - 1``); other rows of ``out`` are left as they are.
+    """
+    base = build_disturbance(replace(dist, waves=False), n_steps, dt, 0)
+    if out is None:
+        out = np.empty((len(seeds),) + base.shape)
+    rows = np.arange(len(seeds), dtype=np.int64) if rows is None else np.asarray(rows, dtype=np.int64)
+    if dist.waves:
+        noise = coloured_noise_rows(n_steps, dt, [np.random.default_rng(int(s)) for s in seeds],
+                                    dist.wave_sample_time, dist.wave_power)
+    else:
+        noise = np.zeros((len(seeds), 0))
+    _fill(out, rows, base, noise, W_RUDDER)
+    return out
+
+
+@numba.njit(cache=True)
+def _fill(out, rows, base, noise, ch):
+    """``out[rows[q]] = base``, plus ``noise[q]`` on channel ``ch`` (when ``noise`` has columns):
+    the sum ``base + noise`` of :func:`build_disturbance`'s ``+=``, element by element."""
+    for q in range(rows.shape[0]):
+        r = rows[q]
+        for k in range(base.shape[0]):
+            for c in range(base.shape[1]):
+                out[r, k, c] = base[k, c]
+        if noise.shape[1] > 0:
+            for k in range(base.shape[0]):
+                out[r, k, ch] = base[k, ch] + noise[q, k]
