@@ -9,7 +9,8 @@ import numpy as np
 
 from steerlab.environment.channels import (N_CHANNELS, W_RUDDER, W_WIND_DIR, W_WIND_SPEED,
                                            set_current)
-from steerlab.environment.waves import coloured_noise, coloured_noise_rows
+from steerlab.environment.iir_filter import _padded, _transposed_df2
+from steerlab.environment.waves import band_pass_eq39, coloured_noise, white_samples_rows
 from steerlab.errors import require_finite_range
 
 
@@ -95,23 +96,32 @@ def build_disturbances(dist: Disturbance, n_steps: int, dt: float, seeds, out=No
         out = np.empty((len(seeds),) + base.shape)
     rows = np.arange(len(seeds), dtype=np.int64) if rows is None else np.asarray(rows, dtype=np.int64)
     if dist.waves:
-        noise = coloured_noise_rows(n_steps, dt, [np.random.default_rng(int(s)) for s in seeds],
-                                    dist.wave_sample_time, dist.wave_power)
+        samples, hold = white_samples_rows(n_steps, dt, [np.random.default_rng(int(s)) for s in seeds],
+                                           dist.wave_sample_time, dist.wave_power)
+        b, a = _padded(*band_pass_eq39(dt))
     else:
-        noise = np.zeros((len(seeds), 0))
-    _fill(out, rows, base, noise, W_RUDDER)
+        samples, hold, b, a = np.zeros((len(seeds), 0)), 1, np.zeros(1), np.ones(1)
+    _fill(out, rows, base, samples, hold, b, a, W_RUDDER)
     return out
 
 
 @numba.njit(cache=True)
-def _fill(out, rows, base, noise, ch):
-    """``out[rows[q]] = base``, plus ``noise[q]`` on channel ``ch`` (when ``noise`` has columns):
-    the sum ``base + noise`` of :func:`build_disturbance`'s ``+=``, element by element."""
+def _fill(out, rows, base, samples, hold, b, a, ch):
+    """``out[rows[q]] = base``, plus on channel ``ch`` (when ``samples`` has columns) the
+    wave sequence: ``samples[q]`` held ``hold`` steps each and filtered by ``b/a`` (the one
+    filter loop, :func:`~steerlab.environment.iir_filter._transposed_df2`) - the sum
+    ``base + coloured_noise`` of :func:`build_disturbance`'s ``+=``, element by element."""
+    n = base.shape[0]
+    held = np.empty(n)
+    y = np.empty(n)
     for q in range(rows.shape[0]):
         r = rows[q]
-        for k in range(base.shape[0]):
+        for k in range(n):
             for c in range(base.shape[1]):
                 out[r, k, c] = base[k, c]
-        if noise.shape[1] > 0:
-            for k in range(base.shape[0]):
-                out[r, k, ch] = base[k, ch] + noise[q, k]
+        if samples.shape[1] > 0:
+            for k in range(n):
+                held[k] = samples[q, k // hold]
+            _transposed_df2(b, a, held, y)
+            for k in range(n):
+                out[r, k, ch] = base[k, ch] + y[k]

@@ -90,6 +90,19 @@ def coloured_noise(n_steps: int, dt: float, rng: np.random.Generator,
     return lfilter(b, a, white)
 
 
+def white_samples_rows(n_steps: int, dt: float, rngs, sample_time: float = 0.5,
+                       power: float = 1e-4) -> tuple[np.ndarray, int]:
+    """The white-noise samples of :func:`held_white_noise` for each generator of ``rngs``:
+    ``(samples, hold)``, ``samples`` ``(len(rngs), n_samples)`` (row ``q`` the draws and
+    products ``held_white_noise(n_steps, dt, rngs[q], ...)`` holds, ``hold`` steps each)."""
+    hold, n_samples = _hold(n_steps, dt, sample_time, power)
+    samples = np.empty((len(rngs), n_samples))
+    for q, rng in enumerate(rngs):
+        samples[q] = rng.standard_normal(n_samples)
+    samples *= math.sqrt(power / sample_time)
+    return samples, hold
+
+
 def coloured_noise_rows(n_steps: int, dt: float, rngs, sample_time: float = 0.5,
                         power: float = 1e-4) -> np.ndarray:
     """:func:`coloured_noise` for each generator of ``rngs``, filtered in one compiled call:
@@ -98,11 +111,7 @@ def coloured_noise_rows(n_steps: int, dt: float, rngs, sample_time: float = 0.5,
     and filter loop; only the Python overhead per sequence is gone)."""
     from steerlab.environment.iir_filter import lfilter_rows
 
-    hold, n_samples = _hold(n_steps, dt, sample_time, power)
-    samples = np.empty((len(rngs), n_samples))
-    for q, rng in enumerate(rngs):
-        samples[q] = rng.standard_normal(n_samples)
-    samples *= math.sqrt(power / sample_time)
+    samples, hold = white_samples_rows(n_steps, dt, rngs, sample_time, power)
     b, a = band_pass_eq39(dt)
     return lfilter_rows(b, a, np.repeat(samples, hold, axis=1)[:, : n_steps + 1])
 

@@ -46,7 +46,8 @@ R_MAX = math.pi   #: |r| [rad/s] beyond which a ship counts as diverged (180 deg
 @lru_cache(maxsize=None)
 def finisher(guide):
     """``finish(i, X, K, J, dt, nc, gd, GZ, REF, PS, rpm_slot, lam, reward, obs, rew, bad)``:
-    the end of lane ``i``'s env step, after its plant steps (compiled, inlined into callers).
+    the end of lane ``i``'s env step, after its plant steps (compiled like the engines' fused
+    kernels, :func:`steerlab.sim.kernels._fused`, and inlined into its callers).
 
     Counts the env step (``J[i]``), flags a diverged ship (a non-finite state or
     ``|r| > R_MAX``: ``bad[i]``, observation and reward 0), else runs the guidance kernel
@@ -56,7 +57,12 @@ def finisher(guide):
     reward (``reward`` selects the criterion, :data:`REWARDS`; ``lam`` its rudder weight).
     """
 
-    @numba.njit(inline="always")
+    from steerlab.sim.kernels import _fused, _jit_fused
+
+    g = _fused(guide)          # inlined, no reference counting: as the engines' loops call it
+    wrap = _fused(wrap_to_pi)
+
+    @_jit_fused
     def finish(i, X, K, J, dt, nc, gd, GZ, REF, PS, rpm_slot, lam, reward, obs, rew, bad):
         x = X[i]
         nx = x.shape[0]
@@ -71,10 +77,10 @@ def finisher(guide):
         bad[i] = not ok
         if ok:
             ref = REF[i]
-            guide(K[i] * dt, x, gd, GZ[i], ref, h_env)
+            g(K[i] * dt, x, gd, GZ[i], ref, h_env)
             if rpm_slot >= 0 and ref[REF_RPM] >= 0.0:
                 PS[i, rpm_slot] = ref[REF_RPM]
-            e = wrap_to_pi(ref[0] - x[2])
+            e = wrap(ref[0] - x[2])
             d = x[nx - 1]
             obs[i, 0] = e
             obs[i, 1] = x[5]
