@@ -135,24 +135,20 @@ def lane_stepper(ship_rhs, guide):
 def vector_stepper(ship_rhs, guide, nx: int):
     """The same step as :func:`lane_stepper` (same arguments but ``work``, plus ``w_index``
     (N,) int64 = ``arange(N)``), the plants advanced by the ship driver's ``step_lanes``
-    (groups of ``LANES`` ships, structure of arrays, vectorised RK4 stages)."""
+    (groups of ``LANES`` ships, structure of arrays, vectorised RK4 stages) - one compiled
+    call per env step."""
     from steerlab.sim.drivers import driver, entry
     from steerlab.sim.lanes import LANES
 
-    mod = driver(ship_rhs, None, None, int(nx), LANES)
+    plants = entry(driver(ship_rhs, None, None, int(nx), LANES), "step_lanes")   # disk-cached
     finish = finisher(guide)
 
     @numba.njit(nogil=True)
-    def finish_lanes(idx, X, K, J, dt, nc, gd, GZ, REF, PS, rpm_slot, lam, reward, obs, rew, bad):
-        for q in range(idx.shape[0]):
-            finish(idx[q], X, K, J, dt, nc, gd, GZ, REF, PS, rpm_slot, lam, reward, obs, rew, bad)
-
     def step(X, K, J, cmd, W, w_index, PS, PG, dt, nc, gd, GZ, REF, rpm_slot, lam, reward, active, obs, rew, bad):
         idx = np.flatnonzero(active)
-        if idx.shape[0] == 0:
-            return
-        entry(mod, "step_lanes")(X, K, cmd, W, w_index, PS, PG, idx, dt, nc)
-        finish_lanes(idx, X, K, J, dt, nc, gd, GZ, REF, PS, rpm_slot, lam, reward, obs, rew, bad)
+        plants(X, K, cmd, W, w_index, PS, PG, idx, dt, nc)
+        for q in range(idx.shape[0]):
+            finish(idx[q], X, K, J, dt, nc, gd, GZ, REF, PS, rpm_slot, lam, reward, obs, rew, bad)
 
     return step
 
