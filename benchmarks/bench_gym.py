@@ -11,8 +11,9 @@ waves, dt 0.1 s, control_dt 1 s = 10 RK4 steps per env step, 120 s episodes so r
 included), random actions drawn up front. For each N: env-steps/s (N ships x steps / wall) of
 ``gymnasium.make_vec(..., vectorization_mode="vector_entry_point")`` (one compiled call for N
 ships) and of ``gymnasium.vector.SyncVectorEnv`` over N single environments, and their ratio.
-Each figure is the median of ``--repeats`` after one untimed warm-up. Not a test: numbers
-depend on the machine and its load.
+Each figure is the median of ``--repeats`` after one untimed warm-up; ``reset_ms`` is the
+median wall time of one reset of all N native ships without a seed (what an autoreset round
+costs: the N seas drawn in one call). Not a test: numbers depend on the machine and its load.
 """
 
 from __future__ import annotations
@@ -41,6 +42,16 @@ def _rate(env, n, steps, repeats, seed=0):
     return n * steps / float(np.median(times))
 
 
+def _reset_ms(env, n, repeats):
+    core = env.unwrapped.core
+    times = []
+    for _ in range(max(repeats, 3)):
+        t0 = time.perf_counter()
+        core.reset_lanes(range(n))
+        times.append(time.perf_counter() - t0)
+    return 1e3 * float(np.median(times))
+
+
 def main(argv=None) -> int:
     import gymnasium as gym
 
@@ -49,7 +60,7 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--n", default="1,64,1024", help="comma-separated numbers of ships")
     ap.add_argument("--steps", type=int, default=150, help="env steps per timing (> 120: one autoreset inside)")
-    ap.add_argument("--repeats", type=int, default=2)
+    ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--json", action="store_true")
     a = ap.parse_args(argv)
     kw = {"episode_s": 120.0}
@@ -59,11 +70,12 @@ def main(argv=None) -> int:
         sync = gym.vector.SyncVectorEnv([lambda: gym.make("steerlab/CourseKeeping-v0", **kw) for _ in range(n)])
         r_native = _rate(native, n, a.steps, a.repeats)
         r_sync = _rate(sync, n, a.steps, a.repeats)
+        reset_ms = _reset_ms(native, n, a.repeats)
         rows.append({"n": n, "native_env_steps_per_s": r_native, "sync_env_steps_per_s": r_sync,
-                     "ratio": r_native / r_sync})
+                     "ratio": r_native / r_sync, "native_reset_all_ms": reset_ms})
         if not a.json:
             print(f"N={n:5d}  native {r_native:12.4g} env-steps/s   SyncVectorEnv {r_sync:12.4g}   "
-                  f"ratio {r_native / r_sync:8.1f}x", file=sys.stderr if a.json else sys.stdout)
+                  f"ratio {r_native / r_sync:8.1f}x   native reset of all N {reset_ms:8.2f} ms")
     if a.json:
         print(json.dumps({"workload": "steerlab/CourseKeeping-v0, esso 16 kn, waves, 10 RK4 steps per env step",
                           "rows": rows}, indent=2))

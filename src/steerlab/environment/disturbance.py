@@ -2,13 +2,15 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
+import numba
 import numpy as np
 
 from steerlab.environment.channels import (N_CHANNELS, W_RUDDER, W_WIND_DIR, W_WIND_SPEED,
                                            set_current)
-from steerlab.environment.waves import coloured_noise
+from steerlab.environment.iir_filter import _padded, _transposed_df2
+from steerlab.environment.waves import band_pass_eq39, coloured_noise, white_samples_rows
 from steerlab.errors import require_finite_range
 
 
@@ -78,3 +80,48 @@ def build_disturbance(dist: Disturbance, n_steps: int, dt: float, seed: int) -> 
         rng = np.random.default_rng(seed)
         w[:, W_RUDDER] += coloured_noise(n_steps, dt, rng, dist.wave_sample_time, dist.wave_power)
     return w
+
+
+def build_disturbances(dist: Disturbance, n_steps: int, dt: float, seeds, out=None, rows=None) -> np.ndarray:
+    """:func:`build_disturbance` for many seeds at once (the Gymnasium vector environment's
+    resets): the seed-free channels are built once, the seeds' wave sequences in one compiled
+    filter call (:func:`~steerlab.environment.waves.coloured_noise_rows`).
+
+    Returns ``out`` (default a new ``(len(seeds), n_steps + 1, N_CHANNELS)`` array) with
+    ``out[rows[q]]`` bit-identical to ``build_disturbance(dist, n_steps, dt, seeds[q])``
+    (``rows`` default ``0 .. len(seeds) - 1``); other rows of ``out`` are left as they are.
+    """
+    base = build_disturbance(replace(dist, waves=False), n_steps, dt, 0)
+    if out is None:
+        out = np.empty((len(seeds),) + base.shape)
+    rows = np.arange(len(seeds), dtype=np.int64) if rows is None else np.asarray(rows, dtype=np.int64)
+    if dist.waves:
+        samples, hold = white_samples_rows(n_steps, dt, [np.random.default_rng(int(s)) for s in seeds],
+                                           dist.wave_sample_time, dist.wave_power)
+        b, a = _padded(*band_pass_eq39(dt))
+    else:
+        samples, hold, b, a = np.zeros((len(seeds), 0)), 1, np.zeros(1), np.ones(1)
+    _fill(out, rows, base, samples, hold, b, a, W_RUDDER)
+    return out
+
+
+@numba.njit(cache=True)
+def _fill(out, rows, base, samples, hold, b, a, ch):
+    """``out[rows[q]] = base``, plus on channel ``ch`` (when ``samples`` has columns) the
+    wave sequence: ``samples[q]`` held ``hold`` steps each and filtered by ``b/a`` (the one
+    filter loop, :func:`~steerlab.environment.iir_filter._transposed_df2`) - the sum
+    ``base + coloured_noise`` of :func:`build_disturbance`'s ``+=``, element by element."""
+    n = base.shape[0]
+    held = np.empty(n)
+    y = np.empty(n)
+    for q in range(rows.shape[0]):
+        r = rows[q]
+        for k in range(n):
+            for c in range(base.shape[1]):
+                out[r, k, c] = base[k, c]
+        if samples.shape[1] > 0:
+            for k in range(n):
+                held[k] = samples[q, k // hold]
+            _transposed_df2(b, a, held, y)
+            for k in range(n):
+                out[r, k, ch] = base[k, ch] + y[k]

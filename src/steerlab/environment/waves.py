@@ -33,9 +33,8 @@ EQ39_NUM = (10.8, 0.0)
 EQ39_DEN = (1.0, 0.672, 2.6729)
 
 
-def held_white_noise(n_steps: int, dt: float, rng: np.random.Generator,
-                     sample_time: float = 0.5, power: float = 1e-4) -> np.ndarray:
-    """Zero-order-held white noise on the simulation grid ``k*dt``, ``k = 0..n_steps``."""
+def _hold(n_steps: int, dt: float, sample_time: float, power: float) -> tuple[int, int]:
+    """``(hold, n_samples)``: simulation steps per white-noise sample, samples drawn (checked)."""
     require_finite_range("waves.sample_time", sample_time, 0.0, lo_open=True)
     require_finite_range("waves.power", power, 0.0)
     ratio = sample_time / dt
@@ -43,7 +42,13 @@ def held_white_noise(n_steps: int, dt: float, rng: np.random.Generator,
     if hold < 1 or abs(ratio - hold) > 1e-9 * max(1.0, ratio):
         raise InputError("waves.sample_time",
                          f"must be a positive integer multiple of dt={dt} s, got {sample_time} s")
-    n_samples = n_steps // hold + 1
+    return hold, n_steps // hold + 1
+
+
+def held_white_noise(n_steps: int, dt: float, rng: np.random.Generator,
+                     sample_time: float = 0.5, power: float = 1e-4) -> np.ndarray:
+    """Zero-order-held white noise on the simulation grid ``k*dt``, ``k = 0..n_steps``."""
+    hold, n_samples = _hold(n_steps, dt, sample_time, power)
     samples = rng.standard_normal(n_samples) * math.sqrt(power / sample_time)
     return np.repeat(samples, hold)[: n_steps + 1]
 
@@ -83,6 +88,32 @@ def coloured_noise(n_steps: int, dt: float, rng: np.random.Generator,
     b, a = band_pass_eq39(dt)
     # ZOH discretisation: output k depends on inputs up to k-1 (b[0] == 0)
     return lfilter(b, a, white)
+
+
+def white_samples_rows(n_steps: int, dt: float, rngs, sample_time: float = 0.5,
+                       power: float = 1e-4) -> tuple[np.ndarray, int]:
+    """The white-noise samples of :func:`held_white_noise` for each generator of ``rngs``:
+    ``(samples, hold)``, ``samples`` ``(len(rngs), n_samples)`` (row ``q`` the draws and
+    products ``held_white_noise(n_steps, dt, rngs[q], ...)`` holds, ``hold`` steps each)."""
+    hold, n_samples = _hold(n_steps, dt, sample_time, power)
+    samples = np.empty((len(rngs), n_samples))
+    for q, rng in enumerate(rngs):
+        samples[q] = rng.standard_normal(n_samples)
+    samples *= math.sqrt(power / sample_time)
+    return samples, hold
+
+
+def coloured_noise_rows(n_steps: int, dt: float, rngs, sample_time: float = 0.5,
+                        power: float = 1e-4) -> np.ndarray:
+    """:func:`coloured_noise` for each generator of ``rngs``, filtered in one compiled call:
+    array ``(len(rngs), n_steps + 1)`` [rad] whose row ``q`` is bit-identical to
+    ``coloured_noise(n_steps, dt, rngs[q], sample_time, power)`` (the same draws, products
+    and filter loop; only the Python overhead per sequence is gone)."""
+    from steerlab.environment.iir_filter import lfilter_rows
+
+    samples, hold = white_samples_rows(n_steps, dt, rngs, sample_time, power)
+    b, a = band_pass_eq39(dt)
+    return lfilter_rows(b, a, np.repeat(samples, hold, axis=1)[:, : n_steps + 1])
 
 
 def stationary_std_eq39(power: float = 1e-4, num=EQ39_NUM, den=EQ39_DEN) -> float:

@@ -10,6 +10,14 @@ plant steps, order held). Each lane owns a random generator (gymnasium's
 ``seeding.np_random``); at reset it draws the sea's seed and, for course keeping, the initial
 heading offset. Lanes are independent: lane i of N behaves as a single environment seeded
 alike.
+
+``vectorised=True`` (the native vector environment) advances the ships with the batch
+engine's vectorised groups (:func:`steerlab.gym.plant_batch.vector_stepper`) instead of one
+after the other; the numbers are the same. Resets of many lanes draw their seas in one call
+(:func:`steerlab.environment.disturbance.build_disturbances`, the seas
+:func:`~steerlab.sim.setup.realise` gives, without re-designing anything per reset); a sea
+with optional blocks (``uses_sea``: spectra, gusts, current variation, wind rudder) is
+realised lane by lane.
 """
 
 from __future__ import annotations
@@ -55,11 +63,13 @@ class Episodes:
 
     def __init__(self, n, task="course_keeping", ship="esso", speed_kn=16.0, gear=None, environment=None,
                  ship_options=None, dt=0.1, control_dt=1.0, episode_s=300.0, lam=0.1,
-                 initial_offset_deg=10.0, change_deg=20.0, change_t=10.0, guidance=None, reward="speed_loss"):
-        from steerlab.gym.plant_batch import REWARDS, lane_stepper
+                 initial_offset_deg=10.0, change_deg=20.0, change_t=10.0, guidance=None, reward="speed_loss",
+                 vectorised=False):
+        from steerlab.environment.sea import uses_sea
+        from steerlab.gym.plant_batch import REWARDS, lane_stepper, resetter, vector_stepper
         from steerlab.guidance.reference_models import course_guide
         from steerlab.guidance.reference_vector import initial_reference
-        from steerlab.sim.setup import build_seeds
+        from steerlab.sim.setup import design, realise
 
         if task not in TASKS:
             raise InputError("task", f"must be one of {TASKS}, got {task!r}")
@@ -79,8 +89,12 @@ class Episodes:
         self.n_env_steps = int(math.ceil(episode_s / control_dt - 1e-9))
         self.scenario = _scenario(task, ship, speed_kn, gear, environment, ship_options, dt,
                                   self.n_env_steps * nc * dt, change_deg, change_t, guidance)
-        self._build_seeds = build_seeds
-        s0 = build_seeds(self.scenario, [0])[0]
+        self.design = design(self.scenario)
+        self._realise = realise
+        s0 = realise(self.design, 0)
+        # the seed changes only the sea (no sensors here): draw many lanes' seas at once unless
+        # an optional sea block needs the per-seed machinery
+        self._fast_seas = not uses_sea(self.scenario.environment) and self.scenario.sensors is None
         self.task, self.n, self.dt, self.nc, self.lam = task, int(n), float(dt), nc, float(lam)
         self.control_dt = nc * self.dt
         self.offset_max = rad(initial_offset_deg) if task == "course_keeping" else 0.0
@@ -103,8 +117,16 @@ class Episodes:
         self.rew = np.zeros(n)
         self.bad = np.zeros(n, dtype=np.bool_)
         self.active = np.ones(n, dtype=np.bool_)
+        self.W[:] = s0.w
+        self.w_index = np.arange(n, dtype=np.int64)
         self._work = np.empty((5, nx))
-        self._step = lane_stepper(s0.ship.rhs, self.guide)
+        self.vectorised = bool(vectorised)
+        if self.vectorised:
+            self._vstep = vector_stepper(s0.ship.rhs, self.guide, nx)
+        else:
+            self._step = lane_stepper(s0.ship.rhs, self.guide)
+        self._reset = resetter(self.guide)
+        self._x0, self._ps0, self._ref0 = s0.x0, s0.ps, initial_reference()
         self.rngs = [None] * n
 
     # ----------------------------------------------------------------- reset
@@ -112,44 +134,41 @@ class Episodes:
         """Reset ``lanes`` (indices); ``seeds[i]`` (int or None) reseeds lane's generator first."""
         from gymnasium.utils import seeding
 
-        from steerlab.guidance.reference_vector import REF_RPM, initial_reference
-        from steerlab.gym.plant_batch import observe
+        from steerlab.environment.disturbance import build_disturbances
 
-        lanes = list(lanes)
-        sea_seeds, offsets = [], []
-        for q, i in enumerate(lanes):
+        lanes = np.asarray(list(lanes), dtype=np.int64)
+        m = lanes.shape[0]
+        sea_seeds, offsets = [], np.zeros(m)
+        for q, i in enumerate(lanes.tolist()):
             s = None if seeds is None else seeds[q]
             if s is not None or self.rngs[i] is None:
                 self.rngs[i], _ = seeding.np_random(s)
             rng = self.rngs[i]
             sea_seeds.append(int(rng.integers(0, 2**31 - 1)))
-            offsets.append(float(rng.uniform(-self.offset_max, self.offset_max)) if self.offset_max > 0 else 0.0)
-        setups = self._build_seeds(self.scenario, sea_seeds)
-        for q, i in enumerate(lanes):
-            su = setups[q]
-            self.X[i] = su.x0
-            self.X[i, 2] += offsets[q]
-            self.W[i] = su.w
-            self.PS[i] = su.ps
-            self.K[i] = 0
-            self.J[i] = 0
-            self.cmd[i] = 0.0
-            self.bad[i] = False
-            self.GZ[i] = su.gz0
-            self.REF[i] = initial_reference()
-            self.guide(0.0, self.X[i], self.gd, self.GZ[i], self.REF[i], self.control_dt)
-            if self.rpm_slot >= 0 and self.REF[i, REF_RPM] >= 0.0:
-                self.PS[i, self.rpm_slot] = self.REF[i, REF_RPM]
-            observe(self.X[i], self.REF[i, 0], self.obs[i])
-            self.rew[i] = 0.0
-        return [{"sea_seed": sea_seeds[q], "initial_heading": float(self.X[i, 2])} for q, i in enumerate(lanes)]
+            if self.offset_max > 0:
+                offsets[q] = float(rng.uniform(-self.offset_max, self.offset_max))
+        if self._fast_seas:
+            sc = self.scenario
+            build_disturbances(self.design.dist, sc.n_steps, sc.dt, sea_seeds, out=self.W, rows=lanes)
+        else:
+            for q, i in enumerate(lanes.tolist()):
+                self.W[i] = self._realise(self.design, sea_seeds[q]).w
+        self.K[lanes] = 0
+        self.J[lanes] = 0
+        self.cmd[lanes] = 0.0
+        self.bad[lanes] = False
+        self.rew[lanes] = 0.0
+        self._reset(lanes, self.X, self.PS, self.GZ, self.REF, self._x0, self._ps0, self.gz0, self._ref0, offsets,
+                    self.gd, self.control_dt, self.rpm_slot, self.obs)
+        return [{"sea_seed": sea_seeds[q], "initial_heading": float(self.X[i, 2])}
+                for q, i in enumerate(lanes.tolist())]
 
     # ----------------------------------------------------------------- step
     def orders(self, actions) -> np.ndarray:
         """Rudder orders [rad] from actions in [-1, 1] (fraction of the gear limit); refuses others."""
         a = np.asarray(actions, dtype=np.float64).reshape(self.n)
-        if not np.all(np.isfinite(a)) or np.any(np.abs(a) > 1.0):
-            i = int(np.argmax(~np.isfinite(a) | (np.abs(a) > 1.0)))
+        if not (np.abs(a) <= 1.0).all():                 # NaN fails the comparison too
+            i = int(np.argmax(~(np.abs(a) <= 1.0)))
             raise InputError("action", f"must be finite and in [-1, 1] (rudder order / gear limit "
                                        f"{math.degrees(self.delta_max):g} deg), got {a[i]!r}")
         return a * self.delta_max
@@ -158,7 +177,13 @@ class Episodes:
         """Advance the ``active`` lanes (default all) by one env step; fills ``obs``, ``rew``, ``bad``."""
         self.cmd[:] = self.orders(actions)
         act = self.active if active is None else active
-        self._step(self.X, self.K, self.J, self.cmd, self.W, self.PS, self.PG, self.dt, self.nc, self.gd, self.GZ,
-                   self.REF, self.rpm_slot, self.lam, self.reward, act, self.obs, self.rew, self.bad, self._work)
+        if self.vectorised:
+            self._vstep(self.X, self.K, self.J, self.cmd, self.W, self.w_index, self.PS, self.PG, self.dt, self.nc,
+                        self.gd, self.GZ, self.REF, self.rpm_slot, self.lam, self.reward, act, self.obs, self.rew,
+                        self.bad)
+        else:
+            self._step(self.X, self.K, self.J, self.cmd, self.W, self.PS, self.PG, self.dt, self.nc, self.gd,
+                       self.GZ, self.REF, self.rpm_slot, self.lam, self.reward, act, self.obs, self.rew, self.bad,
+                       self._work)
         truncated = self.J >= self.n_env_steps
         return self.obs, self.rew, self.bad.copy(), truncated & ~self.bad

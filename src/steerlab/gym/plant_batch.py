@@ -1,11 +1,19 @@
-r"""One compiled call that advances N ships (same model) by one environment step each.
+r"""Compiled calls that advance N ships (same model) by one environment step each.
 
-``step_lanes`` loops over the N plants; each plant takes ``nc`` classic RK4 steps of ship +
-steering gear with its rudder order held - the engines' own kernel
-(:func:`steerlab.sim.kernels.plant_step`) - at the engine's times ``t = k dt``, then the
-scenario's guidance kernel gives the new reference and the observation and the reward of the
-lane are computed by scalar code, so a lane's numbers do not depend on N or on the other lanes
-(the single environment is the same call with N = 1).
+Each plant takes ``nc`` classic RK4 steps of ship + steering gear with its rudder order held,
+at the engine's times ``t = k dt``; then (:func:`finisher`) the scenario's guidance kernel
+gives the new reference and the observation and the reward of the lane are computed by
+scalar code. Two schedules of the same operations:
+
+* :func:`lane_stepper` (the single environment): one plant after the other through the
+  engines' scalar step (:func:`steerlab.sim.kernels.plant_step`);
+* :func:`vector_stepper` (the native vector environment): the ship driver's ``step_lanes``
+  (:mod:`steerlab.sim.driver_template`), the batch engine's structure-of-arrays groups of
+  ``LANES`` ships with every RK4 stage vectorised across the group.
+
+Per ship both perform the same IEEE operations in the same order, so a lane's numbers do not
+depend on N, on the schedule or on the other lanes: ship i of the vector environment equals
+a single environment seeded alike, bit for bit (``tests/test_gym.py``).
 
 Observation ``[e, r, delta]``: heading error ``e = wrap_to_pi(psi_ref - psi)`` [rad], yaw
 rate ``r`` [rad/s], rudder angle ``delta`` [rad]. Rewards (after the step, e and delta in rad,
@@ -36,27 +44,80 @@ R_MAX = math.pi   #: |r| [rad/s] beyond which a ship counts as diverged (180 deg
 
 
 @lru_cache(maxsize=None)
+def finisher(guide):
+    """``finish(i, X, K, J, dt, nc, gd, GZ, REF, PS, rpm_slot, lam, reward, obs, rew, bad)``:
+    the end of lane ``i``'s env step, after its plant steps (compiled like the engines' fused
+    kernels, :func:`steerlab.sim.kernels._fused`, and inlined into its callers).
+
+    Counts the env step (``J[i]``), flags a diverged ship (a non-finite state or
+    ``|r| > R_MAX``: ``bad[i]``, observation and reward 0), else runs the guidance kernel
+    ``guide(t, x, gd, gz, ref, h)`` at ``t = K[i] dt`` (the engines' one, e.g. the time-only
+    course schedule or LOS; as in the engines a propeller-rate order ``ref[REF_RPM] >= 0``
+    goes to ``PS[i, rpm_slot]`` when ``rpm_slot >= 0``) and writes the observation and the
+    reward (``reward`` selects the criterion, :data:`REWARDS`; ``lam`` its rudder weight).
+    """
+
+    from steerlab.sim.kernels import _fused, _jit_fused
+
+    g = _fused(guide)          # inlined, no reference counting: as the engines' loops call it
+    wrap = _fused(wrap_to_pi)
+
+    @_jit_fused
+    def finish(i, X, K, J, dt, nc, gd, GZ, REF, PS, rpm_slot, lam, reward, obs, rew, bad):
+        x = X[i]
+        nx = x.shape[0]
+        h_env = nc * dt
+        J[i] += 1
+        ok = True
+        for q in range(nx):
+            if not np.isfinite(x[q]):
+                ok = False
+        if not abs(x[5]) <= R_MAX:
+            ok = False
+        bad[i] = not ok
+        if ok:
+            ref = REF[i]
+            g(K[i] * dt, x, gd, GZ[i], ref, h_env)
+            if rpm_slot >= 0 and ref[REF_RPM] >= 0.0:
+                PS[i, rpm_slot] = ref[REF_RPM]
+            e = wrap(ref[0] - x[2])
+            d = x[nx - 1]
+            obs[i, 0] = e
+            obs[i, 1] = x[5]
+            obs[i, 2] = d
+            if reward == REWARD_SPEED_LOSS:
+                rew[i] = -(e * e + lam * d * d) * h_env
+            elif reward == REWARD_ITAE:
+                rew[i] = -(K[i] * dt) * abs(e) * h_env
+            else:
+                rew[i] = -abs(e) * h_env
+        else:
+            obs[i, 0] = 0.0
+            obs[i, 1] = 0.0
+            obs[i, 2] = 0.0
+            rew[i] = 0.0
+
+    return finish
+
+
+@lru_cache(maxsize=None)
 def lane_stepper(ship_rhs, guide):
-    """``step_lanes(X, K, J, cmd, W, PS, PG, dt, nc, gd, GZ, REF, rpm_slot, lam, reward, active, obs, rew, bad, work)``.
+    """``step_lanes(X, K, J, cmd, W, PS, PG, dt, nc, gd, GZ, REF, rpm_slot, lam, reward, active, obs, rew, bad, work)``,
+    one plant after the other (the single environment).
 
     ``X`` (N, nx) plant states, ``K`` (N,) plant-step counters, ``J`` (N,) env-step counters,
     ``cmd`` (N,) rudder orders [rad], ``W`` (N, n_steps + 1, channels) disturbances, ``PS``,
     ``PG`` packed ship and gear records, ``gd`` the guidance record, ``GZ`` (N, n_gz) guidance
-    states and ``REF`` (N, N_REF) reference vectors (advanced in place); after the plant steps
-    the guidance kernel ``guide(t, x, gd, gz, ref, h)`` (the engines' one, e.g. the time-only
-    course schedule or LOS) gives the new reference, and, as in the engines, a propeller-rate
-    order ``ref[REF_RPM] >= 0`` goes to ``PS[i, rpm_slot]`` when ``rpm_slot >= 0``. ``reward``
-    selects the criterion (:data:`REWARDS`), ``lam`` its rudder weight. ``active``
-    (N,) lanes to step; writes ``obs`` (N, 3), ``rew`` (N,), ``bad`` (N,) diverged (a
-    non-finite state or ``|r| > R_MAX``). ``work`` is a (5, nx) scratch array.
+    states and ``REF`` (N, N_REF) reference vectors (advanced in place); ``active`` (N,) lanes
+    to step; writes ``obs`` (N, 3), ``rew`` (N,), ``bad`` (N,) (:func:`finisher`). ``work`` is
+    a (5, nx) scratch array.
     """
     rk4_step = plant_step(ship_rhs)
+    finish = finisher(guide)
 
     @numba.njit
     def step_lanes(X, K, J, cmd, W, PS, PG, dt, nc, gd, GZ, REF, rpm_slot, lam, reward, active, obs, rew, bad,
                    work):
-        nx = X.shape[1]
-        h_env = nc * dt
         for i in range(X.shape[0]):
             if not active[i]:
                 continue
@@ -65,37 +126,56 @@ def lane_stepper(ship_rhs, guide):
                 k = K[i]
                 rk4_step(k * dt, x, cmd[i], W[i, k], PS[i], PG[i], dt, work)
                 K[i] = k + 1
-            J[i] += 1
-            ok = True
-            for q in range(nx):
-                if not np.isfinite(x[q]):
-                    ok = False
-            if not abs(x[5]) <= R_MAX:
-                ok = False
-            bad[i] = not ok
-            if ok:
-                ref = REF[i]
-                guide(K[i] * dt, x, gd, GZ[i], ref, h_env)
-                if rpm_slot >= 0 and ref[REF_RPM] >= 0.0:
-                    PS[i, rpm_slot] = ref[REF_RPM]
-                e = wrap_to_pi(ref[0] - x[2])
-                d = x[nx - 1]
-                obs[i, 0] = e
-                obs[i, 1] = x[5]
-                obs[i, 2] = d
-                if reward == REWARD_SPEED_LOSS:
-                    rew[i] = -(e * e + lam * d * d) * h_env
-                elif reward == REWARD_ITAE:
-                    rew[i] = -(K[i] * dt) * abs(e) * h_env
-                else:
-                    rew[i] = -abs(e) * h_env
-            else:
-                obs[i, 0] = 0.0
-                obs[i, 1] = 0.0
-                obs[i, 2] = 0.0
-                rew[i] = 0.0
+            finish(i, X, K, J, dt, nc, gd, GZ, REF, PS, rpm_slot, lam, reward, obs, rew, bad)
 
     return step_lanes
+
+
+@lru_cache(maxsize=None)
+def vector_stepper(ship_rhs, guide, nx: int):
+    """The same step as :func:`lane_stepper` (same arguments but ``work``, plus ``w_index``
+    (N,) int64 = ``arange(N)``), the plants advanced by the ship driver's ``step_lanes``
+    (groups of ``LANES`` ships, structure of arrays, vectorised RK4 stages) - one compiled
+    call per env step."""
+    from steerlab.sim.drivers import driver, entry
+    from steerlab.sim.lanes import LANES
+
+    plants = entry(driver(ship_rhs, None, None, int(nx), LANES), "step_lanes")   # disk-cached
+    finish = finisher(guide)
+
+    @numba.njit(nogil=True)
+    def step(X, K, J, cmd, W, w_index, PS, PG, dt, nc, gd, GZ, REF, rpm_slot, lam, reward, active, obs, rew, bad):
+        idx = np.flatnonzero(active)
+        plants(X, K, cmd, W, w_index, PS, PG, idx, dt, nc)
+        for q in range(idx.shape[0]):
+            finish(idx[q], X, K, J, dt, nc, gd, GZ, REF, PS, rpm_slot, lam, reward, obs, rew, bad)
+
+    return step
+
+
+@lru_cache(maxsize=None)
+def resetter(guide):
+    """``reset(idx, X, PS, GZ, REF, x0, ps, gz0, ref0, offsets, gd, h_env, rpm_slot, obs)``: the
+    lanes ``idx`` back to the design's start (``x0`` with the heading offset ``offsets[q]``
+    [rad] added, ``ps``, ``gz0``, ``ref0``), their first reference from the guidance kernel
+    at ``t = 0`` (a propeller order to ``PS[i, rpm_slot]`` as in :func:`finisher`) and their
+    observation (:func:`observe`); one compiled call for all of them."""
+
+    @numba.njit
+    def reset(idx, X, PS, GZ, REF, x0, ps, gz0, ref0, offsets, gd, h_env, rpm_slot, obs):
+        for q in range(idx.shape[0]):
+            i = idx[q]
+            X[i, :] = x0
+            X[i, 2] += offsets[q]
+            PS[i, :] = ps
+            GZ[i, :] = gz0
+            REF[i, :] = ref0
+            guide(0.0, X[i], gd, GZ[i], REF[i], h_env)
+            if rpm_slot >= 0 and REF[i, REF_RPM] >= 0.0:
+                PS[i, rpm_slot] = REF[i, REF_RPM]
+            observe(X[i], REF[i, 0], obs[i])
+
+    return reset
 
 
 @numba.njit

@@ -3,7 +3,9 @@ r"""The native vector environment: N ships stepped in one compiled call.
 ``gymnasium.make_vec("steerlab/CourseKeeping-v0", num_envs=N, vectorization_mode="vector_entry_point")``
 gives a :class:`SteeringVectorEnv`: spaces, reward and episodes as the single
 :class:`~steerlab.gym.env.SteeringEnv` (observations (N, 3), actions (N, 1)), all N ships
-advanced by one numba loop (:mod:`steerlab.gym.plant_batch`). ``reset(seed=s)`` seeds ship i
+advanced by the batch engine's vectorised groups of ``LANES`` ships in one compiled call
+(:func:`steerlab.gym.plant_batch.vector_stepper`; the single environment steps its ship with
+the scalar kernel, with the same numbers). ``reset(seed=s)`` seeds ship i
 with ``s + i`` (as gymnasium's ``SyncVectorEnv``), so ship i's episode equals a single
 environment's reset with seed ``s + i``. Autoreset: gymnasium's ``NEXT_STEP`` mode (the step
 after an episode ends resets that ship and ignores its action; reward 0).
@@ -25,7 +27,7 @@ class SteeringVectorEnv(VectorEnv):
 
     def __init__(self, num_envs: int = 1, task="course_keeping", render_mode=None, **kw):
         self.num_envs = int(num_envs)
-        self.core = Episodes(self.num_envs, task=task, **kw)
+        self.core = Episodes(self.num_envs, task=task, vectorised=True, **kw)
         self.single_observation_space, self.single_action_space = spaces()
         self.observation_space = batch_space(self.single_observation_space, self.num_envs)
         self.action_space = batch_space(self.single_action_space, self.num_envs)

@@ -17,10 +17,14 @@ What is in a driver (one definition of each loop, for every engine):
 * ``run``: the single run's closed loop (:func:`steerlab.sim.kernels.guided_closed_loop`
   documents its arguments);
 * ``group``: the batch engine's loop over a group of ``LANES`` runs in lock step,
-  structure of arrays, vectorised across the runs (:mod:`steerlab.sim.lanes` documents it).
+  structure of arrays, vectorised across the runs (:mod:`steerlab.sim.lanes` documents it);
+* ``step_lanes``: N plants (no controller), each with its own held rudder order, clock and
+  disturbance rows, advanced by a few RK4 steps in groups of ``LANES``, structure of arrays,
+  vectorised like ``group`` (the Gymnasium vector environment, :mod:`steerlab.gym.plant_batch`).
 
-Per run, both loops perform the same operations in the same order, so a batch run is
-bit-identical to the same run alone; the readable engine calls the same ``rk4_step``.
+Per run, these loops perform the same operations in the same order, so a batch run is
+bit-identical to the same run alone, and a plant of ``step_lanes`` to the same plant stepped
+by ``rk4_step``; the readable engine calls the same ``rk4_step``.
 Only what is called is compiled: a process that runs one scenario compiles (or loads) only
 ``run``.
 
@@ -317,3 +321,96 @@ def group(X, Z, PS, PG, PC, GD, GZ, W, w_index, i0, n_act, dt, nc, n_steps, rec_
         rk4_lanes(t, k, i0, n_act, CMD, W, w_index, dt, h2, s6, ACC, E, DPREV,
                   XL, PL, PGL, WL, K1, K2, K3, K4, XT)
     store(X, i0, n_act, XL)
+
+
+# ---------------------------------------------------------------- plants only: N ships, groups of LANES
+
+@_jit_fused
+def load_plants(X, PS, PG, idx, i0, n_act, XL, PL, PGL):
+    """Copy the states and ship and gear records of plants ``idx[i0 .. i0 + n_act - 1]`` into
+    the group's scratch (columns = plants)."""
+    for g in range(n_act):
+        i = idx[i0 + g]
+        for q in range(NX):
+            XL[q, g] = X[i, q]
+        for q in range(PS.shape[1]):
+            PL[q, g] = PS[i, q]
+        for q in range(PG.shape[1]):
+            PGL[q, g] = PG[i, q]
+
+
+@_jit_fused
+def store_plants(X, idx, i0, n_act, XL):
+    """Copy the group's states back to plants ``idx[i0 .. i0 + n_act - 1]``."""
+    for g in range(n_act):
+        i = idx[i0 + g]
+        for q in range(NX):
+            X[i, q] = XL[q, g]
+
+
+@_jit_fused
+def rk4_plants(n_act, T, CMD, dt, h2, s6, XL, PL, PGL, WL, K1, K2, K3, K4, XT):
+    """One RK4 step of every plant of the group, each at its own time ``T[g]`` [s] with its own
+    held order ``CMD[g]`` and disturbance column ``WL[:, g]``: :func:`rk4_lanes`' stages
+    (per plant the operations of :func:`rk4`), without the metrics accumulator."""
+    # the loops over g below are the vectorised ones: keep their bodies free of calls
+    for g in range(n_act):
+        plant_rhs(T[g], XL[:, g], CMD[g], WL[:, g], PL[:, g], PGL[:, g], K1[:, g])
+    for q in range(NX):
+        for g in range(n_act):
+            XT[q, g] = rk4_stage(XL[q, g], h2, K1[q, g])
+    for g in range(n_act):
+        plant_rhs(T[g] + h2, XT[:, g], CMD[g], WL[:, g], PL[:, g], PGL[:, g], K2[:, g])
+    for q in range(NX):
+        for g in range(n_act):
+            XT[q, g] = rk4_stage(XL[q, g], h2, K2[q, g])
+    for g in range(n_act):
+        plant_rhs(T[g] + h2, XT[:, g], CMD[g], WL[:, g], PL[:, g], PGL[:, g], K3[:, g])
+    for q in range(NX):
+        for g in range(n_act):
+            XT[q, g] = rk4_stage(XL[q, g], dt, K3[q, g])
+    for g in range(n_act):
+        plant_rhs(T[g] + dt, XT[:, g], CMD[g], WL[:, g], PL[:, g], PGL[:, g], K4[:, g])
+    for q in range(NX):
+        for g in range(n_act):
+            XL[q, g] = rk4_update(XL[q, g], s6, K1[q, g], K2[q, g], K3[q, g], K4[q, g])
+    for g in range(n_act):
+        XL[NX - 1, g] = clamp(XL[NX - 1, g], PGL[:, g])
+
+
+@numba.njit(nogil=True, cache=CACHE)
+def step_lanes(X, K, CMD, W, w_index, PS, PG, idx, dt, n_sub):
+    """Advance plants ``idx`` of ``X`` by ``n_sub`` RK4 steps of ``dt`` [s] each, in place.
+
+    ``X`` (N, NX) plant states ``[ship states..., delta]``; ``K`` (N,) int64 plant-step
+    counters: plant ``i``'s step ``k = K[i]`` runs from ``t = k dt`` with disturbance row
+    ``W[w_index[i], k]`` (``W``: a stack of disturbance sequences, ``(n_seas, n_rows,
+    channels)``, shared by index as in the batch engine), and ``K[i]`` advances by ``n_sub``;
+    ``CMD`` (N,) rudder orders [rad], held; ``PS``, ``PG`` (N, .) packed ship and gear
+    records; ``idx`` (M,) int64 the plants to advance (others untouched). The plants go
+    through in groups of ``LANES``, structure of arrays, each RK4 stage vectorised across the
+    group (:func:`rk4_plants`); per plant the operations and their order are those of
+    :func:`rk4_step` called ``n_sub`` times with ``t = k * dt``, so each plant's numbers are
+    bit-identical to that scalar step's, whatever N, ``idx`` or the other plants.
+    """
+    XL, PL, PGL, WL, K1, K2, K3, K4, XT, CL, TL, _ = scratch(PS.shape[1], PG.shape[1], W.shape[2])
+    h2 = 0.5 * dt
+    s6 = dt / 6.0
+    m = idx.shape[0]
+    for i0 in range(0, m, G):
+        n_act = min(G, m - i0)
+        load_plants(X, PS, PG, idx, i0, n_act, XL, PL, PGL)
+        for g in range(n_act):
+            CL[g] = CMD[idx[i0 + g]]
+        for s in range(n_sub):
+            for g in range(n_act):
+                i = idx[i0 + g]
+                k = K[i] + s
+                TL[g] = k * dt
+                row = W[w_index[i], k]
+                for c in range(row.shape[0]):
+                    WL[c, g] = row[c]
+            rk4_plants(n_act, TL, CL, dt, h2, s6, XL, PL, PGL, WL, K1, K2, K3, K4, XT)
+        store_plants(X, idx, i0, n_act, XL)
+        for g in range(n_act):
+            K[idx[i0 + g]] += n_sub

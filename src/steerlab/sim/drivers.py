@@ -1,7 +1,8 @@
 """Compiled drivers, compiled once ever: one generated module per combination, cached on disk.
 
 A *driver* is the compiled closed loop of one (ship, controller, guidance, plant size,
-lanes) combination: the single run, the batch group and the plant step
+lanes) combination: the single run, the batch group, the plant step and the vectorised
+plant step of N ships
 (:mod:`steerlab.sim.driver_template`). Numba cannot cache closures across processes, so
 instead of building the loops as closures this module writes each combination's driver as
 a small Python module in the driver cache directory, whose kernels are module globals, and
@@ -54,7 +55,7 @@ from steerlab.numba_cache import _fingerprint
 TEMPLATE = Path(__file__).with_name("driver_template.py")
 BEGIN = "# ---- bindings: replaced in every generated driver ----"
 END = "# ---- end of bindings ----"
-ENTRY_POINTS = ("run", "group", "rk4_step", "replay_rudder")
+ENTRY_POINTS = ("run", "group", "rk4_step", "replay_rudder", "step_lanes")
 MODULE_PREFIX = "steerlab_driver_"
 
 _LOCK = threading.RLock()
@@ -149,6 +150,22 @@ def _make(key: _Key) -> types.ModuleType:
             # by name: the same driver, compiled in memory
             pass
     return _in_memory(key)
+
+
+_TWINS: dict = {}
+
+
+def in_memory_twin(ship_rhs, ctrl_update=None, guide=None, nx: int = 0, lanes: int = 16) -> types.ModuleType:
+    """The combination's driver compiled in this process only, never from the disk cache
+    (memoised): numba cannot show the LLVM IR of machine code it loaded from its cache, so
+    IR inspection (:func:`steerlab.sim.lanes.vectorisation_report`) compiles this twin - the
+    same source and kernels - instead."""
+    key = _Key(ship_rhs, ctrl_update, guide, int(nx), int(lanes))
+    with _LOCK:
+        mod = _TWINS.get(key)
+        if mod is None:
+            mod = _TWINS[key] = _in_memory(key)
+        return mod
 
 
 def _in_memory(key: _Key) -> types.ModuleType:
@@ -259,7 +276,8 @@ def entry(mod: types.ModuleType, name: str):
     disp = getattr(mod, name)
     if on_compile is not None and not disp.signatures and not is_compiled_on_disk(mod, name):
         what = {"run": "closed loop", "group": "batch loop", "rk4_step": "plant step",
-                "replay_rudder": "rudder replay"}[name]
+                "replay_rudder": "rudder replay",
+                "step_lanes": "vectorised plant step"}[name]
         on_compile(f"steerlab: compiling the {what} for {mod._steerlab_label} "
                    f"(first use{'; cached for next time' if mod._steerlab_cached else ''}) ...")
     return disp

@@ -171,16 +171,39 @@ def vectorisation_report(ship_rhs, ctrl_update, nx: int, guide=None, lanes: int 
     arithmetic, 4 when all RK4 stages are vectorised; the list names library functions the
     vectoriser could only call once per run (``sin``, ``exp`` ...: such a kernel is vectorised
     in name only). A kernel with branches, loops or library calls gives 0 stages.
+    Machine code loaded from the disk cache has no IR to show: the same driver is then
+    compiled once in this process for the inspection (:func:`steerlab.sim.drivers.in_memory_twin`).
     """
+    g = course_guide if guide is None else guide
+    return _report(ship_rhs, ctrl_update, g, int(nx), int(lanes), "group",
+                   "the group has not been compiled yet: run a batch of this combination first")
+
+
+def plant_lanes_report(ship_rhs, nx: int, lanes: int = LANES) -> dict:
+    """:func:`vectorisation_report` for the plant-only ``step_lanes`` entry point of a ship
+    (the Gymnasium vector environment's N ships, :mod:`steerlab.gym.plant_batch`): 4
+    vectorised stages when every RK4 stage runs across the group. Raises ``RuntimeError``
+    if ``step_lanes`` has not been called for this ship, plant size and group size."""
+    return _report(ship_rhs, None, None, int(nx), int(lanes), "step_lanes",
+                   "step_lanes has not been compiled yet: step a vector environment of this ship first")
+
+
+def _report(ship_rhs, ctrl_update, guide, nx: int, lanes: int, name: str, not_compiled: str) -> dict:
     import re
     import struct
 
     from steerlab import sincos as sincos_module
+    from steerlab.sim.drivers import driver, in_memory_twin
 
-    group = lane_loop(ship_rhs, ctrl_update, course_guide if guide is None else guide, int(nx), int(lanes))
-    if not group.signatures:
-        raise RuntimeError("the group has not been compiled yet: run a batch of this combination first")
-    ir = "\n".join(group.inspect_llvm().values())
+    disp = getattr(driver(ship_rhs, ctrl_update, guide, nx, lanes), name)
+    if not disp.signatures:
+        raise RuntimeError(not_compiled)
+    if any(disp.stats.cache_hits.values()):        # loaded from numba's cache: no IR; compile a twin
+        twin = getattr(in_memory_twin(ship_rhs, ctrl_update, guide, nx, lanes), name)
+        for sig in disp.signatures:
+            twin.compile(sig)
+        disp = twin
+    ir = "\n".join(disp.inspect_llvm().values())
     s1 = "0x%016X" % struct.unpack("<Q", struct.pack("<d", sincos_module._S1))[0]
     stages = sum(1 for line in ir.splitlines() if s1 in line and "x double>" in line)
     calls = set(re.findall(r"@llvm\.(\w+)\.[\w.]*v\d+f64", ir)) - _CHEAP_VECTOR_INTRINSICS
