@@ -250,7 +250,7 @@ def quantity_label(v: Variation, ship: str = "") -> str:
 
 def metric_label(metric: str, scale: int = 0) -> str:
     """``itae [deg s^2]`` (with a ``10^k`` factor when the cell labels are scaled)."""
-    from steerlab.tuning.cost import LOGGED, ONLINE
+    from steerlab.costs import LOGGED, ONLINE
 
     unit = ONLINE[metric][1] if metric in ONLINE else LOGGED.get(metric)
     factor = f"10^{scale} " if scale else ""
