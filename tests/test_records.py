@@ -19,8 +19,11 @@ DECLARED = {
     "steerlab.guidance.reference_vector": ("REFERENCE", "REF_", "N_REF"),
     "steerlab.environment.channels": ("CHANNELS", "W_", "N_CHANNELS"),
     "steerlab.metrics_online": ("ACCUMULATOR", "M_", "N_ACC"),
-    "steerlab.control.pid": ("PARAMS", "C_", "N_PARAMS"),
+    "steerlab.control.pid": [("PARAMS", "C_", "N_PARAMS"), ("STATE", "Z_", "N_STATE")],
+    "steerlab.ships.state": ("PLANAR", "I", "N_PLANAR"),
 }
+"""module -> (layout attribute, constant prefix, length constant), or a list of them for a module
+with several layouts (the size name may be None where a record has a variable-length tail)."""
 
 _HAND_WRITTEN_INDEX = re.compile(r"^[A-Z][A-Z0-9_]*(\s*,\s*[A-Z][A-Z0-9_]*)*\s*=\s*(\d+\s*(,\s*\d+\s*)*(#.*)?$|range\()", re.M)
 
@@ -28,12 +31,15 @@ _HAND_WRITTEN_INDEX = re.compile(r"^[A-Z][A-Z0-9_]*(\s*,\s*[A-Z][A-Z0-9_]*)*\s*=
 @pytest.mark.parametrize("module", sorted(DECLARED))
 def test_declared_modules_have_no_hand_written_index_constants(module):
     mod = importlib.import_module(module)
-    layout_name, prefix, size_name = DECLARED[module]
-    layout = getattr(mod, layout_name)
-    assert not _HAND_WRITTEN_INDEX.search(inspect.getsource(mod)), "an index constant is written by hand"
-    for i, f in enumerate(layout.fields):                     # every constant comes from the layout
-        assert getattr(mod, prefix + f.const) == i
-    assert getattr(mod, size_name) == layout.size
+    hand = _HAND_WRITTEN_INDEX.search(inspect.getsource(mod))
+    assert not hand, f"an index constant is written by hand: {hand.group(0)!r}"
+    layouts = DECLARED[module]
+    for layout_name, prefix, size_name in [layouts] if isinstance(layouts[0], str) else layouts:
+        layout = getattr(mod, layout_name)
+        for i, f in enumerate(layout.fields):                 # every constant comes from the layout
+            assert getattr(mod, prefix + f.const) == i, f"{prefix + f.const} is not slot {i} of {layout_name}"
+        if size_name:
+            assert getattr(mod, size_name) == layout.size
 
 
 def test_generated_layouts_keep_the_kernels_slots():
@@ -48,6 +54,11 @@ def test_generated_layouts_keep_the_kernels_slots():
     assert r.REF_NAMES == ("psi_ref", "r_ref", "rdot_ref", "rpm_cmd", "xte", "leg")
     assert (w.W_RUDDER, w.W_CURRENT_N, w.W_YAW_MOMENT, w.N_CHANNELS) == (0, 3, 6, 7)
     assert (m.M_IAE, m.M_E2_DEG, m.M_REVERSALS, m.M_LAST_DIR, m.N_ACC) == (0, 3, 7, 10, 11)
+    from steerlab.ships import state as s
+
+    assert (s.IX, s.IY, s.IPSI, s.IU, s.IV, s.IR, s.N_PLANAR) == tuple(range(7))
+    assert s.PLANAR_NAMES == ("x_n", "y_e", "psi", "u", "v", "r")
+    assert s.PLANAR_UNITS == ("m", "m", "rad", "m/s", "m/s", "rad/s")
     gear = g.SteeringGear(math.radians(30.0), math.radians(3.0), 2.0, math.radians(0.5)).pack()
     np.testing.assert_array_equal(gear, [math.radians(30.0), math.radians(3.0), 0.5, math.radians(0.5)])
 
