@@ -21,6 +21,10 @@ DECLARED = {
     "steerlab.metrics_online": ("ACCUMULATOR", "M_", "N_ACC"),
     "steerlab.control.pid": [("PARAMS", "C_", "N_PARAMS"), ("STATE", "Z_", "N_STATE")],
     "steerlab.ships.state": ("PLANAR", "I", "N_PLANAR"),
+    "steerlab.ships.esso_3dof": ("PARAMS", "P_", "N_PARAMS"),
+    "steerlab.ships.nomoto1": ("PARAMS", "P_", "N_PARAMS"),
+    "steerlab.ships.bech": [("PARAMS", "P_", "N_PARAMS"), ("STATE", "", "N_STATES")],
+    "steerlab.ships.van_leeuwen": [("SET", "S_", "N_SET"), ("PARAMS", "P_", "N_PARAMS"), ("STATE", "", "N_STATES")],
 }
 """module -> (layout attribute, constant prefix, length constant), or a list of them for a module
 with several layouts (the size name may be None where a record has a variable-length tail)."""
@@ -107,3 +111,29 @@ def test_pid_gain_is_named_once_config_record_and_constants_agree():
     assert rec[pid.C_KP] == 2.0 and rec[pid.C_KI] == 0.1 and rec[pid.C_KD] == 5.0 and rec[pid.C_UMAX] == 0.5
     with pytest.raises(InputError, match=r"controller\.u_max: .*allowed range \(0\.0, inf\)"):
         pid.PID(u_max=0.0).pack()
+
+
+def test_ship_records_keep_their_slots():
+    """The ships' generated slots are the ones their kernels were written with (no number moved)."""
+    from steerlab.ships import bech, esso_3dof, nomoto1, nomoto2, van_leeuwen
+
+    assert (esso_3dof.P_XVR, esso_3dof.P_N, esso_3dof.P_YUR_M, esso_3dof.P_MUNK, esso_3dof.P_ND,
+            esso_3dof.N_PARAMS) == (0, 3, 4, 9, 13, 14)
+    assert esso_3dof.PARAM_NAMES[:4] == ("m22/m11", "X_uu/m11", "thrust/m11", "n")
+    assert (nomoto1.P_K, nomoto1.P_T, nomoto1.N_PARAMS) == (0, 1, 2)
+    assert (bech.P_A, bech.P_T3, bech.P_C2A, bech.P_C3, bech.N_PARAMS, bech.I_Z, bech.N_STATES) == (0, 2, 6, 7, 8, 6, 7)
+    assert (bech.STATE_NAMES, bech.STATE_UNITS) == (nomoto2.STATE_NAMES, nomoto2.STATE_UNITS)
+    v = van_leeuwen
+    assert (v.P_L, v.P_SWITCH, v.P_SET0, v.S_T1, v.S_K, v.S_A3, v.N_SET, v.N_PARAMS, v.I_RDOT) == \
+        (0, 1, 2, 0, 2, 6, 7, 16, 6)
+    assert v.PARAMS.index("set1.K") == v.P_SET0 + v.N_SET + v.S_K
+    assert v.STATE_NAMES == ("x_n", "y_e", "psi", "u", "v", "r", "rdot")
+
+
+def test_ship_pack_names_the_field_of_a_bad_value():
+    from steerlab.ships import bech, esso_3dof
+
+    with pytest.raises(InputError, match=r"ship\.n: must be finite"):
+        esso_3dof.pack(n_rps=float("nan"))
+    with pytest.raises(InputError, match=r"ship\.c3: must be finite"):
+        bech.pack_params(0.1, 0.01, 10.0, c3=float("inf"))
