@@ -30,6 +30,9 @@ DECLARED = {
     "steerlab.ships.mmg": ("PARAMS", "P_", "N_FIXED"),
     "steerlab.ships.mmg_standard": ("PARAMS", "P_", "N_PARAMS"),
     "steerlab.ships.mss_tanker": [("PARAMS", "P_", None), ("STATE", "", "N_STATES")],
+    "steerlab.sensors.wrapper": [("PARAMS", "P_", "OFF_P"), ("STATE", "Z_", "OFF_X")],
+    "steerlab.control.wave_filter": [("PARAMS", "WF_", "N_WF_PARAMS"), ("STATE", "F_", "N_WF")],
+    "steerlab.control.wave_filtered": [("PARAMS", "P_", "OFF_P"), ("STATE", "Z_", "OFF_Z")],
 }
 """module -> (layout attribute, constant prefix, length constant), or a list of them for a module
 with several layouts (the size name may be None where a record has a variable-length tail)."""
@@ -37,6 +40,7 @@ with several layouts (the size name may be None where a record has a variable-le
 NOT_INDEX = {
     "steerlab.ships.mmg": {"N_STRIPS"},                # number of cross-flow strips, not a slot
     "steerlab.ships.rpm_schedule": {"MAX_SCHEDULE"},   # most schedule points a scenario may give
+    "steerlab.control.wave_filtered": {"NX_MAX"},      # largest plant state the wrapper copies
 }
 """Integer constants of declared modules that are counts, not record slots."""
 
@@ -170,3 +174,42 @@ def test_rpm_ship_records_keep_their_slots_and_name_the_rate():
     assert (c.L, c.t, c.Tnn, c.Nccbbdz) == (304.8, 0.22, 0.0000354, 0.344)
     assert mss_tanker.PARAMS.fields[mss_tanker.P_XUU].doc == mss_tanker.COEFFICIENTS.fields[
         mss_tanker.COEFFICIENTS.index("Xuu")].doc
+
+
+def test_wrapper_records_compose_with_the_inner_layout():
+    """Sensors and wave filter: their own slots are unchanged, and an inner field is
+    addressable by name through the wrapper, at the slot the packed record has it."""
+    from steerlab.control import pid, wave_filter, wave_filtered
+    from steerlab.sensors import wrapper
+
+    assert (wrapper.Z_CALLS, wrapper.Z_PSI, wrapper.Z_R, wrapper.OFF_X) == (0, 1, 2, 3)
+    assert (wrapper.P_HI, wrapper.P_SPSI, wrapper.P_DROP, wrapper.P_M, wrapper.OFF_P) == (0, 2, 6, 7, 8)
+    assert (wave_filter.F_PSI, wave_filter.F_R, wave_filter.F_XI, wave_filter.N_WF) == (0, 1, 6, 7)
+    assert (wave_filter.WF_TLF, wave_filter.WF_XIMIN, wave_filter.N_WF_PARAMS) == (0, 3, 4)
+    wf = wave_filtered
+    assert (wf.P_K, wf.P_T, wf.OFF_P, wf.OFF_X, wf.OFF_Z) == (4, 5, 6, 7, 7 + wf.NX_MAX)
+
+    inner = pid.PID(Kp=2.5, Ki=0.01, Kd=30.0, u_max=0.5)
+    sensed = wrapper.sensed_layout(pid.PARAMS)
+    p = np.concatenate([wrapper.SensorParams(7, sigma_psi=0.001, m=2).pack(), inner.pack()])
+    assert sensed.size == p.size and p[sensed.index("inner.Kd")] == 30.0 and p[sensed.index("m")] == 2.0
+    assert sensed.unpack(p)["inner.u_max"] == 0.5
+    filtered = wf.wave_filtered_layout(pid.PARAMS)
+    p = wf.WaveFiltered(inner, K=0.05, T=40.0).pack(inner.pack())
+    assert filtered.size == p.size and p[filtered.index("inner.Kp")] == 2.5 and p[filtered.index("filter_T")] == 40.0
+    assert filtered.unpack(p)["wave_filter.T_lf"] == 20.0
+    assert wf.wave_filtered_state_layout(pid.STATE).index("inner.integral") == wf.OFF_Z + pid.Z_INT
+    with pytest.raises(InputError, match=r"controller\.filter_K: 0\.0 is out of range; allowed range \(0\.0, 100\.0\]"):
+        wf.WaveFiltered(inner, K=0.0, T=40.0).pack(inner.pack())
+    with pytest.raises(InputError, match=r"controller\.wave_filter\.xi_min: 2\.0 is out of range"):
+        wf.WaveFiltered(inner, K=0.1, T=40.0, filt=wave_filter.WaveFilterParams(xi_min=2.0)).pack(inner.pack())
+
+
+def test_wave_filter_config_comes_from_the_declaration():
+    from steerlab.control import wave_filter
+
+    schema = wave_filter.WaveFilterConfig.model_json_schema()["properties"]
+    for f in wave_filter.PARAMS.fields:
+        assert schema[f.name]["default"] == f.default and schema[f.name]["exclusiveMinimum"] == f.lo
+        assert schema[f.name]["maximum"] == f.hi and f"[{f.unit}]" in schema[f.name]["description"]
+    assert wave_filter.WaveFilterConfig().params() == wave_filter.WaveFilterParams()
