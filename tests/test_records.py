@@ -213,3 +213,17 @@ def test_wave_filter_config_comes_from_the_declaration():
         assert schema[f.name]["default"] == f.default and schema[f.name]["exclusiveMinimum"] == f.lo
         assert schema[f.name]["maximum"] == f.hi and f"[{f.unit}]" in schema[f.name]["description"]
     assert wave_filter.WaveFilterConfig().params() == wave_filter.WaveFilterParams()
+
+
+STATE_BY_NAME = ["steerlab.ships.esso_3dof", "steerlab.ships.nomoto1", "steerlab.ships.bech",
+                 "steerlab.ships.van_leeuwen", "steerlab.ships.de_keizer", "steerlab.ships.mmg",
+                 "steerlab.ships.mmg_standard", "steerlab.ships.mss_tanker", "steerlab.ships.kinematics",
+                 "steerlab.sensors.wrapper", "steerlab.control.wave_filtered"]
+"""Modules that read and write the plant state only through named slots (steerlab.ships.state)."""
+
+
+@pytest.mark.parametrize("module", STATE_BY_NAME)
+def test_no_literal_state_index(module):
+    src = inspect.getsource(importlib.import_module(module))
+    hits = re.findall(r"\b(?:x|dx|x0|xs|xf)\[\s*-?[0-9]+\s*\]", src)
+    assert hits in ([], ["x0[-1]"]), f"literal state indices: {hits}"   # x0[-1]: the rudder, last by definition

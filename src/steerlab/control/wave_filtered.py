@@ -7,10 +7,10 @@ and makes a new one whose kernel
 
 1. advances the wave filter of :mod:`steerlab.control.wave_filter` (van Amerongen 1982,
    Fig. 4.13-4.14; a Nomoto model with fixed K, T predicts, the measured heading corrects,
-   noise-adaptive gains) from the measured heading ``x[2]`` and the actual rudder (last
+   noise-adaptive gains) from the measured heading ``x[IPSI]`` and the actual rudder (last
    plant state);
 2. copies the plant state ``x`` into a scratch block of its own state ``z`` and replaces
-   heading and yaw rate there (``x[2]``, ``x[5]``) by the filtered estimates;
+   heading and yaw rate there (``x[IPSI]``, ``x[IR]``) by the filtered estimates;
 3. calls the inner controller's kernel on that copy, with views of its own state and
    parameter blocks, and returns its order.
 
