@@ -60,7 +60,7 @@ from steerlab.records import Field as RecordField
 from steerlab.records import Layout
 from steerlab.ships.kinematics import earth_velocity
 from steerlab.ships.rpm_schedule import RATE, check_rpm_schedule, pack_with_rate, scheduled_rate
-from steerlab.ships.state import IPSI, IR, IU, IV, N_PLANAR, ship_state
+from steerlab.ships.state import IPSI, IR, IU, IV, ship_state
 
 
 COEFFICIENTS = Layout("mss-tanker coefficients", "K_", [
@@ -140,7 +140,7 @@ PARAMS = Layout("ship", "P_", [
     RecordField("M11", "m11", "-", "m11 - Xudotz z"),
     RecordField("M22", "m22", "-", "m22 - Yvdotz z"),
     RecordField("M33L2", "m33L2", "m^2", "(m33 - Nrdotz z) L^2"),
-    RecordField("T", "t", "-", "thrust deduction"),
+    _coefficient("t"),
     *(_coefficient(n) for n in ("cun", "cnn", "Tuu", "Tun", "Tnn", "d11", "d22", "d33",
                                 "Xuu", "Xvv", "Xccdd", "Xccbd", "Xuuz", "Xvrz", "Xvvzz",
                                 "YT", "Yvv", "Yuv", "Yccd", "Yccbbd", "Yurz")),
