@@ -213,6 +213,10 @@ def test_wave_filter_config_comes_from_the_declaration():
         assert schema[f.name]["default"] == f.default and schema[f.name]["exclusiveMinimum"] == f.lo
         assert schema[f.name]["maximum"] == f.hi and f"[{f.unit}]" in schema[f.name]["description"]
     assert wave_filter.WaveFilterConfig().params() == wave_filter.WaveFilterParams()
+    import pickle                                  # generated types travel to batch workers
+
+    for obj in (wave_filter.WaveFilterConfig(T_lf=3.0), wave_filter.WaveFilterParams(P0=1e-6)):
+        assert pickle.loads(pickle.dumps(obj)) == obj
 
 
 STATE_BY_NAME = ["steerlab.ships.esso_3dof", "steerlab.ships.nomoto1", "steerlab.ships.bech",
