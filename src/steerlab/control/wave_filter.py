@@ -44,58 +44,69 @@ phase lag. ``k_r = k_psi^2/(2 - k_psi)`` is the steady-state relation of the alp
 (Kalman) tracker of Benedict and Bordner (1962). ``xi`` is also the noise level used for gain
 scheduling of ASA (eqs 4.5, 4.86, 4.87, 4.91).
 
-State record ``zf`` (``N_WF`` floats, see the ``F_*`` indices) and parameter record
-``pf`` (``N_WF_PARAMS`` floats, ``WF_*`` indices; :class:`WaveFilterParams`).
+State record ``zf`` (:data:`STATE`: ``N_WF`` floats, ``F_*`` indices) and parameter record
+``pf`` (:data:`PARAMS`: ``N_WF_PARAMS`` floats, ``WF_*`` indices; :class:`WaveFilterParams`), both
+declared once (:mod:`steerlab.records`); the parameters' bounds, defaults and units also give
+:class:`WaveFilterConfig`.
 """
 
 from __future__ import annotations
 
 import math
-from typing import NamedTuple
 
 import numba
 import numpy as np
-from pydantic import Field
+from pydantic import create_model
 
 from steerlab.angles import wrap_to_pi
 from steerlab.config_base import FrozenConfig
-from steerlab.errors import require_finite_range
+from steerlab.records import Field as RecordField
+from steerlab.records import Layout
 
-F_PSI, F_R, F_DELTA, F_ELF, F_PL, F_PH, F_XI = 0, 1, 2, 3, 4, 5, 6
-N_WF = 7
-"""Filter state: [psi^ (rad), r^ (rad/s), previous rudder (rad), low-passed innovation (rad),
-P_L (rad^2), P_H (rad^2), xi (-)]."""
+STATE = Layout("wave filter state", "F_", [
+    RecordField("PSI", "psi_hat", "rad", "filtered heading psi^"),
+    RecordField("R", "r_hat", "rad/s", "filtered yaw rate r^"),
+    RecordField("DELTA", "delta_prev", "rad", "rudder angle at the previous sample"),
+    RecordField("ELF", "eps_lf", "rad", "low-passed innovation eps_L"),
+    RecordField("PL", "P_L", "rad^2", "power of the LF innovation"),
+    RecordField("PH", "P_H", "rad^2", "power of the HF innovation"),
+    RecordField("XI", "xi", "-", "noise level xi = k_psi (1: no noise seen)"),
+], size_name="N_WF")
+STATE.export(globals())          # F_PSI = 0, F_R = 1, F_DELTA = 2, F_ELF = 3, F_PL = 4, F_PH = 5, F_XI = 6, N_WF = 7
 
-WF_TLF, WF_TPOW, WF_P0, WF_XIMIN = 0, 1, 2, 3
-N_WF_PARAMS = 4
-
-
-class WaveFilterParams(NamedTuple):
-    """Tuning of the noise-adaptive filter (SI)."""
-
-    T_lf: float = 20.0       #: low-pass splitting the innovation into LF / HF [s]
-    T_pow: float = 60.0      #: averaging time of the LF / HF powers [s]
-    P0: float = 1e-8         #: noise floor [rad^2] (xi -> 1 below it)
-    xi_min: float = 0.02     #: lower bound of xi and of the filter gain k_psi [-]
-
-    def pack(self, field: str = "controller.wave_filter") -> np.ndarray:
-        require_finite_range(f"{field}.T_lf", self.T_lf, 0.0, 1e5, lo_open=True)
-        require_finite_range(f"{field}.T_pow", self.T_pow, 0.0, 1e6, lo_open=True)
-        require_finite_range(f"{field}.P0", self.P0, 0.0, 1.0, lo_open=True)
-        require_finite_range(f"{field}.xi_min", self.xi_min, 0.0, 1.0, lo_open=True)
-        return np.array([self.T_lf, self.T_pow, self.P0, self.xi_min], dtype=np.float64)
+PARAMS = Layout("controller.wave_filter", "WF_", [
+    RecordField("TLF", "T_lf", "s", "low-pass splitting the innovation into LF / HF", 0.0, 1e5, lo_open=True,
+                default=20.0),
+    RecordField("TPOW", "T_pow", "s", "averaging time of the LF / HF powers", 0.0, 1e6, lo_open=True,
+                default=60.0),
+    RecordField("P0", "P0", "rad^2", "noise floor (xi -> 1 below it)", 0.0, 1.0, lo_open=True, default=1e-8),
+    RecordField("XIMIN", "xi_min", "-", "lower bound of xi and of the filter gain k_psi", 0.0, 1.0, lo_open=True,
+                default=0.02),
+], size_name="N_WF_PARAMS")
+PARAMS.export(globals())         # WF_TLF = 0, WF_TPOW = 1, WF_P0 = 2, WF_XIMIN = 3, N_WF_PARAMS = 4
 
 
-class WaveFilterConfig(FrozenConfig):
-    """``wave_filter = { ... }`` in a controller block (seconds, rad^2)."""
+def _pack(self, field: str = "controller.wave_filter") -> np.ndarray:
+    """The checked record; errors name ``<field>.<name>`` (ASA packs it under its own name)."""
+    layout = PARAMS if field == PARAMS.component else Layout(field, "WF_", PARAMS.fields)
+    return layout.pack(self._asdict())
 
-    T_lf: float = Field(20.0, gt=0.0, le=1e5, description="LF/HF split of the innovation [s]")
-    T_pow: float = Field(60.0, gt=0.0, le=1e6, description="averaging time of the powers [s]")
-    P0: float = Field(1e-8, gt=0.0, le=1.0, description="noise floor [rad^2]")
-    xi_min: float = Field(0.02, gt=0.0, le=1.0, description="lower bound of xi and k_psi [-]")
 
-    def params(self) -> WaveFilterParams:
+WaveFilterParams = PARAMS.record_type("WaveFilterParams", {"pack": _pack})
+"""Tuning of the noise-adaptive filter (SI): ``WaveFilterParams(T_lf, T_pow, P0, xi_min)``, ``.pack()``."""
+WaveFilterParams.__module__ = __name__
+
+
+class _WaveFilterConfigBase(FrozenConfig):
+    def params(self) -> "WaveFilterParams":
         return WaveFilterParams(self.T_lf, self.T_pow, self.P0, self.xi_min)
+
+
+WaveFilterConfig = create_model(
+    "WaveFilterConfig", __base__=_WaveFilterConfigBase,
+    __doc__="``wave_filter = { ... }`` in a controller block (seconds, rad^2).",
+    **PARAMS.config_fields(PARAMS.names))
+WaveFilterConfig.__module__ = __name__
 
 
 def wave_filter_init(zf, psi, r, delta):

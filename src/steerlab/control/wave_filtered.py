@@ -7,15 +7,17 @@ and makes a new one whose kernel
 
 1. advances the wave filter of :mod:`steerlab.control.wave_filter` (van Amerongen 1982,
    Fig. 4.13-4.14; a Nomoto model with fixed K, T predicts, the measured heading corrects,
-   noise-adaptive gains) from the measured heading ``x[2]`` and the actual rudder (last
+   noise-adaptive gains) from the measured heading ``x[IPSI]`` and the actual rudder (last
    plant state);
 2. copies the plant state ``x`` into a scratch block of its own state ``z`` and replaces
-   heading and yaw rate there (``x[2]``, ``x[5]``) by the filtered estimates;
+   heading and yaw rate there (``x[IPSI]``, ``x[IR]``) by the filtered estimates;
 3. calls the inner controller's kernel on that copy, with views of its own state and
    parameter blocks, and returns its order.
 
-Layouts: ``z = [filter (N_WF) | x copy (NX_MAX) | inner z]``,
-``p = [filter params (N_WF_PARAMS) | K [1/s] | T [s] | inner p]``. Nothing is allocated
+Layouts (declared once, :mod:`steerlab.records`): ``z = [filter (N_WF) | x copy (NX_MAX) | inner z]``
+(:data:`STATE`), ``p = [filter params (N_WF_PARAMS) | K [1/s] | T [s] | inner p]`` (:data:`PARAMS`);
+:func:`wave_filtered_layout` composes the record with the inner controller's, so an inner field
+is addressable through the wrapper (``"inner.Kp"``). Nothing is allocated
 (the copy lives in ``z``; slices are views), so the kernel obeys the engine's rules. The
 kernel is a copy of one template function whose module globals bind ``_inner`` to the inner
 kernel (:func:`steerlab.kernel_refs.bound_kernel`), so the engine's fusing (which follows
@@ -48,19 +50,46 @@ import numpy as np
 from pydantic import Field, create_model
 
 from steerlab.control.registry import ControllerSpec
-from steerlab.control.wave_filter import (F_PSI, F_R, N_WF, N_WF_PARAMS, WaveFilterConfig, WaveFilterParams,
-                                          wave_filter_init, wave_filter_step)
-from steerlab.errors import InputError, require_finite_range
+from steerlab.control.wave_filter import PARAMS as WF_PARAMS
+from steerlab.control.wave_filter import STATE as WF_STATE
+from steerlab.control.wave_filter import (F_PSI, F_R, WaveFilterConfig, WaveFilterParams, wave_filter_init,
+                                          wave_filter_step)
+from steerlab.errors import InputError
 from steerlab.kernel_refs import bound_kernel
+from steerlab.records import Field as RecordField
+from steerlab.records import Layout
+from steerlab.ships.state import IPSI, IR
 
 NX_MAX = 32
 """Largest plant state (ship states + rudder) the wrapper can copy."""
 
-OFF_X = N_WF
-OFF_Z = N_WF + NX_MAX
-P_K = N_WF_PARAMS
-P_T = N_WF_PARAMS + 1
-OFF_P = N_WF_PARAMS + 2
+PARAMS = Layout("controller", "P_", [
+    *(RecordField("WF_" + f.const, "wave_filter." + f.name, f.unit, f.doc, f.lo, f.hi, f.lo_open, f.hi_open,
+                  f.default) for f in WF_PARAMS.fields),
+    RecordField("K", "filter_K", "1/s", "Nomoto gain of the filter's model (default: the ship's at the design speed)",
+                0.0, 100.0, lo_open=True),
+    RecordField("T", "filter_T", "s", "Nomoto time constant of the filter's model, non-zero", -1e4, 1e4),
+], size_name="OFF_P")
+PARAMS.export(globals())         # P_WF_TLF = 0, ..., P_K = 4, P_T = 5, OFF_P = 6 (the inner record from here)
+STATE = Layout("controller state", "Z_", [
+    *(RecordField("WF_" + f.const, "wave_filter." + f.name, f.unit, f.doc) for f in WF_STATE.fields),
+    *(RecordField(f"X{i}", f"x_copy.{i}", "-", "scratch: the plant state with filtered heading and yaw rate")
+      for i in range(NX_MAX)),
+], size_name="OFF_Z")
+STATE.export(globals())          # Z_WF_PSI = 0, ..., Z_X0 = 7, ..., OFF_Z = 39 (the inner state from here)
+OFF_X = Z_X0
+
+
+def wave_filtered_layout(inner: Layout) -> Layout:
+    """The record of ``"<name>+wf"`` for an inner controller whose record is ``inner``: the
+    wrapper's fields, then the inner ones as ``inner.<name>`` (``.index("inner.Kp")``)."""
+    return PARAMS.then("inner", inner)
+
+
+def wave_filtered_state_layout(inner: Layout) -> Layout:
+    """The state ``z`` of ``"<name>+wf"`` around an inner state layout (``inner.<name>``)."""
+    return STATE.then("inner", inner)
+
 
 SUFFIX = "+wf"
 NOT_WRAPPED = ("asa",)
@@ -73,12 +102,12 @@ def _inner(z, p, t, x, ref, h):  # pragma: no cover - replaced per wrapper
 def _wf_update_template(z, p, t, x, ref, h):
     """Wave filter, then the inner controller on the filtered copy of ``x`` (module doc)."""
     nx = x.shape[0]
-    wave_filter_step(z, p, p[P_K], p[P_T], x[2], x[nx - 1], h)
+    wave_filter_step(z, p, p[P_K], p[P_T], x[IPSI], x[nx - 1], h)
     xf = z[OFF_X:OFF_X + nx]
     for i in range(nx):
         xf[i] = x[i]
-    xf[2] = z[F_PSI]
-    xf[5] = z[F_R]
+    xf[IPSI] = z[F_PSI]
+    xf[IR] = z[F_R]
     return _inner(z[OFF_Z:], p[OFF_P:], t, xf, ref, h)
 
 
@@ -91,12 +120,11 @@ class WaveFiltered(NamedTuple):
     filt: WaveFilterParams = WaveFilterParams()
 
     def pack(self, inner_p) -> np.ndarray:
-        require_finite_range("controller.filter_K", self.K, 0.0, 100.0, lo_open=True)
-        require_finite_range("controller.filter_T", self.T, -1e4, 1e4)
+        values = {"wave_filter." + k: v for k, v in self.filt._asdict().items()}
+        head = PARAMS.pack(values, filter_K=self.K, filter_T=self.T)
         if abs(self.T) < 1e-6:
             raise InputError("controller.filter_T", "must be non-zero (|T| >= 1e-6 s)")
-        wf = self.filt.pack("controller.wave_filter")
-        return np.concatenate([wf, [self.K, self.T], np.asarray(inner_p, dtype=np.float64)])
+        return np.concatenate([head, np.asarray(inner_p, dtype=np.float64)])
 
     def init_state(self, x0, ref0) -> np.ndarray:
         x0 = np.asarray(x0, dtype=float)
@@ -104,7 +132,7 @@ class WaveFiltered(NamedTuple):
             raise InputError("ship.model", f"plant state of {x0.shape[0]} > {NX_MAX} values: too large for '+wf'")
         zi = np.asarray(self.inner.init_state(x0, ref0), dtype=float)
         z = np.zeros(OFF_Z + zi.shape[0])
-        wave_filter_init(z, float(x0[2]), float(x0[5]), float(x0[-1]))
+        wave_filter_init(z, float(x0[IPSI]), float(x0[IR]), float(x0[-1]))
         z[OFF_X:OFF_X + x0.shape[0]] = x0
         z[OFF_Z:] = zi
         return z

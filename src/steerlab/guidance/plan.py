@@ -69,7 +69,7 @@ def propeller_slot(ship, ps: np.ndarray) -> int:
     if ship.rhs is not mmg.mmg_rhs:
         raise InputError("guidance.type", f"berthing orders the propeller rate; ship {ship.name!r} has no "
                                           "rpm input (use an MMG ship, e.g. kosoko, or type = 'los')")
-    if int(ps[mmg.P_NCONST + 1]) != 0:
+    if int(ps[mmg.PARAMS.index("rpm.n_points")]) != 0:
         raise InputError("ship.options.rpm_schedule", "berthing plans the propeller rate itself; "
                                                       "remove the rpm_schedule")
     return mmg.P_NCONST

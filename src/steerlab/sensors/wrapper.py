@@ -6,8 +6,8 @@ controller spec in a new one whose kernel
 
 1. on every ``m``-th controller sample (the sensor period is ``m`` controller periods) takes a
    new measurement, unless the sample drops out (probability ``p_drop``; the last value is
-   held, as a receiver does when a packet is lost): heading ``x[2] + sigma_psi n`` and yaw
-   rate ``x[5] + sigma_r n`` (``n`` standard normal), each rounded to its quantum
+   held, as a receiver does when a packet is lost): heading ``x[IPSI] + sigma_psi n`` and yaw
+   rate ``x[IR] + sigma_r n`` (``n`` standard normal), each rounded to its quantum
    ``q * floor(v / q + 1/2)`` when ``q > 0``; between samples the last measurement is held;
 2. copies the plant state ``x`` into a scratch block of its own state ``z``, puts the held
    measurements in place of heading and yaw rate, and calls the inner controller on the copy
@@ -19,8 +19,9 @@ on the sensor sample index, keyed by the scenario seed (packed in the parameters
 kernel allocates nothing, keeps no generator state, and the compiled and readable engines
 give identical numbers. Streams: 0 heading noise, 1 yaw-rate noise, 2 dropouts.
 
-Layouts: ``z = [calls, psi_m, r_m, x copy (nx) | inner z]``;
-``p = [seed_hi, seed_lo, sigma_psi, sigma_r, q_psi, q_r, p_drop, m | inner p]`` (SI, rad).
+Layouts (declared once, :mod:`steerlab.records`): ``z = [calls, psi_m, r_m, x copy (nx) | inner z]``
+(:data:`STATE`); ``p = [seed_hi, seed_lo, sigma_psi, sigma_r, q_psi, q_r, p_drop, m | inner p]``
+(:data:`PARAMS`, SI, rad); :func:`sensed_layout` composes the record with the inner controller's.
 Sample 0 (at the first controller call) is never dropped.
 """
 
@@ -36,10 +37,36 @@ import numpy as np
 from steerlab.control.registry import ControllerSpec
 from steerlab.errors import InputError
 from steerlab.kernel_refs import bound_kernel
+from steerlab.records import Field as RecordField
+from steerlab.records import Layout
 from steerlab.sensors.counter_rng import make_key, normal, split_seed, uniform
+from steerlab.ships.state import IPSI, IR
 
-Z_CALLS, Z_PSI, Z_R, OFF_X = 0, 1, 2, 3
-P_HI, P_LO, P_SPSI, P_SR, P_QPSI, P_QR, P_DROP, P_M, OFF_P = range(9)
+STATE = Layout("sensors state", "Z_", [
+    RecordField("CALLS", "calls", "-", "controller calls so far"),
+    RecordField("PSI", "psi_m", "rad", "held heading measurement"),
+    RecordField("R", "r_m", "rad/s", "held yaw-rate measurement"),
+], size_name="OFF_X")
+STATE.export(globals())          # Z_CALLS = 0, Z_PSI = 1, Z_R = 2, OFF_X = 3 (the x copy, then the inner z)
+PARAMS = Layout("sensors", "P_", [
+    RecordField("HI", "seed_hi", "-", "scenario seed, upper 32 bits (counter_rng.split_seed)"),
+    RecordField("LO", "seed_lo", "-", "scenario seed, lower 32 bits"),
+    RecordField("SPSI", "sigma_psi", "rad", "heading noise standard deviation", lo=0.0),
+    RecordField("SR", "sigma_r", "rad/s", "yaw-rate noise standard deviation", lo=0.0),
+    RecordField("QPSI", "q_psi", "rad", "heading quantum (0: none)", lo=0.0),
+    RecordField("QR", "q_r", "rad/s", "yaw-rate quantum (0: none)", lo=0.0),
+    RecordField("DROP", "p_drop", "-", "dropout probability per sample", lo=0.0, hi=1.0, hi_open=True),
+    RecordField("M", "m", "-", "sensor period in controller periods", lo=1.0),
+], size_name="OFF_P")
+PARAMS.export(globals())         # P_HI = 0, ..., P_M = 7, OFF_P = 8 (the inner record from here)
+
+
+def sensed_layout(inner: Layout) -> Layout:
+    """The record of ``"<name>+sensors"`` for an inner controller whose record is ``inner``:
+    the sensors' fields, then the inner ones as ``inner.<name>`` (``.index("inner.Kp")``)."""
+    return PARAMS.then("inner", inner)
+
+
 SUFFIX = "+sensors"
 
 
@@ -66,8 +93,8 @@ def sensor_sample(z, p, x):
         if k > 0 and p[P_DROP] > 0.0:
             drop = uniform(make_key(p[P_HI], p[P_LO], 2), k) <= p[P_DROP]
         if not drop:
-            psi = x[2]
-            r = x[5]
+            psi = x[IPSI]
+            r = x[IR]
             if p[P_SPSI] > 0.0:
                 psi += p[P_SPSI] * normal(make_key(p[P_HI], p[P_LO], 0), k)
             if p[P_SR] > 0.0:
@@ -84,8 +111,8 @@ def _sensed_update_template(z, p, t, x, ref, h):
     xs = z[OFF_X:OFF_X + nx]
     for i in range(nx):
         xs[i] = x[i]
-    xs[2] = z[Z_PSI]
-    xs[5] = z[Z_R]
+    xs[IPSI] = z[Z_PSI]
+    xs[IR] = z[Z_R]
     return _inner(z[OFF_X + nx:], p[OFF_P:], t, xs, ref, h)
 
 
@@ -110,7 +137,8 @@ class SensorParams(NamedTuple):
 
     def pack(self) -> np.ndarray:
         hi, lo = split_seed(self.seed)
-        return np.array([hi, lo, self.sigma_psi, self.sigma_r, self.q_psi, self.q_r, self.p_drop, float(self.m)])
+        return PARAMS.pack(seed_hi=hi, seed_lo=lo, sigma_psi=self.sigma_psi, sigma_r=self.sigma_r, q_psi=self.q_psi,
+                           q_r=self.q_r, p_drop=self.p_drop, m=float(self.m))
 
 
 def sensor_params(cfg, seed: int, controller_sample_time: float) -> SensorParams:

@@ -19,8 +19,8 @@ form needs no rudder derivative: with ``z = r' + a r - b T3 delta`` [rad/s^2]::
     r' = z - a r + b T3 delta + w[W_YAW_MOMENT]
     z' = b (delta - H_B(r))
 
-State ``[x_n, y_e, psi, u, v, r, z]``; constant surge, no sway, position as in
-:mod:`steerlab.ships.nomoto2`. With ``H_B(r) = r/K`` the model is exactly
+State ``[x_n, y_e, psi, u, v, r, z]`` (:data:`STATE`, the same as :mod:`steerlab.ships.nomoto2`'s);
+constant surge, no sway, position as in :mod:`steerlab.ships.nomoto2`. With ``H_B(r) = r/K`` the model is exactly
 :mod:`steerlab.ships.nomoto2`.
 
 Parameters, SI with r in rad/s and H_B in rad (packed ``[a, b, T3, c0, c1, c2, c2a, c3]``):
@@ -41,35 +41,52 @@ from pydantic import Field
 
 from steerlab.config_base import FrozenConfig
 from steerlab.environment.channels import W_RUDDER, W_YAW_MOMENT
-from steerlab.ships.nomoto2 import N_STATES, STATE_NAMES, STATE_UNITS
-from steerlab.ships.spiral_polynomial import spiral_polynomial
+from steerlab.records import Field as RecordField
+from steerlab.records import Layout
 from steerlab.ships.kinematics import earth_velocity
+from steerlab.ships.spiral_polynomial import spiral_polynomial
+from steerlab.ships.state import IPSI, IR, IU, IV, ship_state
 
-P_A, P_B, P_T3, P_C0, P_C1, P_C2, P_C2A, P_C3 = 0, 1, 2, 3, 4, 5, 6, 7
-N_PARAMS = 8
+PARAMS = Layout("ship", "P_", [
+    RecordField("A", "a", "1/s", "(T1 + T2)/(T1 T2) (eq 2.24 divided by T1 T2)"),
+    RecordField("B", "b", "1/s^3", "K/(T1 T2)"),
+    RecordField("T3", "T3", "s", "rudder-rate time constant of Nomoto's second-order model"),
+    RecordField("C0", "c0", "rad", "H_B(0): rudder that holds r = 0 (asymmetry)"),
+    RecordField("C1", "c1", "s", "linear spiral coefficient (1/K; < 0: course-unstable)"),
+    RecordField("C2", "c2", "s^2/rad", "r^2 spiral coefficient"),
+    RecordField("C2A", "c2a", "s^2/rad", "r|r| spiral coefficient"),
+    RecordField("C3", "c3", "s^3/rad^2", "r^3 spiral coefficient"),
+], size_name="N_PARAMS")
+PARAMS.export(globals())         # P_A = 0, P_B = 1, P_T3 = 2, P_C0 = 3, ..., P_C3 = 7, N_PARAMS = 8
+STATE = ship_state("ship state", "I_", [
+    RecordField("Z", "z", "rad/s^2", "observable-canonical state z = r' + a r - b T3 delta"),
+])
+STATE.export(globals())          # the planar IX..IR, I_Z = 6, N_STATES = 7
+STATE_NAMES = STATE.names
+STATE_UNITS = STATE.units
 DEG = 180.0 / math.pi
 
 
 @numba.njit(cache=True)
 def bech_rhs(t, x, delta, w, p, dx):
     """Derivatives of ``[x_n, y_e, psi, u, v, r, z]`` (see the module docstring)."""
-    psi = x[2]
-    u = x[3]
-    r = x[5]
-    z = x[6]
+    psi = x[IPSI]
+    u = x[IU]
+    r = x[IR]
+    z = x[I_Z]
     b = p[P_B]
     d = delta + w[W_RUDDER]
     earth_velocity(psi, u, 0.0, w, dx)
-    dx[2] = r
-    dx[3] = 0.0
-    dx[4] = 0.0
-    dx[5] = z - p[P_A] * r + b * p[P_T3] * d + w[W_YAW_MOMENT]
-    dx[6] = b * (d - spiral_polynomial(r, p[P_C0], p[P_C1], p[P_C2], p[P_C2A], p[P_C3]))
+    dx[IPSI] = r
+    dx[IU] = 0.0
+    dx[IV] = 0.0
+    dx[IR] = z - p[P_A] * r + b * p[P_T3] * d + w[W_YAW_MOMENT]
+    dx[I_Z] = b * (d - spiral_polynomial(r, p[P_C0], p[P_C1], p[P_C2], p[P_C2A], p[P_C3]))
 
 
 def pack_params(a, b, T3, c0=0.0, c1=1.0, c2=0.0, c2a=0.0, c3=0.0) -> np.ndarray:
     """The packed record ``[a, b, T3, c0, c1, c2, c2a, c3]`` (SI)."""
-    return np.array([a, b, T3, c0, c1, c2, c2a, c3], dtype=np.float64)
+    return PARAMS.pack(a=a, b=b, T3=T3, c0=c0, c1=c1, c2=c2, c2a=c2a, c3=c3)
 
 
 def from_nomoto2(K, T1, T2, T3) -> dict:

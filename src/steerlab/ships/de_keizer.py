@@ -55,41 +55,62 @@ from pydantic import Field, field_validator
 from steerlab.config_base import FrozenConfig
 from steerlab.environment.channels import W_RUDDER, W_YAW_MOMENT
 from steerlab.errors import InputError
-from steerlab.ships.rpm_schedule import check_rpm_schedule, pack_rate, scheduled_rate
+from steerlab.records import Field as RecordField
+from steerlab.records import Layout
 from steerlab.ships.kinematics import earth_velocity
+from steerlab.ships.rpm_schedule import RATE, check_rpm_schedule, pack_with_rate, scheduled_rate
+from steerlab.ships.state import IPSI, IR, IU, IV, ship_state
 
 U_MIN = 0.05
 """Floor of the speed [m/s] used in ``L/U`` (keeps the model finite near standstill)."""
 
-P_L, P_K, P_T1, P_T2, P_A0, P_A1, P_A2, P_A3 = 0, 1, 2, 3, 4, 5, 6, 7
-P_KU, P_TU, P_H2, P_TA, P_VNOM, P_NNOM = 8, 9, 10, 11, 12, 13
-P_RATE = 14                       # rpm block (ships/rpm_schedule.py) from here
-IRD, IDU0 = 6, 7                  # extra states: r' [rad/s^2], U0 - V_nom [m/s]
-N_STATES = 8
-STATE_NAMES = ("x_n", "y_e", "psi", "u", "v", "r", "r_dot", "dU0")
-STATE_UNITS = ("m", "m", "rad", "m/s", "m/s", "rad/s", "rad/s^2", "m/s")
+PARAMS = Layout("ship", "P_", [
+    RecordField("L", "L", "m", "ship length", lo=0.0, lo_open=True),
+    RecordField("K", "K", "-", "K* of the yaw equation (2.41)"),
+    RecordField("T1", "tau1", "-", "tau1* (2.41)"),
+    RecordField("T2", "tau2", "-", "tau2* (2.41)"),
+    RecordField("A0", "a0", "-", "H(r*) constant term (2.36)"),
+    RecordField("A1", "a1", "-", "H(r*) linear term: +1 stable, -1 unstable (2.36)"),
+    RecordField("A2", "a2", "-", "H(r*) quadratic term"),
+    RecordField("A3", "a3", "-", "H(r*) cubic term"),
+    RecordField("KU", "K_u", "-", "K_u* speed-loss gain (2.42)"),
+    RecordField("TU", "tau_u", "-", "tau_u* speed-loss time constant [ship lengths]"),
+    RecordField("H2", "h2", "-", "H_u(u*) = u* + h2 u*^2"),
+    RecordField("TA", "tau_a", "-", "acceleration time constant [ship lengths] (Fig. 2.11)"),
+    RecordField("VNOM", "V_nom", "m/s", "speed held at the nominal rate (the scenario's speed)"),
+    RecordField("NNOM", "n_nom", "rev/s", "nominal propeller rate", lo=0.0, lo_open=True),
+]).then("rpm", RATE)
+PARAMS.export(globals())         # P_L = 0, ..., P_NNOM = 13, P_RPM_N = 14, P_RPM_K = 15
+P_RATE = PARAMS.index("rpm.n")   # rpm block (ships/rpm_schedule.py) from here
+STATE = ship_state("ship state", "I", [
+    RecordField("RD", "r_dot", "rad/s^2", "yaw acceleration r'"),
+    RecordField("DU0", "dU0", "m/s", "U0 - V_nom, the zero-turn speed's deviation from the scenario speed"),
+])
+STATE.export(globals())          # the planar IX..IR, IRD = 6, IDU0 = 7, N_STATES = 8
+STATE_NAMES = STATE.names
+STATE_UNITS = STATE.units
 
 
 @numba.njit(cache=True)
 def de_keizer_rhs(t, x, delta, w, p, dx):
     """Derivatives of ``[x_n, y_e, psi, U, 0, r, r', U0 - V_nom]`` (module docstring); writes ``dx[0:8]``."""
-    psi = x[2]
-    U = x[3]
-    r = x[5]
+    psi = x[IPSI]
+    U = x[IU]
+    r = x[IR]
     rd = x[IRD]
     U0 = x[IDU0] + p[P_VNOM]
     L = p[P_L]
     Ue = max(U, U_MIN)
     U0e = max(U0, U_MIN)
     earth_velocity(psi, U, 0.0, w, dx)
-    dx[2] = r
+    dx[IPSI] = r
     # yaw (2.41)
     rs = r * L / Ue
     H = ((p[P_A3] * rs + p[P_A2]) * rs + p[P_A1]) * rs + p[P_A0]
     lu = L / Ue
     t1t2 = p[P_T1] * p[P_T2]
     rhs = (Ue / L) * (p[P_K] * (delta + w[W_RUDDER]) - H) - (p[P_T1] + p[P_T2]) * lu * rd
-    dx[5] = rd
+    dx[IR] = rd
     dx[IRD] = rhs / (t1t2 * lu * lu) + w[W_YAW_MOMENT] / ((p[P_T1] + p[P_T2]) * lu)
     # thrust / acceleration dynamics (Fig. 2.11)
     n = scheduled_rate(t, p, P_RATE)
@@ -99,8 +120,8 @@ def de_keizer_rhs(t, x, delta, w, p, dx):
     # speed loss (2.42): U = U0 (1 - u*)
     us = 1.0 - U / U0e
     dus = (Ue / (p[P_TU] * L)) * (p[P_KU] * rs * rs - (us + p[P_H2] * us * us))
-    dx[3] = dU0 * (U / U0e) - U0 * dus
-    dx[4] = 0.0
+    dx[IU] = dU0 * (U / U0e) - U0 * dus
+    dx[IV] = 0.0
 
 
 class DeKeizerOptions(FrozenConfig):
@@ -137,9 +158,10 @@ def pack(speed: float, rpm=None, options: DeKeizerOptions | None = None) -> np.n
     if o.rpm_schedule and rpm is not None:
         raise InputError("ship.options.rpm_schedule", "give either [ship] rpm or an rpm_schedule, not both")
     n_rps = (o.rpm_nominal if rpm is None else rpm) / 60.0
-    head = np.array([o.L, o.K, o.tau1, o.tau2, *o.a, o.K_u, o.tau_u, o.h2, o.tau_a, speed,
-                     o.rpm_nominal / 60.0], dtype=np.float64)
-    return np.concatenate([head, pack_rate(n_rps, o.rpm_schedule)])
+    a0, a1, a2, a3 = o.a
+    return pack_with_rate(PARAMS, dict(L=o.L, K=o.K, tau1=o.tau1, tau2=o.tau2, a0=a0, a1=a1, a2=a2, a3=a3,
+                                       K_u=o.K_u, tau_u=o.tau_u, h2=o.h2, tau_a=o.tau_a, V_nom=speed,
+                                       n_nom=o.rpm_nominal / 60.0), n_rps, o.rpm_schedule)
 
 
 def _spec():

@@ -41,7 +41,9 @@ import numba
 import numpy as np
 
 from steerlab.environment.channels import W_RUDDER
+from steerlab.records import Field, Layout
 from steerlab.ships.kinematics import earth_velocity
+from steerlab.ships.state import IPSI, IR, IU, IV, N_PLANAR, PLANAR_NAMES, PLANAR_UNITS
 
 
 class EssoTable2(NamedTuple):
@@ -72,15 +74,28 @@ class EssoTable2(NamedTuple):
     N_uud: float = -0.1274    #: N_uu delta [-] (paper sign: delta_p < 0 starboard)
 
 
-# Layout of the packed coefficient record (SI, steerlab rudder sign). Each equation of (8)-(10)
-# is divided through by its mass term in :func:`pack`, so the kernel is multiply-adds only:
+# The packed coefficient record (SI, steerlab rudder sign). Each equation of (8)-(10) is divided
+# through by its mass term in :func:`pack`, so the kernel is multiply-adds only:
 # dx3 = XVR v r + XUU |u| u + THRUST n^2, dx4 = YUR_M u r + ..., dx5 = MUNK u v + ...
-P_XVR, P_XUU, P_THRUST, P_N = 0, 1, 2, 3               # m22/m11 [-], X_|u|u/(L m11) [1/m], (1-t_p) X_nn L/m11 [m], n [rev/s]
-P_YUR_M, P_YUV, P_YVV, P_YUR, P_YD = 4, 5, 6, 7, 8     # -m11/m22 [-]; Y_|u|v/(L m22), Y_|v|v/(L m22) [1/m], Y_|u|r/m22 [-], Y_uud/(L m22) [1/m]
-P_MUNK, P_NUV, P_NUR, P_NVR, P_ND = 9, 10, 11, 12, 13  # all / m33 with m33 = (J_z - N_rdot) L^2: [1/m^2], [1/m^2], [1/m], [1/m], [1/m^2]
-N_PARAMS = 14
-PARAM_NAMES = ("m22/m11", "X_uu/m11", "thrust/m11", "n", "-m11/m22", "Y_uv/m22", "Y_vv/m22",
-               "Y_ur/m22", "Y_d/m22", "munk/m33", "N_uv/m33", "N_ur/m33", "N_vr/m33", "N_d/m33")
+# m11 = 1 - X_udot, m22 = 1 - Y_vdot [-]; m33 = (J_z - N_rdot) L^2 [m^2] (:func:`mass_terms`).
+PARAMS = Layout("ship", "P_", [
+    Field("XVR", "m22/m11", "-", "v r coupling of the surge equation (8), from C (11)"),
+    Field("XUU", "X_uu/m11", "1/m", "X_|u|u / (L m11): hull resistance (Table 2 x L^-1)"),
+    Field("THRUST", "thrust/m11", "m", "(1 - t_p) X_nn L / m11: thrust per n^2 (Table 2 x L)"),
+    Field("N", "n", "rev/s", "propeller rate, held constant (Table 1: 80 rpm at 16 kn)"),
+    Field("YUR_M", "-m11/m22", "-", "u r coupling of the sway equation (9), from C (11)"),
+    Field("YUV", "Y_uv/m22", "1/m", "Y_|u|v / (L m22)"),
+    Field("YVV", "Y_vv/m22", "1/m", "Y_|v|v / (L m22)"),
+    Field("YUR", "Y_ur/m22", "-", "Y_|u|r / m22"),
+    Field("YD", "Y_d/m22", "1/m", "-Y_uud / (L m22), steerlab rudder sign"),
+    Field("MUNK", "munk/m33", "1/m^2", "(Y_vdot - X_udot) / m33: the Munk moment (Table 2, note 5)"),
+    Field("NUV", "N_uv/m33", "1/m^2", "N_|u|v / m33 (viscous part)"),
+    Field("NUR", "N_ur/m33", "1/m", "N_|u|r L / m33"),
+    Field("NVR", "N_vr/m33", "1/m", "N_|v|r L / m33"),
+    Field("ND", "N_d/m33", "1/m^2", "-N_uud / m33, steerlab rudder sign"),
+], size_name="N_PARAMS")
+PARAMS.export(globals())         # P_XVR = 0, ..., P_N = 3, ..., P_ND = 13, N_PARAMS = 14
+PARAM_NAMES = PARAMS.names
 
 
 def mass_terms(table: "EssoTable2") -> tuple[float, float, float]:
@@ -103,22 +118,22 @@ def pack(table: EssoTable2 = EssoTable2(), n_rps: float | None = None, speed: fl
     t = table
     L = t.L
     m11, m22, m33 = mass_terms(t)
-    p = np.empty(N_PARAMS)
-    p[P_XVR] = m22 / m11
-    p[P_XUU] = t.X_uu / L / m11
-    p[P_THRUST] = (1.0 - t.t_p) * t.X_nn * L / m11
-    p[P_YUR_M] = -m11 / m22
-    p[P_YUV] = t.Y_uv / L / m22
-    p[P_YVV] = t.Y_vv / L / m22
-    p[P_YUR] = t.Y_ur / m22
-    p[P_YD] = -t.Y_uud / L / m22       # steerlab sign: delta = -delta_p
-    p[P_MUNK] = (t.Y_vdot - t.X_udot) / m33
-    p[P_NUV] = t.N_uv / m33
-    p[P_NUR] = t.N_ur * L / m33
-    p[P_NVR] = t.N_vr * L / m33
-    p[P_ND] = -t.N_uud / m33            # steerlab sign
-    p[P_N] = propeller_rate_for_speed(speed, table) if n_rps is None else n_rps
-    return p
+    return PARAMS.pack({
+        "m22/m11": m22 / m11,
+        "X_uu/m11": t.X_uu / L / m11,
+        "thrust/m11": (1.0 - t.t_p) * t.X_nn * L / m11,
+        "n": propeller_rate_for_speed(speed, table) if n_rps is None else n_rps,
+        "-m11/m22": -m11 / m22,
+        "Y_uv/m22": t.Y_uv / L / m22,
+        "Y_vv/m22": t.Y_vv / L / m22,
+        "Y_ur/m22": t.Y_ur / m22,
+        "Y_d/m22": -t.Y_uud / L / m22,        # steerlab sign: delta = -delta_p
+        "munk/m33": (t.Y_vdot - t.X_udot) / m33,
+        "N_uv/m33": t.N_uv / m33,
+        "N_ur/m33": t.N_ur * L / m33,
+        "N_vr/m33": t.N_vr * L / m33,
+        "N_d/m33": -t.N_uud / m33,             # steerlab sign
+    })
 
 
 @numba.njit(cache=True)
@@ -140,20 +155,20 @@ def esso_rhs(t, x, delta, w, p, dx):
     dx : ndarray
         Output derivatives.
     """
-    psi = x[2]
-    u = x[3]
-    v = x[4]
-    r = x[5]
+    psi = x[IPSI]
+    u = x[IU]
+    v = x[IV]
+    r = x[IR]
     d = delta + w[W_RUDDER]
     au = abs(u)
     earth_velocity(psi, u, v, w, dx)
-    dx[2] = r
+    dx[IPSI] = r
     n = p[P_N]
     u2d = u * u * d
-    dx[3] = p[P_XVR] * v * r + p[P_XUU] * au * u + p[P_THRUST] * n * n
-    dx[4] = (p[P_YUR_M] * u * r + (p[P_YUV] * au + p[P_YVV] * abs(v)) * v
+    dx[IU] = p[P_XVR] * v * r + p[P_XUU] * au * u + p[P_THRUST] * n * n
+    dx[IV] = (p[P_YUR_M] * u * r + (p[P_YUV] * au + p[P_YVV] * abs(v)) * v
              + p[P_YUR] * au * r + p[P_YD] * u2d)
-    dx[5] = (p[P_MUNK] * u * v + p[P_NUV] * au * v
+    dx[IR] = (p[P_MUNK] * u * v + p[P_NUV] * au * v
              + (p[P_NUR] * au + p[P_NVR] * abs(v)) * r + p[P_ND] * u2d)
 
 
@@ -215,13 +230,12 @@ def _spec_b2(speed: float) -> float:
 
 def _ship_specs():
     from steerlab.ships.registry import ShipSpec
-    from steerlab.ships.state import PLANAR_NAMES, PLANAR_UNITS
 
     t = EssoTable2()
     return [ShipSpec(
         name="esso",
         description="Esso Bernicia 190 kdwt tanker, 3-DOF nonlinear (Zwierzewicz et al. 2021, Table 2)",
-        rhs=esso_rhs, n_states=6, state_names=PLANAR_NAMES, state_units=PLANAR_UNITS,
+        rhs=esso_rhs, n_states=N_PLANAR, state_names=PLANAR_NAMES, state_units=PLANAR_UNITS,
         pack=_spec_pack, b2_exact=_spec_b2, dims=(t.c_B, t.L, t.B),
         source="Zwierzewicz, Dorobczynski, Artyszuk, Energies 14 (2021) 7937, Sec. 3.1",
         linearise=linearise)]

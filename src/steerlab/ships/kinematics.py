@@ -19,12 +19,13 @@ branches), so that the batch engine can vectorise this kernel across runs.
 import numba
 
 from steerlab.environment.channels import W_CURRENT_E, W_CURRENT_N
+from steerlab.ships.state import IX, IY
 from steerlab.sincos import sincos
 
 
 @numba.njit(cache=True, inline="always")
 def earth_velocity(psi, u, v, w, dx):
-    """Write ``dx[0] = x_n'`` and ``dx[1] = y_e'`` [m/s] (see the module docstring)."""
+    """Write ``dx[IX] = x_n'`` and ``dx[IY] = y_e'`` [m/s] (see the module docstring)."""
     s, c = sincos(psi)
-    dx[0] = (u * c - v * s) + w[W_CURRENT_N]
-    dx[1] = (u * s + v * c) + w[W_CURRENT_E]
+    dx[IX] = (u * c - v * s) + w[W_CURRENT_N]
+    dx[IY] = (u * s + v * c) + w[W_CURRENT_E]

@@ -68,8 +68,11 @@ from steerlab.environment.wind_fujiwara import (RHO_AIR, WindGeometry, fujiwara_
 from steerlab.errors import InputError
 from steerlab.ships.clarke import (ClarkeDerivatives, PrimeMass, clarke_derivatives, nomoto_KT_eq11,
                                    prime_mass, state_space_eq10)
-from steerlab.ships.rpm_schedule import check_rpm_schedule, pack_rate, scheduled_rate
+from steerlab.records import Field as RecordField
+from steerlab.records import Layout
 from steerlab.ships.kinematics import earth_velocity
+from steerlab.ships.rpm_schedule import RATE, check_rpm_schedule, pack_with_rate, scheduled_rate
+from steerlab.ships.state import IPSI, IR, IU, IV, N_PLANAR, PLANAR_NAMES, PLANAR_UNITS
 from steerlab.sincos import sincos
 
 # ---------------------------------------------------------------------------------------------
@@ -203,16 +206,46 @@ def mmg_ships() -> tuple[MMGShipData, ...]:
 # ---------------------------------------------------------------------------------------------
 # packed record
 
-P_M11, P_MY, P_MXC, P_M = 0, 1, 2, 3                 # m + m_x, m + m_y, m x_c [kg, kg, kg m], m [kg]
-P_I22, P_I23, P_I32, P_I33 = 4, 5, 6, 7              # inverse of the sway-yaw mass matrix
-P_YV, P_YR, P_NV, P_NR = 8, 9, 10, 11                # [kg/m], [kg], [kg], [kg m]  (times U v, U r)
-P_YD, P_ND, P_XD = 12, 13, 14                        # rudder [kg/m], [kg], drag [kg/m] (times U_R^2)
-P_XUU, P_CF, P_L, P_RHO = 15, 16, 17, 18             # [kg/m], 0.5 rho T C_D [kg/m^3], [m], [kg/m^3]
-P_DP, P_KT0, P_KT1, P_KT2, P_WP, P_TP, P_ETA = 19, 20, 21, 22, 23, 24, 25
-P_RHOA, P_AF, P_AL = 26, 27, 28
-P_WC = 29                                            # 10 Fujiwara coefficients: 29..38
-P_NCONST = 39                                        # rpm block (ships/rpm_schedule.py) from here
-N_FIXED = 41
+WIND_COEFFICIENTS = ("X0", "X1", "X3", "X5", "Y1", "Y3", "Y5", "N1", "N2", "N3")
+"""The ten Fujiwara coefficients of eqs (14)-(16), in :func:`fujiwara_coefficients`' order."""
+
+PARAMS = Layout("ship", "P_", [
+    RecordField("M11", "m_plus_mx", "kg", "m + m_x, surge mass"),
+    RecordField("MY", "m_plus_my", "kg", "m - Y_vdot, the v r coupling of the surge equation"),
+    RecordField("MXC", "m_xc", "kg m", "m x_c"),
+    RecordField("M", "m", "kg", "ship mass"),
+    RecordField("I22", "Minv_vv", "1/kg", "inverse sway-yaw mass matrix, (v, Y) entry"),
+    RecordField("I23", "Minv_vN", "1/(kg m)", "inverse sway-yaw mass matrix, (v, N) entry"),
+    RecordField("I32", "Minv_rY", "1/(kg m)", "inverse sway-yaw mass matrix, (r, Y) entry"),
+    RecordField("I33", "Minv_rN", "1/(kg m^2)", "inverse sway-yaw mass matrix, (r, N) entry"),
+    RecordField("YV", "Y_v", "kg/m", "0.5 rho L^2 Y'_v (times U v)"),
+    RecordField("YR", "Y_r", "kg", "0.5 rho L^3 Y'_r (times U r)"),
+    RecordField("NV", "N_v", "kg", "0.5 rho L^3 N'_v (times U v)"),
+    RecordField("NR", "N_r", "kg m", "0.5 rho L^4 N'_r (times U r)"),
+    RecordField("YD", "Y_delta", "kg/m", "rudder side force per U_R^2 rad, steerlab sign"),
+    RecordField("ND", "N_delta", "kg", "rudder yaw moment per U_R^2 rad, steerlab sign"),
+    RecordField("XD", "X_delta", "kg/m", "rudder drag coefficient |Y_delta|"),
+    RecordField("XUU", "X_uu", "kg/m", "resistance, calibrated at the design point (< 0)"),
+    RecordField("CF", "crossflow", "kg/m^3", "0.5 rho T C_D, cross-flow drag per strip"),
+    RecordField("L", "L", "m", "length between perpendiculars", lo=0.0, lo_open=True),
+    RecordField("RHO", "rho", "kg/m^3", "water density", lo=0.0, lo_open=True),
+    RecordField("DP", "D", "m", "propeller diameter", lo=0.0, lo_open=True),
+    RecordField("KT0", "kt0", "-", "K_T(J) constant term"),
+    RecordField("KT1", "kt1", "-", "K_T(J) linear term"),
+    RecordField("KT2", "kt2", "-", "K_T(J) quadratic term"),
+    RecordField("WP", "w_p", "-", "wake fraction"),
+    RecordField("TP", "t_p", "-", "thrust deduction"),
+    RecordField("ETA", "slipstream", "-", "fraction of the rudder in the slipstream"),
+    RecordField("RHOA", "rho_air", "kg/m^3", "air density"),
+    RecordField("AF", "A_F", "m^2", "frontal windage area"),
+    RecordField("AL", "A_L", "m^2", "lateral windage area"),
+] + [RecordField(f"WC_{c}", f"wind_{c}", "-", f"Fujiwara coefficient {c} (eqs 14-16)") for c in WIND_COEFFICIENTS]
+).then("rpm", RATE)
+PARAMS.export(globals())         # P_M11 = 0, ..., P_WC_X0 = 29, ..., P_WC_N3 = 38, P_RPM_N = 39, P_RPM_K = 40
+P_WC = PARAMS.index("wind_X0")   # the 10 Fujiwara coefficients, a block from here
+N_WC = len(WIND_COEFFICIENTS)
+P_NCONST = PARAMS.index("rpm.n")  # rpm block (ships/rpm_schedule.py) from here
+N_FIXED = PARAMS.size
 N_STRIPS = 8
 
 
@@ -272,35 +305,34 @@ def pack(data: MMGShipData, n_rps: float, schedule=()) -> np.ndarray:
     h, rd, pr = data.hull, data.rudder, data.propeller
     d, mp, m, xc, M, (q2, q3, q4) = _dimensional(data)
     Minv = np.linalg.inv(M)
-    block = pack_rate(n_rps, schedule)
-    p = np.zeros(N_FIXED - 2 + block.size)
-    p[P_M11] = m * (1.0 + h.m_x_ratio)
-    p[P_MY] = m - d.Y_vdot * q3
-    p[P_MXC] = m * xc
-    p[P_M] = m
-    p[P_I22], p[P_I23], p[P_I32], p[P_I33] = Minv[0, 0], Minv[0, 1], Minv[1, 0], Minv[1, 1]
-    p[P_YV] = d.Y_v * q2
-    p[P_YR] = d.Y_r * q3
-    p[P_NV] = d.N_v * q3
-    p[P_NR] = d.N_r * q4
-    p[P_YD] = -d.Y_delta * q2          # steerlab sign: delta = -delta_paper
-    p[P_ND] = -d.N_delta * q3          # steerlab sign
-    p[P_XD] = abs(d.Y_delta) * q2
-    p[P_XUU] = resistance_coefficient(data)
-    p[P_CF] = 0.5 * h.rho * h.T * h.C_D_crossflow
-    p[P_L] = h.L
-    p[P_RHO] = h.rho
-    p[P_DP] = pr.D
-    p[P_KT0], p[P_KT1], p[P_KT2] = pr.kt
-    p[P_WP] = pr.w_p
-    p[P_TP] = pr.t_p
-    p[P_ETA] = rd.slipstream
-    p[P_RHOA] = data.wind.rho_air
-    p[P_AF] = data.wind.A_F
-    p[P_AL] = data.wind.A_L
-    p[P_WC:P_WC + 10] = fujiwara_coefficients(data.wind_geometry())
-    p[P_NCONST:] = block
-    return p
+    values = {
+        "m_plus_mx": m * (1.0 + h.m_x_ratio),
+        "m_plus_my": m - d.Y_vdot * q3,
+        "m_xc": m * xc,
+        "m": m,
+        "Minv_vv": Minv[0, 0], "Minv_vN": Minv[0, 1], "Minv_rY": Minv[1, 0], "Minv_rN": Minv[1, 1],
+        "Y_v": d.Y_v * q2,
+        "Y_r": d.Y_r * q3,
+        "N_v": d.N_v * q3,
+        "N_r": d.N_r * q4,
+        "Y_delta": -d.Y_delta * q2,          # steerlab sign: delta = -delta_paper
+        "N_delta": -d.N_delta * q3,          # steerlab sign
+        "X_delta": abs(d.Y_delta) * q2,
+        "X_uu": resistance_coefficient(data),
+        "crossflow": 0.5 * h.rho * h.T * h.C_D_crossflow,
+        "L": h.L,
+        "rho": h.rho,
+        "D": pr.D,
+        "kt0": pr.kt[0], "kt1": pr.kt[1], "kt2": pr.kt[2],
+        "w_p": pr.w_p,
+        "t_p": pr.t_p,
+        "slipstream": rd.slipstream,
+        "rho_air": data.wind.rho_air,
+        "A_F": data.wind.A_F,
+        "A_L": data.wind.A_L,
+    }
+    values.update(zip((f"wind_{c}" for c in WIND_COEFFICIENTS), fujiwara_coefficients(data.wind_geometry())))
+    return pack_with_rate(PARAMS, values, n_rps, schedule)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -332,17 +364,17 @@ def mmg_rhs(t, x, delta, w, p, dx):
     dx : ndarray
         Output derivatives.
     """
-    psi = x[2]
-    u = x[3]
-    v = x[4]
-    r = x[5]
+    psi = x[IPSI]
+    u = x[IU]
+    v = x[IV]
+    r = x[IR]
     d = delta + w[W_RUDDER]
     # current (north, east components) in body axes
     sp, cp = sincos(psi)
     uc = w[W_CURRENT_N] * cp + w[W_CURRENT_E] * sp
     vcb = w[W_CURRENT_E] * cp - w[W_CURRENT_N] * sp
     earth_velocity(psi, u, v, w, dx)
-    dx[2] = r
+    dx[IPSI] = r
     U = math.sqrt(u * u + v * v)
     # propeller
     n = propeller_rate(t, p)
@@ -374,15 +406,15 @@ def mmg_rhs(t, x, delta, w, p, dx):
     nw = 0.0
     if w[W_WIND_SPEED] > 0.0:
         UR, psia = relative_wind(u + uc, v + vcb, psi, w[W_WIND_SPEED], w[W_WIND_DIR])
-        xw, yw, nw = wind_force(p[P_WC:P_WC + 10], p[P_RHOA], p[P_AF], p[P_AL], L, UR, psia)
+        xw, yw, nw = wind_force(p[P_WC:P_WC + N_WC], p[P_RHOA], p[P_AF], p[P_AL], L, UR, psia)
     m = p[P_M]
     mxc = p[P_MXC]
     X = p[P_XUU] * u * abs(u) + (1.0 - p[P_TP]) * tp + xr + xw + p[P_MY] * v * r + mxc * r * r
     Y = p[P_YV] * U * v + p[P_YR] * U * r + ycf + yr + yw - m * u * r
     N = p[P_NV] * U * v + p[P_NR] * U * r + ncf + nr + nw - mxc * u * r
-    dx[3] = X / p[P_M11]
-    dx[4] = p[P_I22] * Y + p[P_I23] * N
-    dx[5] = p[P_I32] * Y + p[P_I33] * N + w[W_YAW_MOMENT]
+    dx[IU] = X / p[P_M11]
+    dx[IV] = p[P_I22] * Y + p[P_I23] * N
+    dx[IR] = p[P_I32] * Y + p[P_I33] * N + w[W_YAW_MOMENT]
 
 
 # ---------------------------------------------------------------------------------------------
@@ -423,7 +455,6 @@ def linearise_data(data: MMGShipData, speed: float):
 
 def _spec_for(data: MMGShipData):
     from steerlab.ships.registry import ShipSpec
-    from steerlab.ships.state import PLANAR_NAMES, PLANAR_UNITS
 
     def spec_pack(speed, rpm, options=None):
         o = options or MMGOptions()
@@ -444,7 +475,7 @@ def _spec_for(data: MMGShipData):
         return nomoto_KT_eq11(*linearise_data(data, speed))
 
     return ShipSpec(
-        name=data.id, description=data.description, rhs=mmg_rhs, n_states=6,
+        name=data.id, description=data.description, rhs=mmg_rhs, n_states=N_PLANAR,
         state_names=PLANAR_NAMES, state_units=PLANAR_UNITS, pack=spec_pack, b2_exact=b2_exact,
         dims=(data.hull.C_b, data.hull.L, data.hull.B), source=data.source, linearise=linearise,
         options_model=MMGOptions, nomoto_KT=nomoto_KT, speed_range=tuple(data.speed_range_m_s))

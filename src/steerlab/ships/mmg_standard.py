@@ -58,7 +58,10 @@ from pydantic import Field, ValidationError
 from steerlab.config_base import FrozenConfig
 from steerlab.environment.channels import W_RUDDER, W_YAW_MOMENT
 from steerlab.errors import InputError
+from steerlab.records import Field as RecordField
+from steerlab.records import Layout
 from steerlab.ships.kinematics import earth_velocity
+from steerlab.ships.state import IPSI, IR, IU, IV, N_PLANAR, PLANAR_NAMES, PLANAR_UNITS
 from steerlab.sincos import sincos
 from steerlab.vecmath import atan2, exp_neg
 
@@ -178,18 +181,48 @@ def get_mmgstd_data(name: str) -> MMGStdShipData:
 # ---------------------------------------------------------------------------------------------
 # packed record (SI)
 
-P_MX, P_MY, P_XGM = 0, 1, 2                 # m + m_x, m + m_y [kg], x_G m [kg m]
-P_I22, P_I23, P_I32, P_I33 = 3, 4, 5, 6     # inverse of [[m + m_y, x_G m], [x_G m, I_zG + x_G^2 m + J_z]]
-P_QX, P_QN = 7, 8                           # 1/2 rho L d [kg/m^2], 1/2 rho L^2 d [kg/m]
-P_L, P_RHO = 9, 10
-P_HULL = 11                                 # 17 coefficients: R0, Xvv, Xvr, Xrr, Xvvvv, Yv..Yrrr, Nv..Nrrr
-P_D = 28
-P_K0, P_K1, P_K2, P_TP, P_WP0, P_XP, P_C1, P_C2P, P_C2M = 29, 30, 31, 32, 33, 34, 35, 36, 37
-P_QR = 38                                   # 1/2 rho A_R f_alpha [kg/m]
-P_TR, P_AH, P_XRXH = 39, 40, 41             # t_R, 1 + a_H, (x_R + a_H x_H) L [m]
-P_EPS, P_KAPPA, P_ETA, P_LR, P_GRP, P_GRM = 42, 43, 44, 45, 46, 47
-P_N = 48                                    # propeller rate [rev/s]
-N_PARAMS = 49
+HULL_COEFFICIENTS = ("R_0", "X_vv", "X_vr", "X_rr", "X_vvvv", "Y_v", "Y_r", "Y_vvv", "Y_vvr", "Y_vrr", "Y_rrr",
+                     "N_v", "N_r", "N_vvv", "N_vvr", "N_vrr", "N_rrr")
+"""YY2015's non-dimensional hull derivatives, as :class:`MMGStdHull` names them (``R_0`` is ``R'_0``)."""
+
+PARAMS = Layout("ship", "P_", [
+    RecordField("MX", "m_plus_mx", "kg", "m + m_x"),
+    RecordField("MY", "m_plus_my", "kg", "m + m_y"),
+    RecordField("XGM", "xG_m", "kg m", "x_G m"),
+    RecordField("I22", "Minv_vv", "1/kg", "inverse of [[m + m_y, x_G m], [x_G m, I_zG + x_G^2 m + J_z]], (v, Y)"),
+    RecordField("I23", "Minv_vN", "1/(kg m)", "inverse mass matrix, (v, N) entry"),
+    RecordField("I32", "Minv_rY", "1/(kg m)", "inverse mass matrix, (r, Y) entry"),
+    RecordField("I33", "Minv_rN", "1/(kg m^2)", "inverse mass matrix, (r, N) entry"),
+    RecordField("QX", "q_force", "kg/m^2", "1/2 rho L d, hull force scale"),
+    RecordField("QN", "q_moment", "kg/m", "1/2 rho L^2 d, hull moment scale"),
+    RecordField("L", "L", "m", "length between perpendiculars", lo=0.0, lo_open=True),
+    RecordField("RHO", "rho", "kg/m^3", "water density", lo=0.0, lo_open=True),
+] + [RecordField("H_" + c.replace("_", "").upper(), c, "-", f"hull derivative {c}' (YY2015)") for c in HULL_COEFFICIENTS]
+  + [
+    RecordField("D", "D", "m", "propeller diameter", lo=0.0, lo_open=True),
+    RecordField("K0", "k0", "-", "K_T(J) constant term"),
+    RecordField("K1", "k1", "-", "K_T(J) linear term"),
+    RecordField("K2", "k2", "-", "K_T(J) quadratic term"),
+    RecordField("TP", "t_P", "-", "thrust deduction"),
+    RecordField("WP0", "w_P0", "-", "wake fraction in straight motion"),
+    RecordField("XP", "x_P", "-", "x'_P, propeller position / L"),
+    RecordField("C1", "C_1", "-", "wake-change constant"),
+    RecordField("C2P", "C_2_plus", "-", "C_2 for beta_P > 0"),
+    RecordField("C2M", "C_2_minus", "-", "C_2 for beta_P < 0"),
+    RecordField("QR", "q_rudder", "kg/m", "1/2 rho A_R f_alpha"),
+    RecordField("TR", "t_R", "-", "steering resistance deduction"),
+    RecordField("AH", "one_plus_a_H", "-", "1 + a_H"),
+    RecordField("XRXH", "x_R_plus_a_H_x_H", "m", "(x_R + a_H x_H) L"),
+    RecordField("EPS", "epsilon", "-", "(1 - w_R)/(1 - w_P)"),
+    RecordField("KAPPA", "kappa", "-", "slipstream correction"),
+    RecordField("ETA", "eta", "-", "D / H_R"),
+    RecordField("LR", "l_R", "-", "l'_R, effective rudder position / L"),
+    RecordField("GRP", "gamma_R_plus", "-", "flow straightening, beta_R > 0"),
+    RecordField("GRM", "gamma_R_minus", "-", "flow straightening, beta_R < 0"),
+    RecordField("N", "n", "rev/s", "propeller rate (constant)"),
+], size_name="N_PARAMS")
+PARAMS.export(globals())         # P_MX = 0, ..., P_H_R0 = 11, ..., P_H_NRRR = 27, P_D = 28, ..., P_N = 48, N_PARAMS = 49
+P_HULL = P_H_R0                  # the hull derivatives, a block from here
 
 
 def masses(data: MMGStdShipData):
@@ -234,30 +267,29 @@ def pack(data: MMGStdShipData, n_rps: float) -> np.ndarray:
     xg = h.x_G
     M = np.array([[m + my, xg * m], [xg * m, Izg + xg * xg * m + Jz]])
     Minv = np.linalg.inv(M)
-    p = np.zeros(N_PARAMS)
-    p[P_MX] = m + mx
-    p[P_MY] = m + my
-    p[P_XGM] = xg * m
-    p[P_I22], p[P_I23], p[P_I32], p[P_I33] = Minv[0, 0], Minv[0, 1], Minv[1, 0], Minv[1, 1]
-    p[P_QX] = 0.5 * h.rho * h.L * h.d
-    p[P_QN] = 0.5 * h.rho * h.L**2 * h.d
-    p[P_L] = h.L
-    p[P_RHO] = h.rho
-    p[P_HULL:P_HULL + 17] = [h.R_0, h.X_vv, h.X_vr, h.X_rr, h.X_vvvv,
-                             h.Y_v, h.Y_r, h.Y_vvv, h.Y_vvr, h.Y_vrr, h.Y_rrr,
-                             h.N_v, h.N_r, h.N_vvv, h.N_vvr, h.N_vrr, h.N_rrr]
-    p[P_D] = pr.D
-    p[P_K0], p[P_K1], p[P_K2] = pr.kt
-    p[P_TP], p[P_WP0], p[P_XP] = pr.t_P, pr.w_P0, pr.x_P
-    p[P_C1], p[P_C2P], p[P_C2M] = pr.C_1, pr.C_2_plus, pr.C_2_minus
-    p[P_QR] = 0.5 * h.rho * rd.A_R * rd.f_alpha
-    p[P_TR] = rd.t_R
-    p[P_AH] = 1.0 + rd.a_H
-    p[P_XRXH] = (rd.x_R + rd.a_H * rd.x_H) * h.L
-    p[P_EPS], p[P_KAPPA], p[P_ETA] = rd.epsilon, rd.kappa, pr.D / rd.H_R
-    p[P_LR], p[P_GRP], p[P_GRM] = rd.l_R, rd.gamma_R_plus, rd.gamma_R_minus
-    p[P_N] = n_rps
-    return p
+    values = {
+        "m_plus_mx": m + mx,
+        "m_plus_my": m + my,
+        "xG_m": xg * m,
+        "Minv_vv": Minv[0, 0], "Minv_vN": Minv[0, 1], "Minv_rY": Minv[1, 0], "Minv_rN": Minv[1, 1],
+        "q_force": 0.5 * h.rho * h.L * h.d,
+        "q_moment": 0.5 * h.rho * h.L**2 * h.d,
+        "L": h.L,
+        "rho": h.rho,
+        **{c: getattr(h, c) for c in HULL_COEFFICIENTS},
+        "D": pr.D,
+        "k0": pr.kt[0], "k1": pr.kt[1], "k2": pr.kt[2],
+        "t_P": pr.t_P, "w_P0": pr.w_P0, "x_P": pr.x_P,
+        "C_1": pr.C_1, "C_2_plus": pr.C_2_plus, "C_2_minus": pr.C_2_minus,
+        "q_rudder": 0.5 * h.rho * rd.A_R * rd.f_alpha,
+        "t_R": rd.t_R,
+        "one_plus_a_H": 1.0 + rd.a_H,
+        "x_R_plus_a_H_x_H": (rd.x_R + rd.a_H * rd.x_H) * h.L,
+        "epsilon": rd.epsilon, "kappa": rd.kappa, "eta": pr.D / rd.H_R,
+        "l_R": rd.l_R, "gamma_R_plus": rd.gamma_R_plus, "gamma_R_minus": rd.gamma_R_minus,
+        "n": n_rps,
+    }
+    return PARAMS.pack(values)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -283,13 +315,13 @@ def mmgstd_rhs(t, x, delta, w, p, dx):
     dx : ndarray
         Output derivatives.
     """
-    psi = x[2]
-    u = x[3]
-    v = x[4]
-    r = x[5]
+    psi = x[IPSI]
+    u = x[IU]
+    v = x[IV]
+    r = x[IR]
     d = delta + w[W_RUDDER]
     earth_velocity(psi, u, v, w, dx)
-    dx[2] = r
+    dx[IPSI] = r
     L = p[P_L]
     U2 = u * u + v * v
     U = math.sqrt(U2)
@@ -298,14 +330,13 @@ def mmgstd_rhs(t, x, delta, w, p, dx):
     Ui = Ui if moving else 0.0
     vp = v * Ui                     # v'
     rp = r * L * Ui                 # r'
-    h = P_HULL
     # hull, dimensional
-    XH = p[P_QX] * U2 * (-p[h] + p[h + 1] * vp * vp + p[h + 2] * vp * rp + p[h + 3] * rp * rp
-                         + p[h + 4] * vp * vp * vp * vp)
-    YH = p[P_QX] * U2 * (p[h + 5] * vp + p[h + 6] * rp + p[h + 7] * vp * vp * vp + p[h + 8] * vp * vp * rp
-                         + p[h + 9] * vp * rp * rp + p[h + 10] * rp * rp * rp)
-    NH = p[P_QN] * U2 * (p[h + 11] * vp + p[h + 12] * rp + p[h + 13] * vp * vp * vp + p[h + 14] * vp * vp * rp
-                         + p[h + 15] * vp * rp * rp + p[h + 16] * rp * rp * rp)
+    XH = p[P_QX] * U2 * (-p[P_H_R0] + p[P_H_XVV] * vp * vp + p[P_H_XVR] * vp * rp + p[P_H_XRR] * rp * rp
+                         + p[P_H_XVVVV] * vp * vp * vp * vp)
+    YH = p[P_QX] * U2 * (p[P_H_YV] * vp + p[P_H_YR] * rp + p[P_H_YVVV] * vp * vp * vp + p[P_H_YVVR] * vp * vp * rp
+                         + p[P_H_YVRR] * vp * rp * rp + p[P_H_YRRR] * rp * rp * rp)
+    NH = p[P_QN] * U2 * (p[P_H_NV] * vp + p[P_H_NR] * rp + p[P_H_NVVV] * vp * vp * vp + p[P_H_NVVR] * vp * vp * rp
+                         + p[P_H_NVRR] * vp * rp * rp + p[P_H_NRRR] * rp * rp * rp)
     # propeller: drift-dependent wake
     beta = atan2(-v, u)             # 0 at U = 0
     bP = beta - p[P_XP] * rp
@@ -337,9 +368,9 @@ def mmgstd_rhs(t, x, delta, w, p, dx):
     X = XH + XP + XR + p[P_MY] * v * r + p[P_XGM] * r * r
     Y = YH + YR - p[P_MX] * u * r
     N = NH + NR - p[P_XGM] * u * r
-    dx[3] = X / p[P_MX]
-    dx[4] = p[P_I22] * Y + p[P_I23] * N
-    dx[5] = p[P_I32] * Y + p[P_I33] * N + w[W_YAW_MOMENT]
+    dx[IU] = X / p[P_MX]
+    dx[IV] = p[P_I22] * Y + p[P_I23] * N
+    dx[IR] = p[P_I32] * Y + p[P_I33] * N + w[W_YAW_MOMENT]
 
 
 # ---------------------------------------------------------------------------------------------
@@ -358,12 +389,13 @@ def linearise_data(data: MMGStdShipData, speed: float, n_rps: float | None = Non
     n = propeller_rate_for_speed(speed, data) if n_rps is None else n_rps
     p = pack(data, n)
     w = np.zeros(N_CHANNELS)
-    dx = np.zeros(6)
+    dx = np.zeros(N_PLANAR)
 
     def f(v, r, dlt):
-        x = np.array([0.0, 0.0, 0.0, speed, v, r])
+        x = np.zeros(N_PLANAR)
+        x[IU], x[IV], x[IR] = speed, v, r
         mmgstd_rhs(0.0, x, dlt, w, p, dx)
-        return np.array([dx[4], dx[5]])
+        return np.array([dx[IV], dx[IR]])
 
     hv, hr, hd = step * speed, step * speed / data.hull.L, step
     A = np.column_stack([(f(hv, 0, 0) - f(-hv, 0, 0)) / (2 * hv), (f(0, hr, 0) - f(0, -hr, 0)) / (2 * hr)])
@@ -374,7 +406,6 @@ def linearise_data(data: MMGStdShipData, speed: float, n_rps: float | None = Non
 def _spec_for(data: MMGStdShipData):
     from steerlab.ships.linear_analysis import nomoto_from_linear
     from steerlab.ships.ship_traits import TraitShipSpec
-    from steerlab.ships.state import PLANAR_NAMES, PLANAR_UNITS
 
     lo, hi = data.speed_range_m_s
 
@@ -396,7 +427,7 @@ def _spec_for(data: MMGStdShipData):
         return n["K"], n["T"]
 
     return TraitShipSpec(
-        name=data.id, description=data.description, rhs=mmgstd_rhs, n_states=6,
+        name=data.id, description=data.description, rhs=mmgstd_rhs, n_states=N_PLANAR,
         state_names=PLANAR_NAMES, state_units=PLANAR_UNITS, pack=spec_pack, b2_exact=b2_exact,
         dims=(data.hull.volume / (data.hull.L * data.hull.B * data.hull.d), data.hull.L, data.hull.B),
         source=data.source, linearise=linearise, nomoto_KT=nomoto_KT, speed_range=(lo, hi),

@@ -46,7 +46,6 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import NamedTuple
 
 import numba
 import numpy as np
@@ -57,73 +56,101 @@ from pydantic import field_validator
 from steerlab.config_base import FrozenConfig
 from steerlab.environment.channels import W_RUDDER, W_YAW_MOMENT
 from steerlab.errors import InputError
+from steerlab.records import Field as RecordField
+from steerlab.records import Layout
 from steerlab.ships.kinematics import earth_velocity
-from steerlab.ships.rpm_schedule import check_rpm_schedule, pack_rate, scheduled_rate
+from steerlab.ships.rpm_schedule import RATE, check_rpm_schedule, pack_with_rate, scheduled_rate
+from steerlab.ships.state import IPSI, IR, IU, IV, ship_state
 
 
-class TankerCoefficients(NamedTuple):
-    """MSS ``tanker.m`` (van Berlekom & Goddard 1972) values, non-dimensional unless stated."""
-
-    L: float = 304.8        #: length [m]
-    T: float = 18.46        #: draught [m]
-    B: float = 47.17        #: beam [m] (Zwierzewicz et al. 2021 Table 1; tanker.m gives none)
-    c_B: float = 0.83       #: block coefficient (Zwierzewicz et al. 2021 Table 1)
-    t: float = 0.22         #: thrust deduction
-    cun: float = 0.605
-    cnn: float = 38.2
-    Tuu: float = -0.00695
-    Tun: float = -0.00063
-    Tnn: float = 0.0000354
-    m11: float = 1.050      #: 1 - Xudot
-    m22: float = 2.020      #: 1 - Yvdot
-    m33: float = 0.1232     #: kz^2 - Nrdot
-    d11: float = 2.020      #: 1 + Xvr
-    d22: float = -0.752     #: Yur - 1
-    d33: float = -0.231     #: Nur - xG
-    Xuu: float = -0.0377
-    Xvv: float = 0.3
-    Xccdd: float = -0.093
-    Xccbd: float = 0.152
-    Xudotz: float = -0.05
-    Xuuz: float = -0.0061
-    Xvrz: float = 0.387
-    Xvvzz: float = 0.0125
-    YT: float = 0.04
-    Yvv: float = -2.400
-    Yuv: float = -1.205
-    Yccd: float = 0.208
-    Yccbbd: float = -2.16
-    Yvdotz: float = -0.387
-    Yurz: float = 0.182
-    Yvvz: float = -1.5
-    Yccbbdz: float = -0.191
-    NT: float = -0.02
-    Nvr: float = -0.300
-    Nuv: float = -0.451
-    Nccd: float = -0.098
-    Nccbbd: float = 0.688
-    Nrdotz: float = -0.0045
-    Nurz: float = -0.047
-    Nvrz: float = -0.120
-    Nuvz: float = -0.241
-    Nccbbdz: float = 0.344
+COEFFICIENTS = Layout("mss-tanker coefficients", "K_", [
+    RecordField("L", "L", "m", "length", default=304.8),
+    RecordField("T", "T", "m", "draught", default=18.46),
+    RecordField("B", "B", "m", "beam (Zwierzewicz et al. 2021 Table 1; tanker.m gives none)", default=47.17),
+    RecordField("C_B", "c_B", "-", "block coefficient (Zwierzewicz et al. 2021 Table 1)", default=0.83),
+    RecordField("TDED", "t", "-", "thrust deduction", default=0.22),
+    RecordField("CUN", "cun", "-", "slipstream c^2 = cun u n + cnn n^2: u n term", default=0.605),
+    RecordField("CNN", "cnn", "-", "slipstream c^2: n^2 term", default=38.2),
+    RecordField("TUU", "Tuu", "-", "thrust g_T: u^2 / L term", default=-0.00695),
+    RecordField("TUN", "Tun", "-", "thrust g_T: u n term", default=-0.00063),
+    RecordField("TNN", "Tnn", "-", "thrust g_T: L |n| n term", default=0.0000354),
+    RecordField("M11", "m11", "-", "1 - Xudot", default=1.050),
+    RecordField("M22", "m22", "-", "1 - Yvdot", default=2.020),
+    RecordField("M33", "m33", "-", "kz^2 - Nrdot", default=0.1232),
+    RecordField("D11", "d11", "-", "1 + Xvr", default=2.020),
+    RecordField("D22", "d22", "-", "Yur - 1", default=-0.752),
+    RecordField("D33", "d33", "-", "Nur - xG", default=-0.231),
+    RecordField("XUU", "Xuu", "-", "surge: u^2", default=-0.0377),
+    RecordField("XVV", "Xvv", "-", "surge: v^2", default=0.3),
+    RecordField("XCCDD", "Xccdd", "-", "surge: |c|c d^2", default=-0.093),
+    RecordField("XCCBD", "Xccbd", "-", "surge: |c|c beta d", default=0.152),
+    RecordField("XUDOTZ", "Xudotz", "-", "shallow water: m11 - Xudotz z", default=-0.05),
+    RecordField("XUUZ", "Xuuz", "-", "surge: u^2 z", default=-0.0061),
+    RecordField("XVRZ", "Xvrz", "-", "surge: L v r z", default=0.387),
+    RecordField("XVVZZ", "Xvvzz", "-", "surge: v^2 z^2", default=0.0125),
+    RecordField("YT", "YT", "-", "sway: L g_T (propeller side force)", default=0.04),
+    RecordField("YVV", "Yvv", "-", "sway: |v|v", default=-2.400),
+    RecordField("YUV", "Yuv", "-", "sway: u v", default=-1.205),
+    RecordField("YCCD", "Yccd", "-", "sway: |c|c d", default=0.208),
+    RecordField("YCCBBD", "Yccbbd", "-", "sway: |c|c |beta|beta |d|", default=-2.16),
+    RecordField("YVDOTZ", "Yvdotz", "-", "shallow water: m22 - Yvdotz z", default=-0.387),
+    RecordField("YURZ", "Yurz", "-", "sway: L u r z", default=0.182),
+    RecordField("YVVZ", "Yvvz", "-", "sway: |v|v z", default=-1.5),
+    RecordField("YCCBBDZ", "Yccbbdz", "-", "sway: |c|c |beta|beta |d| z", default=-0.191),
+    RecordField("NT", "NT", "-", "yaw: L g_T (propeller moment)", default=-0.02),
+    RecordField("NVR", "Nvr", "-", "yaw: L |v| r", default=-0.300),
+    RecordField("NUV", "Nuv", "-", "yaw: u v", default=-0.451),
+    RecordField("NCCD", "Nccd", "-", "yaw: |c|c d", default=-0.098),
+    RecordField("NCCBBD", "Nccbbd", "-", "yaw: |c|c |beta|beta |d|", default=0.688),
+    RecordField("NRDOTZ", "Nrdotz", "-", "shallow water: m33 - Nrdotz z", default=-0.0045),
+    RecordField("NURZ", "Nurz", "-", "yaw: L u r z", default=-0.047),
+    RecordField("NVRZ", "Nvrz", "-", "yaw: L |v| r z", default=-0.120),
+    RecordField("NUVZ", "Nuvz", "-", "yaw: u v z", default=-0.241),
+    RecordField("NCCBBDZ", "Nccbbdz", "-", "yaw: |c|c |beta|beta |d| z", default=0.344),
+])
+"""MSS ``tanker.m`` (van Berlekom & Goddard 1972) values, non-dimensional unless a unit is given."""
+TankerCoefficients = COEFFICIENTS.record_type("TankerCoefficients")
+TankerCoefficients.__module__ = __name__
 
 
 COEF = TankerCoefficients()
 MIN_DEPTH = 18.5   #: m, tanker.m refuses shallower water (the draught is 18.46 m)
 N_MAX_RPM = 80.0   #: tanker.m's shaft-rate limit [rpm]
 T_SHAFT = 50.0     #: tanker.m's shaft time constant T_m [s]
-N_STATES = 7
-STATE_NAMES = ("x_n", "y_e", "psi", "u", "v", "r", "dn")
-STATE_UNITS = ("m", "m", "rad", "m/s", "m/s", "rad/s", "rev/s")
+STATE = ship_state("ship state", "I_", [
+    RecordField("DN", "dn", "rev/s", "shaft rate's deviation n - n_0 from the rate it starts at"),
+])
+STATE.export(globals())          # the planar IX..IR, I_DN = 6, N_STATES = 7
+STATE_NAMES = STATE.names
+STATE_UNITS = STATE.units
 
-# packed record
-(P_N, P_Z, P_L, P_M11, P_M22, P_M33L2, P_T, P_CUN, P_CNN, P_TUU, P_TUN, P_TNN, P_D11, P_D22, P_D33,
- P_XUU, P_XVV, P_XCCDD, P_XCCBD, P_XUUZ, P_XVRZ, P_XVVZZ,
- P_YT, P_YVV, P_YUV, P_YCCD, P_YCCBBD, P_YURZ, P_YUVZ, P_YVVZ, P_YCCBBDZ,
- P_NT, P_NVR, P_NUV, P_NCCD, P_NCCBBD, P_NURZ, P_NVRZ, P_NUVZ, P_NCCBBDZ, P_INV_TM) = range(41)
-P_RATE = 41        #: rpm block (ships/rpm_schedule.py) from here: the command n_c
-N_FIXED = 41
+
+def _coefficient(name: str) -> RecordField:
+    """The record field that carries the coefficient ``name`` as it is (declared in :data:`COEFFICIENTS`)."""
+    f = COEFFICIENTS.fields[COEFFICIENTS.index(name)]
+    return RecordField(name.upper(), f.name, f.unit, f.doc)
+
+
+# packed record: the shaft rate, the depth parameter, the mass terms at that depth, the
+# coefficients the kernel reads as they are, Yuvz(z) and 1/T_m; then the rpm block (the command n_c)
+PARAMS = Layout("ship", "P_", [
+    RecordField("N", "n", "rev/s", "shaft rate at t = 0 (n_0)"),
+    RecordField("Z", "z", "-", "shallow-water parameter T/(h - T) (0: deep water)", lo=0.0),
+    _coefficient("L"),
+    RecordField("M11", "m11", "-", "m11 - Xudotz z"),
+    RecordField("M22", "m22", "-", "m22 - Yvdotz z"),
+    RecordField("M33L2", "m33L2", "m^2", "(m33 - Nrdotz z) L^2"),
+    _coefficient("t"),
+    *(_coefficient(n) for n in ("cun", "cnn", "Tuu", "Tun", "Tnn", "d11", "d22", "d33",
+                                "Xuu", "Xvv", "Xccdd", "Xccbd", "Xuuz", "Xvrz", "Xvvzz",
+                                "YT", "Yvv", "Yuv", "Yccd", "Yccbbd", "Yurz")),
+    RecordField("YUVZ", "Yuvz", "-", "-0.85 (1 - 0.8/z) for z >= 0.8, else 0"),
+    *(_coefficient(n) for n in ("Yvvz", "Yccbbdz", "NT", "Nvr", "Nuv", "Nccd", "Nccbbd", "Nurz", "Nvrz", "Nuvz",
+                                "Nccbbdz")),
+    RecordField("INV_TM", "inv_T_m", "1/s", "1/T_m, the shaft's inverse time constant", lo=0.0, lo_open=True),
+]).then("rpm", RATE)
+PARAMS.export(globals())         # P_N = 0, P_Z = 1, P_L = 2, ..., P_INV_TM = 40, P_RPM_N = 41, P_RPM_K = 42
+P_RATE = PARAMS.index("rpm.n")   # rpm block (ships/rpm_schedule.py) from here: the command n_c
 
 
 class TankerOptions(FrozenConfig):
@@ -163,25 +190,11 @@ def pack(n_rps: float, depth_m: float | None = None, c: TankerCoefficients = COE
     ``t_shaft``: ``T_m`` [s].
     """
     z = depth_parameter(depth_m, c)
-    block = pack_rate(n_rps, schedule)
-    p = np.zeros(N_FIXED + block.size)
-    p[P_INV_TM] = 1.0 / t_shaft
-    p[P_RATE:] = block
-    p[P_N], p[P_Z], p[P_L] = n_rps, z, c.L
-    p[P_M11] = c.m11 - c.Xudotz * z
-    p[P_M22] = c.m22 - c.Yvdotz * z
-    p[P_M33L2] = (c.m33 - c.Nrdotz * z) * c.L**2
-    p[P_T], p[P_CUN], p[P_CNN] = c.t, c.cun, c.cnn
-    p[P_TUU], p[P_TUN], p[P_TNN] = c.Tuu, c.Tun, c.Tnn
-    p[P_D11], p[P_D22], p[P_D33] = c.d11, c.d22, c.d33
-    p[P_XUU], p[P_XVV], p[P_XCCDD], p[P_XCCBD] = c.Xuu, c.Xvv, c.Xccdd, c.Xccbd
-    p[P_XUUZ], p[P_XVRZ], p[P_XVVZZ] = c.Xuuz, c.Xvrz, c.Xvvzz
-    p[P_YT], p[P_YVV], p[P_YUV], p[P_YCCD], p[P_YCCBBD] = c.YT, c.Yvv, c.Yuv, c.Yccd, c.Yccbbd
-    p[P_YURZ], p[P_YVVZ], p[P_YCCBBDZ] = c.Yurz, c.Yvvz, c.Yccbbdz
-    p[P_YUVZ] = -0.85 * (1.0 - 0.8 / z) if z >= 0.8 else 0.0
-    p[P_NT], p[P_NVR], p[P_NUV], p[P_NCCD], p[P_NCCBBD] = c.NT, c.Nvr, c.Nuv, c.Nccd, c.Nccbbd
-    p[P_NURZ], p[P_NVRZ], p[P_NUVZ], p[P_NCCBBDZ] = c.Nurz, c.Nvrz, c.Nuvz, c.Nccbbdz
-    return p
+    values = {n: getattr(c, n) for n in PARAMS.names if n in COEFFICIENTS.names}
+    values.update(n=n_rps, z=z, L=c.L, m11=c.m11 - c.Xudotz * z, m22=c.m22 - c.Yvdotz * z,
+                  m33L2=(c.m33 - c.Nrdotz * z) * c.L**2, t=c.t,
+                  Yuvz=-0.85 * (1.0 - 0.8 / z) if z >= 0.8 else 0.0, inv_T_m=1.0 / t_shaft)
+    return pack_with_rate(PARAMS, values, n_rps, schedule)
 
 
 @numba.njit(cache=True)
@@ -203,16 +216,16 @@ def tanker_rhs(t, x, delta, w, p, dx):
     dx : ndarray
         Output derivatives.
     """
-    psi = x[2]
-    u = x[3]
-    v = x[4]
-    r = x[5]
+    psi = x[IPSI]
+    u = x[IU]
+    v = x[IV]
+    r = x[IR]
     d = -(delta + w[W_RUDDER])          # MSS sign
     earth_velocity(psi, u, v, w, dx)
-    dx[2] = r
+    dx[IPSI] = r
     L = p[P_L]
-    n = p[P_N] + x[6]
-    dx[6] = (scheduled_rate(t, p, P_RATE) - n) * p[P_INV_TM]
+    n = p[P_N] + x[I_DN]
+    dx[I_DN] = (scheduled_rate(t, p, P_RATE) - n) * p[P_INV_TM]
     z = p[P_Z]
     beta = math.atan2(v, u)
     gT = p[P_TUU] * u * u / L + p[P_TUN] * u * n + L * p[P_TNN] * abs(n) * n
@@ -230,9 +243,9 @@ def tanker_rhs(t, x, delta, w, p, dx):
     gN = (p[P_NUV] * u * v + L * p[P_NVR] * av * r + p[P_NCCD] * cc * d + L * p[P_D33] * u * r
           + p[P_NCCBBD] * cc * bb + L * p[P_NT] * gT + L * p[P_NURZ] * u * r * z + p[P_NUVZ] * u * v * z
           + L * p[P_NVRZ] * av * r * z + p[P_NCCBBDZ] * cc * bb * z)
-    dx[3] = gX / p[P_M11]
-    dx[4] = gY / p[P_M22]
-    dx[5] = gN / p[P_M33L2] + w[W_YAW_MOMENT]
+    dx[IU] = gX / p[P_M11]
+    dx[IV] = gY / p[P_M22]
+    dx[IR] = gN / p[P_M33L2] + w[W_YAW_MOMENT]
 
 
 # ---------------------------------------------------------------------------------------------
@@ -244,8 +257,10 @@ def _forces(u, v, r, delta, n, depth_m):
 
     p = pack(n, depth_m)
     dx = np.zeros(N_STATES)
-    tanker_rhs(0.0, np.array([0.0, 0.0, 0.0, u, v, r, 0.0]), delta, np.zeros(N_CHANNELS), p, dx)
-    return dx[3:6]
+    x = np.zeros(N_STATES)
+    x[IU], x[IV], x[IR] = u, v, r
+    tanker_rhs(0.0, x, delta, np.zeros(N_CHANNELS), p, dx)
+    return dx[IU:IR + 1]
 
 
 def straight_equilibrium(speed: float, depth_m: float | None = None, n_rps: float | None = None):

@@ -28,23 +28,29 @@ from pydantic import Field, field_validator
 
 from steerlab.config_base import FrozenConfig
 from steerlab.environment.channels import W_RUDDER
+from steerlab.records import Field as RecordField
+from steerlab.records import Layout
 from steerlab.ships.kinematics import earth_velocity
+from steerlab.ships.state import IPSI, IR, IU, IV, N_PLANAR, PLANAR_NAMES, PLANAR_UNITS
 
-P_K, P_T = 0, 1
-N_PARAMS = 2
+PARAMS = Layout("ship", "P_", [
+    RecordField("K", "K", "1/s", "rudder-to-yaw-rate gain (Nomoto 1957)", lo=0.0, lo_open=True),
+    RecordField("T", "T", "s", "time constant, non-zero; < 0: course-unstable"),
+], size_name="N_PARAMS")
+PARAMS.export(globals())         # P_K = 0, P_T = 1, N_PARAMS = 2
 
 
 @numba.njit(cache=True)
 def nomoto1_rhs(t, x, delta, w, p, dx):
     """Derivatives of ``[x_n, y_e, psi, u, v, r]`` (see the module docstring)."""
-    psi = x[2]
-    u = x[3]
-    r = x[5]
+    psi = x[IPSI]
+    u = x[IU]
+    r = x[IR]
     earth_velocity(psi, u, 0.0, w, dx)
-    dx[2] = r
-    dx[3] = 0.0
-    dx[4] = 0.0
-    dx[5] = (p[P_K] * (delta + w[W_RUDDER]) - r) / p[P_T]
+    dx[IPSI] = r
+    dx[IU] = 0.0
+    dx[IV] = 0.0
+    dx[IR] = (p[P_K] * (delta + w[W_RUDDER]) - r) / p[P_T]
 
 
 class Nomoto1Options(FrozenConfig):
@@ -64,12 +70,11 @@ class Nomoto1Options(FrozenConfig):
 
 def pack(speed: float, rpm=None, options: Nomoto1Options | None = None) -> np.ndarray:
     o = options or Nomoto1Options()
-    return np.array([o.K, o.T], dtype=np.float64)
+    return PARAMS.pack(K=o.K, T=o.T)
 
 
 def _spec():
     from steerlab.ships.registry import ShipSpec
-    from steerlab.ships.state import PLANAR_NAMES, PLANAR_UNITS
 
     d = Nomoto1Options()
 
@@ -84,7 +89,7 @@ def _spec():
     return [ShipSpec(
         name="nomoto1",
         description="first-order Nomoto ship, K and T from [ship.options] (default K=0.1 1/s, T=50 s)",
-        rhs=nomoto1_rhs, n_states=6, state_names=PLANAR_NAMES, state_units=PLANAR_UNITS,
+        rhs=nomoto1_rhs, n_states=N_PLANAR, state_names=PLANAR_NAMES, state_units=PLANAR_UNITS,
         pack=pack, b2_exact=b2_exact, dims=(0.8, d.L, d.L / 6.5),
         source="Nomoto (1957); van Amerongen (1982) Sec. 2.3.1",
         options_model=Nomoto1Options, nomoto_KT=nomoto_KT)]

@@ -81,19 +81,39 @@ from pydantic import Field, model_validator
 
 from steerlab.config_base import FrozenConfig
 from steerlab.environment.channels import W_RUDDER, W_YAW_RATE
+from steerlab.records import Field as RecordField
+from steerlab.records import Layout
 from steerlab.ships.kinematics import earth_velocity
+from steerlab.ships.state import IPSI, IR, IU, IV, ship_state
 
 DATA_DIR = Path(__file__).resolve().parent / "data"
 
-# packed ship parameters: [L, switch_time, set_0 (N_SET values), set_1 (N_SET values)]
-P_L, P_SWITCH, P_SET0 = 0, 1, 2
-S_T1, S_T2, S_K, S_A0, S_A1, S_A2, S_A3 = 0, 1, 2, 3, 4, 5, 6
-N_SET = 7
-N_PARAMS = P_SET0 + 2 * N_SET
+# packed ship parameters: [L, switch_time, set0 (N_SET values), set1 (N_SET values)]; the kernel
+# reads a set at offset o (P_SET0 or P_SET0 + N_SET) as p[o + S_K] etc.
+SET = Layout("loading", "S_", [
+    RecordField("T1", "T1", "-", "T1* (Table 1)"),
+    RecordField("T2", "T2", "-", "T2* (Table 1)"),
+    RecordField("K", "K", "-", "K* (Table 1)"),
+    RecordField("A0", "a0", "rad", "a0* of H_N, converted to radians (module docstring)"),
+    RecordField("A1", "a1", "-", "a1* of H_N"),
+    RecordField("A2", "a2", "1/rad", "a2* of H_N, converted to radians"),
+    RecordField("A3", "a3", "1/rad^2", "a3* of H_N, converted to radians"),
+], size_name="N_SET")
+SET.export(globals())            # S_T1 = 0, S_T2 = 1, S_K = 2, S_A0 = 3, ..., S_A3 = 6, N_SET = 7
+PARAMS = Layout("ship", "P_", [
+    RecordField("L", "L", "m", "ship length (U/L scaling of eq 1)", lo=0.0, lo_open=True),
+    RecordField("SWITCH", "switch_time", "s", "time the second set takes over (NO_SWITCH: never)", lo=0.0),
+]).then("set0", SET).then("set1", SET)
+PARAMS.export(globals())         # P_L = 0, P_SWITCH = 1, P_SET0_T1 = 2, ..., P_SET1_A3 = 15
+P_SET0 = PARAMS.index("set0.T1")
+N_PARAMS = PARAMS.size
 NO_SWITCH = 1e300
-STATE_NAMES = ("x_n", "y_e", "psi", "u", "v", "r", "rdot")
-STATE_UNITS = ("m", "m", "rad", "m/s", "m/s", "rad/s", "rad/s^2")
-I_RDOT = 6
+STATE = ship_state("ship state", "I_", [
+    RecordField("RDOT", "rdot", "rad/s^2", "yaw acceleration r'"),
+])
+STATE.export(globals())          # the planar IX..IR, I_RDOT = 6, N_STATES = 7
+STATE_NAMES = STATE.names
+STATE_UNITS = STATE.units
 
 
 class Loading(NamedTuple):
@@ -112,8 +132,8 @@ class Loading(NamedTuple):
     def packed(self) -> np.ndarray:
         """``[T1, T2, K, a0, a1, a2, a3]`` with ``H_N`` converted to radians (module docstring)."""
         d = 180.0 / math.pi
-        return np.array([self.T1, self.T2, self.K, self.a0 / d, self.a1, self.a2 * d,
-                         self.a3 * d * d], dtype=np.float64)
+        return SET.pack(T1=self.T1, T2=self.T2, K=self.K, a0=self.a0 / d, a1=self.a1, a2=self.a2 * d,
+                        a3=self.a3 * d * d)
 
     def nomoto(self, speed: float, L: float) -> tuple[float, float]:
         """Linearisation at r = 0 as a first-order Nomoto model ``(K [1/s], T [s])``:
@@ -151,17 +171,17 @@ def vl_drift_partials(p, o, mu, r):
 def van_leeuwen_rhs(t, x, delta, w, p, dx):
     """Derivatives of ``[x_n, y_e, psi, u, v, r, rdot]`` by eq (1) (module docstring)."""
     o = P_SET0 if t < p[P_SWITCH] else P_SET0 + N_SET
-    psi = x[2]
-    U = x[3]
-    r = x[5]
-    rd = x[6]
+    psi = x[IPSI]
+    U = x[IU]
+    r = x[IR]
+    rd = x[I_RDOT]
     mu = U / p[P_L]
     earth_velocity(psi, U, 0.0, w, dx)
-    dx[2] = r + w[W_YAW_RATE]
-    dx[3] = 0.0
-    dx[4] = 0.0
-    dx[5] = rd
-    dx[6] = vl_gain(p, o, mu) * (delta + w[W_RUDDER]) + vl_drift(p, o, mu, r, rd)
+    dx[IPSI] = r + w[W_YAW_RATE]
+    dx[IU] = 0.0
+    dx[IV] = 0.0
+    dx[IR] = rd
+    dx[I_RDOT] = vl_gain(p, o, mu) * (delta + w[W_RUDDER]) + vl_drift(p, o, mu, r, rd)
 
 
 class VanLeeuwenShip(NamedTuple):
@@ -223,7 +243,10 @@ def pack_ship(ship: VanLeeuwenShip, options) -> np.ndarray:
     first = ship.loading(options.loading)
     second = ship.loading(options.switch_to) if options.switch_to is not None else first
     t_sw = options.switch_time if options.switch_time is not None else NO_SWITCH
-    return np.concatenate(([ship.L, t_sw], first.packed(), second.packed()))
+    values = {"L": ship.L, "switch_time": t_sw}
+    for label, loading in (("set0", first), ("set1", second)):
+        values.update({f"{label}.{k}": v for k, v in SET.unpack(loading.packed()).items()})
+    return PARAMS.pack(values)
 
 
 def design_set(ship_name: str, loading: str) -> tuple[np.ndarray, float]:
@@ -250,11 +273,11 @@ def _spec_for(ship: VanLeeuwenShip):
 
     def equilibrium_rudder(speed, options=None):
         """``K delta0 = H_N(0) = a0`` (radian form): the rudder that cancels the asymmetry."""
-        T1, T2, K, a0 = ship.loading((options or default).loading).packed()[:4]
-        return a0 / K
+        s = ship.loading((options or default).loading).packed()
+        return s[S_A0] / s[S_K]
 
     return ShipSpec(
-        name=ship.name, description=ship.description, rhs=van_leeuwen_rhs, n_states=7,
+        name=ship.name, description=ship.description, rhs=van_leeuwen_rhs, n_states=N_STATES,
         state_names=STATE_NAMES, state_units=STATE_UNITS, pack=pack, b2_exact=b2_exact,
         dims=(ship.c_B, ship.L, ship.B), source=ship.source, options_model=Options,
         nomoto_KT=nomoto_KT, speed_range=(0.5, 15.0), equilibrium_rudder=equilibrium_rudder,
