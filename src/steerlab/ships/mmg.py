@@ -194,13 +194,17 @@ def load_mmg_data(text: str, name: str = "ship data") -> MMGShipData:
     return data
 
 
+def shipped_data_files(prefix: str) -> list:
+    """The ``ships/data/<prefix>*.toml`` files shipped with steerlab, sorted by file name."""
+    folder = resources.files("steerlab.ships") / "data"
+    return sorted((f for f in folder.iterdir() if f.name.startswith(prefix) and f.name.endswith(".toml")),
+                  key=lambda f: f.name)
+
+
 @lru_cache(maxsize=None)
 def mmg_ships() -> tuple[MMGShipData, ...]:
     """Every ``ships/data/mmg_*.toml`` shipped with steerlab, sorted by file name."""
-    folder = resources.files("steerlab.ships") / "data"
-    files = sorted((f for f in folder.iterdir() if f.name.startswith("mmg_") and f.name.endswith(".toml")),
-                   key=lambda f: f.name)
-    return tuple(load_mmg_data(f.read_text(encoding="utf-8"), f.name) for f in files)
+    return tuple(load_mmg_data(f.read_text(encoding="utf-8"), f.name) for f in shipped_data_files("mmg_"))
 
 
 # ---------------------------------------------------------------------------------------------

@@ -48,7 +48,6 @@ from __future__ import annotations
 import math
 import tomllib
 from functools import lru_cache
-from importlib import resources
 from typing import Literal
 
 import numba
@@ -164,10 +163,9 @@ def load_mmgstd_data(text: str, name: str = "ship data") -> MMGStdShipData:
 @lru_cache(maxsize=None)
 def mmgstd_ships() -> tuple[MMGStdShipData, ...]:
     """Every ``ships/data/mmgstd_*.toml`` shipped with steerlab, sorted by file name."""
-    folder = resources.files("steerlab.ships") / "data"
-    files = sorted((f for f in folder.iterdir() if f.name.startswith("mmgstd_") and f.name.endswith(".toml")),
-                   key=lambda f: f.name)
-    return tuple(load_mmgstd_data(f.read_text(encoding="utf-8"), f.name) for f in files)
+    from steerlab.ships.mmg import shipped_data_files
+
+    return tuple(load_mmgstd_data(f.read_text(encoding="utf-8"), f.name) for f in shipped_data_files("mmgstd_"))
 
 
 def get_mmgstd_data(name: str) -> MMGStdShipData:
