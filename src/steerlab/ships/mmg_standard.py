@@ -48,6 +48,7 @@ from __future__ import annotations
 import math
 import tomllib
 from functools import lru_cache
+from importlib import resources  # noqa: F401 (the data folder; tests read it through this module)
 from typing import Literal
 
 import numba
