@@ -34,6 +34,7 @@ DECLARED = {
     "steerlab.control.wave_filter": [("PARAMS", "WF_", "N_WF_PARAMS"), ("STATE", "F_", "N_WF")],
     "steerlab.control.wave_filtered": [("PARAMS", "P_", "OFF_P"), ("STATE", "Z_", "OFF_Z")],
     "steerlab.control.classic_autopilot": [("PARAMS", "C_", "N_PARAMS"), ("STATE", "Z_", "N_STATE")],
+    "steerlab.control.itae_pid": [("PARAMS", "I_", "N_PARAMS"), ("STATE", "Z_", "N_STATE")],
 }
 """module -> (layout attribute, constant prefix, length constant), or a list of them for a module
 with several layouts (the size name may be None where a record has a variable-length tail)."""
