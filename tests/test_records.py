@@ -35,6 +35,8 @@ DECLARED = {
     "steerlab.control.wave_filtered": [("PARAMS", "P_", "OFF_P"), ("STATE", "Z_", "OFF_Z")],
     "steerlab.control.classic_autopilot": [("PARAMS", "C_", "N_PARAMS"), ("STATE", "Z_", "N_STATE")],
     "steerlab.control.itae_pid": [("PARAMS", "I_", "N_PARAMS"), ("STATE", "Z_", "N_STATE")],
+    "steerlab.control.estimators": ("ESO", "E_", "N_ESO"),
+    "steerlab.control.adrc": [("PARAMS", "A_", "N_PARAMS"), ("STATE", "Z_", "N_STATE")],
 }
 """module -> (layout attribute, constant prefix, length constant), or a list of them for a module
 with several layouts (the size name may be None where a record has a variable-length tail)."""
