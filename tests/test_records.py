@@ -42,6 +42,7 @@ DECLARED = {
     "steerlab.control.nonlinear_adrc": [("PARAMS", "N_", "N_PARAMS"), ("STATE", "Z_", "N_STATE")],
     "steerlab.control.sliding_mode": [("PARAMS", "S_", "N_PARAMS"), ("STATE", "Z_", "N_STATE")],
     "steerlab.control.backstepping_a": [("PARAMS", "B_", "N_PARAMS"), ("STATE", "Z_", "N_STATE")],
+    "steerlab.control.asa_layout": [("PARAMS", "P_", "N_PARAMS"), ("STATE", "Z_", "N_STATE")],
 }
 """module -> (layout attribute, constant prefix, length constant), or a list of them for a module
 with several layouts (the size name may be None where a record has a variable-length tail)."""
