@@ -46,6 +46,7 @@ from steerlab.control.van_leeuwen_design import design_model, linear_design_matr
 from steerlab.errors import InputError
 from steerlab.records import Field as RecordField
 from steerlab.records import Layout
+from steerlab.ships import van_leeuwen as vl
 from steerlab.units import rad
 
 _PER_ERROR = ("rad/rad", "s", "s^2", "rad/rad")   # rad per unit of x~ = [psi error, r error, r', delta], eq (12)
@@ -164,7 +165,7 @@ def build(cfg: SlidingModeConfig, ctx):
     A, b = linear_design_matrices(s, mu, T_R)
     poles = cfg.poles
     if poles is None:
-        T2 = s[1] / mu   # dimensional second time constant [s]
+        T2 = s[vl.S_T2] / mu   # dimensional second time constant [s] (T2* of the set)
         poles = (-0.05, -1.0 / T2, -1.0 / T_R)
     k, h = sliding_surface_design(A, b, poles)
     hb = float(h @ b)
