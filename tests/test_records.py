@@ -241,6 +241,8 @@ def test_no_literal_state_index(module):
     src = inspect.getsource(importlib.import_module(module))
     hits = re.findall(r"\b(?:x|dx|x0|xs|xf)\[\s*-?[0-9]+\s*\]", src)
     assert hits in ([], ["x0[-1]"]), f"literal state indices: {hits}"   # x0[-1]: the rudder, last by definition
+
+
 CONTROLLER_MODULES = ("classic_autopilot", "itae_pid", "adrc", "estimators", "nonlinear_adrc", "nonlinear_eso",
                       "tracking_differentiator", "sliding_mode", "backstepping_a", "backstepping_b", "asa",
                       "asa_modes", "pid")

@@ -67,6 +67,7 @@ from steerlab.control.asa_mras import mras_gain_step, mras_identify_step
 from steerlab.control.asa_reference import lyapunov_p12_p22, reference_model_step
 from steerlab.control.asa_schedule import kd_damping, kd_lq, keeping_kp
 from steerlab.control.registry import ControllerSpec
+from steerlab.control.wave_filter import PARAMS as WF_PARAMS
 from steerlab.control.wave_filter import (F_DELTA, F_PSI, F_R, F_XI, WaveFilterConfig, WaveFilterParams,
                                           wave_filter_init, wave_filter_step)
 from steerlab.errors import InputError, require_finite_range
@@ -140,7 +141,7 @@ class ASA(NamedTuple):
                                              "kp_low", "zeta_keep", "alpha", "beta", "gamma", "alpha_id",
                                              "beta_id", "T_decay", "T_decay_id", "threshold", "n_hold", "n_ti",
                                              "rho_acc", "f_delta", "sigma2", "T_pow_id")}
-        return PARAMS.pack({**{f"wave_filter{i}": v for i, v in enumerate(wf)}, **own, "U_freeze": uf,
+        return PARAMS.pack({**{f"wave_filter.{n}": v for n, v in zip(WF_PARAMS.names, wf)}, **own, "U_freeze": uf,
                             "kd_rule": 0.0 if self.kd_rule == "lq" else 1.0, "K_star_min": ks_lo,
                             "K_star_max": ks_hi, "tau_star_min": ts_lo, "tau_star_max": ts_hi,
                             "use_estimator": 1.0 if self.use_estimator else 0.0})

@@ -8,19 +8,20 @@ quantities (time unit L/U).
 
 import math
 
-from steerlab.control.wave_filter import N_WF, N_WF_PARAMS
+from steerlab.control.wave_filter import PARAMS as WF_PARAMS
+from steerlab.control.wave_filter import STATE as WF_STATE
 from steerlab.records import Field, Layout
 
 
-def _wave_filter_block(n: int, what: str) -> list:
-    """The wave filter's ``n`` floats at the front (their meaning: :mod:`steerlab.control.wave_filter`)."""
-    return [Field(f"WF{i}", f"wave_filter{i}", "-", f"wave-filter {what}, slot {i} (steerlab.control.wave_filter)")
-            for i in range(n)]
+def _wave_filter_block(layout: Layout) -> list:
+    """The wave filter's fields at the front, named ``wave_filter.<name>`` (as in ``wave_filtered``)."""
+    return [Field("WF_" + f.const, "wave_filter." + f.name, f.unit, f.doc, f.lo, f.hi, f.lo_open, f.hi_open,
+                  f.default) for f in layout.fields]
 
 
 # ---- state z -------------------------------------------------------------------------
 STATE = Layout("controller state", "Z_", [
-    *_wave_filter_block(N_WF, "state"),
+    *_wave_filter_block(WF_STATE),
     Field("MODE", "mode", "-", "0 = course keeping, 1 = course changing (Sec. 4.6)"),
     Field("PSI_SET", "psi_set", "rad", "set heading in use"),
     Field("PSI_M", "psi_m", "rad", "series reference model heading (4.43)"),
@@ -40,11 +41,11 @@ STATE = Layout("controller state", "Z_", [
     Field("SAT", "saturated", "-", "1 if the last order was limited"),
     Field("DELTA_LIM", "delta_lim", "rad", "rudder limit in use"),
 ], size_name="N_STATE")
-STATE.export(globals())    # Z_WF0..Z_WF6 = 0..6, Z_MODE = N_WF, ..., Z_DELTA_LIM = N_WF + 17, N_STATE
+STATE.export(globals())    # Z_WF_PSI = 0, ..., Z_WF_XI = 6, Z_MODE = N_WF = 7, ..., Z_DELTA_LIM = N_WF + 17, N_STATE
 
 # ---- params p (the first N_WF_PARAMS are the wave filter's) ---------------------------
 PARAMS = Layout("controller", "P_", [
-    *_wave_filter_block(N_WF_PARAMS, "parameter"),
+    *_wave_filter_block(WF_PARAMS),
     Field("L", "L", "m", "ship length", lo=0.0, hi=2000.0, lo_open=True),
     Field("U0", "U0", "m/s", "cruising speed (scenario: cruise_speed_kn)"),
     Field("U_FREEZE", "U_freeze", "m/s", "adaptation frozen below this speed (scenario: freeze_speed_kn)"),
@@ -80,4 +81,4 @@ PARAMS = Layout("controller", "P_", [
     Field("T_POW_ID", "T_pow_id", "s", "averaging time of the identification's power estimates", lo=0.0,
           hi=1e7, lo_open=True),
 ], size_name="N_PARAMS")
-PARAMS.export(globals())   # P_WF0..P_WF3 = 0..3, P_L = N_WF_PARAMS, ..., P_T_POW_ID, N_PARAMS
+PARAMS.export(globals())   # P_WF_TLF = 0, ..., P_WF_XIMIN = 3, P_L = N_WF_PARAMS = 4, ..., P_T_POW_ID, N_PARAMS

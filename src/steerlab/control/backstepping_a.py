@@ -53,7 +53,7 @@ from steerlab.control.van_leeuwen_design import design_model, yaw_accel
 from steerlab.errors import InputError
 from steerlab.records import Field as RecordField
 from steerlab.records import Layout
-from steerlab.ships.van_leeuwen import N_SET, vl_drift, vl_gain
+from steerlab.ships.van_leeuwen import N_SET, SET, vl_drift, vl_gain
 
 
 def _gain(i: int, doc: str, default: float) -> RecordField:
@@ -62,7 +62,7 @@ def _gain(i: int, doc: str, default: float) -> RecordField:
 
 
 # packed parameters (shared with version B): the gains and design data, then the design model's
-# Van Leeuwen set (N_SET floats in the order of ships.van_leeuwen S_*, radian form) at B_SET
+# Van Leeuwen set (ships.van_leeuwen.SET, radian form) at B_SET
 PARAMS = Layout("controller", "B_", [
     _gain(1, "eqs (18), (27) (Table 3, ballast, A: 0.020568)", 0.020568),
     _gain(2, "eq (28) (Table 3, ballast, A: 176.3781)", 176.3781),
@@ -75,12 +75,10 @@ PARAMS = Layout("controller", "B_", [
     RecordField("UMAX", "u_max", "rad", "output limit (scenario default: the gear's limit)", lo=0.0, lo_open=True),
     RecordField("TU", "time_unit", "s", "unit of time of the gains: 1 s, or L/U (gain_time = 'ship')",
                 lo=0.0, lo_open=True),
-    *(RecordField(f"SET{i}", f"design{i}", "-", f"design model: slot {i} of the Van Leeuwen set "
-                  "(ships.van_leeuwen S_*: T1*, T2*, K*, a0*, a1*, a2*, a3*; radian form)")
-      for i in range(N_SET)),
-], size_name="N_PARAMS")
-PARAMS.export(globals())   # B_K1 = 0, ..., B_TU = 8, B_SET0 = 9, ..., B_SET6 = 15, N_PARAMS = 16
-B_SET = PARAMS.index("design0")   # offset of the design set, read by vl_drift/vl_gain as p[B_SET + S_*]
+]).then("design", SET)
+PARAMS.export(globals())   # B_K1 = 0, ..., B_TU = 8, B_DESIGN_T1 = 9, ..., B_DESIGN_A3 = 15
+B_SET = PARAMS.index("design.T1")   # offset of the design set, read by vl_drift/vl_gain as p[B_SET + S_*]
+N_PARAMS = PARAMS.size
 STATE = Layout("controller state", "Z_", [
     RecordField("R_PREV", "r_prev", "rad/s", "previous yaw rate, for the r' estimate on ships without an rdot "
                 "state (van_leeuwen_design.yaw_accel)"),
@@ -107,7 +105,7 @@ class Backstepping(NamedTuple):
         design = rec.pop("design")
         if len(design) != N_SET:
             raise InputError("controller.design", f"needs the {N_SET} values of a Van Leeuwen set, got {len(design)}")
-        rec.update((f"design{i}", v) for i, v in enumerate(design))
+        rec.update(("design." + n, v) for n, v in zip(SET.names, design))
         return PARAMS.pack(rec)
 
     def init_state(self, x0, ref0) -> np.ndarray:
