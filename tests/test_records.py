@@ -258,7 +258,8 @@ def test_controller_layouts_keep_the_kernels_slots():
     assert (c.C_KP, c.C_KI, c.C_KD, c.C_UMAX, c.C_WEATHER, c.C_ON_ORDER, c.C_TF, c.C_ECC, c.N_PARAMS) == tuple(range(9))
     assert (c.Z_INT, c.Z_LP, c.N_STATE) == (0, 1, 2)
     i = itae_pid
-    assert (i.I_WN, i.I_KM, i.I_TM, i.I_VM, i.I_SCHED, i.I_VMIN, i.I_C2, i.I_UMAX, i.I_AW, i.N_PARAMS) == tuple(range(10))
+    assert (i.I_WN, i.I_KM, i.I_TM, i.I_VM, i.I_SCHED, i.I_VMIN, i.I_C2, i.I_UMAX, i.I_AW,
+            i.N_PARAMS) == tuple(range(10))
     assert (i.Z_PSI_P, i.Z_R_P, i.Z_INT, i.N_STATE) == (0, 1, 2, 3)
     a = adrc
     assert (a.A_C0, a.A_KP, a.A_KD, a.A_KDSIGN, a.A_L1, a.A_L2, a.A_L3, a.A_UMAX, a.N_PARAMS) == tuple(range(9))

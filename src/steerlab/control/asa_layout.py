@@ -77,7 +77,8 @@ PARAMS = Layout("controller", "P_", [
     Field("RHO_ACC", "rho_acc", "-", "rho of the model's rudder limiter (scenario: accel_margin)"),
     Field("F_DELTA", "f_delta", "-", "f_delta of (4.85) (scenario: rudder_limit_factor)"),
     Field("USE_EST", "use_estimator", "-", "1: the controller acts on the filtered psi^, r^", lo=0.0, hi=1.0),
-    Field("SIGMA2", "sigma2", "rad^2", "floor of the identification's normalisation m^2 = sigma2 + P_delta + P_r", lo=0.0, hi=1.0, lo_open=True),
+    Field("SIGMA2", "sigma2", "rad^2", "floor of the identification's normalisation m^2 = sigma2 + P_delta + P_r",
+          lo=0.0, hi=1.0, lo_open=True),
     Field("T_POW_ID", "T_pow_id", "s", "averaging time of the identification's power estimates", lo=0.0,
           hi=1e7, lo_open=True),
 ], size_name="N_PARAMS")

@@ -34,8 +34,6 @@ limited to ``u_max``. Gains [1/s], Table 3 (GA-tuned): ballast ``k1..k4 = 5.93, 
 
 from __future__ import annotations
 
-from typing import Literal, Optional
-
 import numba
 from pydantic import create_model
 
