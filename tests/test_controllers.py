@@ -125,7 +125,7 @@ def test_adrc_pack_and_law_sign():
 @pytest.mark.parametrize("kw, field", [
     (dict(c0=0.0), "controller.c0"), (dict(c0=math.nan), "controller.c0"),
     (dict(law="weird"), "controller.law"), (dict(L=(1.0, 1.0)), "controller.L"),
-    (dict(L=(1.0, -1.0, 1.0)), "controller.L[1]"), (dict(u_max=-0.1), "controller.u_max"),
+    (dict(L=(1.0, -1.0, 1.0)), "controller.L2"), (dict(u_max=-0.1), "controller.u_max"),
 ])
 def test_adrc_pack_validation(kw, field):
     args = dict(c0=1e-3, Kp=1e-3, Kd=0.1)

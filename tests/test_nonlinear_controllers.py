@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq
 
-from steerlab.control.backstepping_a import B_MU, B_SET, backstepping_errors
+from steerlab.control.backstepping_a import B_K3, B_MU, B_SET, backstepping_errors
 from steerlab.control.estimators import eso_step
 from steerlab.control.nonlinear_adrc import time_scale_factor, time_scale_retune
 from steerlab.control.nonlinear_eso import fal, nleso_step
@@ -146,7 +146,7 @@ def test_backstepping_lyapunov_function_decreases(typ):
         v = z1 * z1 + z2 * z2 + z3 * z3
         if typ == "backstepping_b":
             mu = p[B_MU]
-            alpha3 = (-p[2] * z3 - z2 - vl_drift(p, B_SET, mu, x[5], x[6]) + a2d) / vl_gain(p, B_SET, mu)
+            alpha3 = (-p[B_K3] * z3 - z2 - vl_drift(p, B_SET, mu, x[5], x[6]) + a2d) / vl_gain(p, B_SET, mu)
             v += (x[-1] - alpha3) ** 2
         V.append(v)
     V = np.array(V)

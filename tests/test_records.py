@@ -33,6 +33,16 @@ DECLARED = {
     "steerlab.sensors.wrapper": [("PARAMS", "P_", "OFF_P"), ("STATE", "Z_", "OFF_X")],
     "steerlab.control.wave_filter": [("PARAMS", "WF_", "N_WF_PARAMS"), ("STATE", "F_", "N_WF")],
     "steerlab.control.wave_filtered": [("PARAMS", "P_", "OFF_P"), ("STATE", "Z_", "OFF_Z")],
+    "steerlab.control.classic_autopilot": [("PARAMS", "C_", "N_PARAMS"), ("STATE", "Z_", "N_STATE")],
+    "steerlab.control.itae_pid": [("PARAMS", "I_", "N_PARAMS"), ("STATE", "Z_", "N_STATE")],
+    "steerlab.control.estimators": ("ESO", "E_", "N_ESO"),
+    "steerlab.control.adrc": [("PARAMS", "A_", "N_PARAMS"), ("STATE", "Z_", "N_STATE")],
+    "steerlab.control.tracking_differentiator": ("TD", "TD_", "N_TD"),
+    "steerlab.control.nonlinear_eso": ("NLESO", "E_", "N_NLESO"),
+    "steerlab.control.nonlinear_adrc": [("PARAMS", "N_", "N_PARAMS"), ("STATE", "Z_", "N_STATE")],
+    "steerlab.control.sliding_mode": [("PARAMS", "S_", "N_PARAMS"), ("STATE", "Z_", "N_STATE")],
+    "steerlab.control.backstepping_a": [("PARAMS", "B_", "N_PARAMS"), ("STATE", "Z_", "N_STATE")],
+    "steerlab.control.asa_layout": [("PARAMS", "P_", "N_PARAMS"), ("STATE", "Z_", "N_STATE")],
 }
 """module -> (layout attribute, constant prefix, length constant), or a list of them for a module
 with several layouts (the size name may be None where a record has a variable-length tail)."""
@@ -231,3 +241,76 @@ def test_no_literal_state_index(module):
     src = inspect.getsource(importlib.import_module(module))
     hits = re.findall(r"\b(?:x|dx|x0|xs|xf)\[\s*-?[0-9]+\s*\]", src)
     assert hits in ([], ["x0[-1]"]), f"literal state indices: {hits}"   # x0[-1]: the rudder, last by definition
+
+
+CONTROLLER_MODULES = ("classic_autopilot", "itae_pid", "adrc", "estimators", "nonlinear_adrc", "nonlinear_eso",
+                      "tracking_differentiator", "sliding_mode", "backstepping_a", "backstepping_b", "asa",
+                      "asa_modes", "pid")
+
+
+def test_controller_layouts_keep_the_kernels_slots():
+    """The controllers' generated slots are the ones their kernels were written with (no number moved)."""
+    from steerlab.control import (adrc, asa_layout, backstepping_a, classic_autopilot, estimators, itae_pid,
+                                  nonlinear_adrc, sliding_mode)
+    from steerlab.control.wave_filter import N_WF, N_WF_PARAMS
+
+    c = classic_autopilot
+    assert (c.C_KP, c.C_KI, c.C_KD, c.C_UMAX, c.C_WEATHER, c.C_ON_ORDER, c.C_TF, c.C_ECC, c.N_PARAMS) == tuple(range(9))
+    assert (c.Z_INT, c.Z_LP, c.N_STATE) == (0, 1, 2)
+    i = itae_pid
+    assert (i.I_WN, i.I_KM, i.I_TM, i.I_VM, i.I_SCHED, i.I_VMIN, i.I_C2, i.I_UMAX, i.I_AW,
+            i.N_PARAMS) == tuple(range(10))
+    assert (i.Z_PSI_P, i.Z_R_P, i.Z_INT, i.N_STATE) == (0, 1, 2, 3)
+    a = adrc
+    assert (a.A_C0, a.A_KP, a.A_KD, a.A_KDSIGN, a.A_L1, a.A_L2, a.A_L3, a.A_UMAX, a.N_PARAMS) == tuple(range(9))
+    assert (a.Z_PSI, a.Z_R, a.Z_F, a.N_STATE) == (estimators.E_PSI, estimators.E_R, estimators.E_F, 3) == (0, 1, 2, 3)
+    n = nonlinear_adrc
+    assert (n.N_B, n.N_BETA1, n.N_A01, n.N_D02, n.N_K1, n.N_A1, n.N_D2, n.N_R, n.N_H0, n.N_UMAX, n.N_PARAMS) == (
+        0, 1, 4, 7, 8, 10, 13, 14, 15, 16, 17)
+    assert (n.Z_V1, n.Z_V2, n.Z_Z1, n.Z_Z2, n.Z_Z3, n.N_STATE) == tuple(range(6))
+    s = sliding_mode
+    assert (s.S_K1, s.S_K4, s.S_H1, s.S_H4, s.S_ETA, s.S_PHI, s.S_HB, s.S_IRDOT, s.S_UMAX, s.N_PARAMS) == (
+        0, 3, 4, 7, 8, 9, 10, 11, 12, 13)
+    b = backstepping_a
+    assert (b.B_K1, b.B_K4, b.B_TR, b.B_MU, b.B_IRDOT, b.B_UMAX, b.B_TU, b.B_SET, b.N_PARAMS, b.N_STATE) == (
+        0, 3, 4, 5, 6, 7, 8, 9, 16, 1)
+    z = asa_layout
+    assert (z.Z_MODE, z.Z_KP, z.Z_DELTA_LIM, z.N_STATE) == (N_WF, N_WF + 7, N_WF + 17, N_WF + 18)
+    assert (z.P_L, z.P_KD_RULE, z.P_T_POW_ID, z.N_PARAMS) == (N_WF_PARAMS, N_WF_PARAMS + 9, N_WF_PARAMS + 29,
+                                                              N_WF_PARAMS + 30)
+
+
+@pytest.mark.parametrize("module", CONTROLLER_MODULES)
+def test_controller_kernels_read_their_state_and_record_by_name(module):
+    """No literal slot of the controller's own state or record (``z[1]``, ``p[3]``, ``xh[i + 2]``)."""
+    src = inspect.getsource(importlib.import_module(f"steerlab.control.{module}"))
+    code = "\n".join(line.split("#")[0] for line in src.splitlines())
+    hits = re.findall(r"\b(?:z|zh|xh|v|p|pc)\[(?:\w+ \+ )?\d+\]", code)
+    assert not hits, f"literal slots: {hits}"
+
+
+def test_controller_records_pack_by_name_and_check_the_declared_bounds():
+    from steerlab.control import adrc, backstepping_a, backstepping_b, classic_autopilot, sliding_mode
+
+    rec = classic_autopilot.ClassicAutopilot(Kp=2.0, weather_on="order", lowpass_T=5.0).pack()
+    vals = classic_autopilot.PARAMS.unpack(rec)
+    assert vals["Kp"] == 2.0 and vals["on_order"] == 1.0 and vals["lowpass_T"] == 5.0
+    assert rec[classic_autopilot.C_ON_ORDER] == 1.0 and rec[classic_autopilot.C_TF] == 5.0
+    with pytest.raises(InputError, match=r"controller\.course_change: .*allowed range \(0\.0, 3\.14"):
+        classic_autopilot.ClassicAutopilot(course_change=0.0).pack()
+    with pytest.raises(InputError, match=r"controller\.L2: -1\.0 is out of range"):
+        adrc.ADRC(c0=1e-3, Kp=1e-3, Kd=0.1, L=(1.0, -1.0, 1.0)).pack()
+    with pytest.raises(InputError, match=r"controller\.k2: must be finite"):
+        sliding_mode.SlidingMode((0.0, math.nan, 1.0, 1.0), (1.0, 1.0, 1.0, 1.0), 0.1, 0.1, 1.0, -1.0, 0.5).pack()
+    # one declaration, two controllers: version B's published gains replace the defaults only
+    a = backstepping_a.BacksteppingAConfig.model_json_schema()["properties"]
+    b = backstepping_b.BacksteppingBConfig.model_json_schema()["properties"]
+    assert a["k1"]["default"] == backstepping_a.PARAMS.fields[backstepping_a.B_K1].default == 0.020568
+    assert b["k1"]["default"] == 5.93 and b["k4"]["default"] == 0.001
+    assert a["k2"]["exclusiveMinimum"] == b["k2"]["exclusiveMinimum"] == 0.0 and b["k2"]["maximum"] == 1e6
+
+
+def test_config_fields_defaults_replace_the_declared_default_only():
+    fields = LAYOUT.config_fields(("Kp", "T"), defaults={"T": 30.0})
+    assert fields["T"][1].default == 30.0 and fields["Kp"][1].default is None
+    assert [m.gt for m in fields["T"][1].metadata if hasattr(m, "gt")] == [0.0]

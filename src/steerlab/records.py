@@ -189,10 +189,13 @@ class Layout:
         cls.__required__ = tuple(missing)
         return cls
 
-    def config_fields(self, names: Iterable[str], upper: Optional[Mapping[str, float]] = None) -> dict:
+    def config_fields(self, names: Iterable[str], upper: Optional[Mapping[str, float]] = None,
+                      defaults: Optional[Mapping[str, float]] = None) -> dict:
         """pydantic field definitions ``{name: (float, Field(...))}`` for the scenario schema:
         default, bounds and ``[unit] doc`` from the layout; ``upper`` adds input-edge upper
-        bounds (sanity limits of a TOML value that the record itself does not need)."""
+        bounds (sanity limits of a TOML value that the record itself does not need);
+        ``defaults`` replaces the layout's defaults (a record shared by two controllers whose
+        published settings differ)."""
         from pydantic import Field as PField
 
         out = {}
@@ -204,7 +207,7 @@ class Layout:
             hi = (upper or {}).get(n, f.hi)
             if hi is not None:
                 kw["lt" if f.hi_open and n not in (upper or {}) else "le"] = hi
-            out[n] = (float, PField(f.default, **kw))
+            out[n] = (float, PField((defaults or {}).get(n, f.default), **kw))
         return out
 
     def __repr__(self) -> str:

@@ -37,15 +37,29 @@ from pydantic import Field, field_validator
 
 from steerlab.angles import wrap_to_pi
 from steerlab.config_base import FrozenConfig
-from steerlab.control.estimators import (PAPER_L, check_discrete_eso, eso_gains_bandwidth, eso_gains_lqr,
-                                         eso_step)
+from steerlab.control.estimators import (ESO, PAPER_L, check_discrete_eso, eso_gains_bandwidth,
+                                         eso_gains_lqr, eso_step)
 from steerlab.control.registry import ControllerSpec
 from steerlab.errors import InputError, require_finite_range
+from steerlab.records import Field as RecordField
+from steerlab.records import Layout
 from steerlab.units import rad
 
-A_C0, A_KP, A_KD, A_KDSIGN, A_L1, A_L2, A_L3, A_UMAX = 0, 1, 2, 3, 4, 5, 6, 7
-N_PARAMS = 8
-N_STATE = 3  # ESO estimate [psi_hat (rad), r_hat (rad/s), total disturbance (rad/s^2)]
+PARAMS = Layout("controller", "A_", [
+    RecordField("C0", "c0", "1/s^2", "rudder efficiency b2 of (37), steerlab's sign (non-zero)"),
+    RecordField("KP", "Kp", "1/s^2", "PD gain of (7d); by (38): 36 / T_settle^2", lo=0.0),
+    RecordField("KD", "Kd", "1/s", "PD gain of (7d); by (38): 12 / T_settle (Herbst) or 2 / T_settle (printed)",
+                lo=0.0),
+    RecordField("KDSIGN", "kd_sign", "-", "sign of the Kd term of (7d): -1 stable, +1 as printed (diverges)",
+                lo=-1.0, hi=1.0),
+    RecordField("L1", "L1", "1/s", "ESO gain l1 of (7a) (paper, Sec. 5: 1.0484)", lo=0.0, lo_open=True),
+    RecordField("L2", "L2", "1/s^2", "ESO gain l2 of (7a) (Sec. 5: 0.44955)", lo=0.0, lo_open=True),
+    RecordField("L3", "L3", "1/s^3", "ESO gain l3 of (7a) (Sec. 5: 0.001)", lo=0.0, lo_open=True),
+    RecordField("UMAX", "u_max", "rad", "output limit (scenario default: the gear's limit)", lo=0.0, lo_open=True),
+], size_name="N_PARAMS")
+PARAMS.export(globals())   # A_C0 = 0, A_KP, A_KD, A_KDSIGN, A_L1, A_L2, A_L3, A_UMAX = 7, N_PARAMS = 8
+STATE = Layout("controller state", "Z_", ESO.fields, size_name="N_STATE")
+STATE.export(globals())    # the ESO estimate (estimators.ESO): Z_PSI = 0, Z_R = 1, Z_F = 2, N_STATE = 3
 
 LAWS = ("stable", "printed")
 KD_RULES = ("herbst", "printed")
@@ -86,21 +100,17 @@ class ADRC(NamedTuple):
         require_finite_range("controller.c0", self.c0)
         if self.c0 == 0.0:
             raise InputError("controller.c0", "must be non-zero (rudder efficiency b2 [1/s^2])")
-        require_finite_range("controller.Kp", self.Kp, 0.0)
-        require_finite_range("controller.Kd", self.Kd, 0.0)
         if len(self.L) != 3:
             raise InputError("controller.L", f"needs 3 observer gains, got {len(self.L)}")
-        for i, li in enumerate(self.L):
-            require_finite_range(f"controller.L[{i}]", li, 0.0, lo_open=True)
-        require_finite_range("controller.u_max", self.u_max, 0.0, lo_open=True)
         if self.law not in LAWS:
             raise InputError("controller.law", f"must be one of {LAWS}, got {self.law!r}")
-        sign = -1.0 if self.law == "stable" else 1.0
-        return np.array([self.c0, self.Kp, self.Kd, sign, *self.L, self.u_max], dtype=np.float64)
+        l1, l2, l3 = self.L
+        return PARAMS.pack(c0=self.c0, Kp=self.Kp, Kd=self.Kd, kd_sign=-1.0 if self.law == "stable" else 1.0,
+                           L1=l1, L2=l2, L3=l3, u_max=self.u_max)
 
     def init_state(self, x0, ref0) -> np.ndarray:
         """ESO starts at the measured heading and yaw rate with no disturbance estimate."""
-        return np.array([x0[2], x0[5], 0.0])
+        return STATE.pack(psi_hat=x0[2], r_hat=x0[5], f_hat=0.0)
 
 
 @numba.njit(cache=True)
@@ -109,8 +119,8 @@ def adrc_update(z, p, t, x, ref, h):
     y = x[2]
     c0 = p[A_C0]
     e = wrap_to_pi(ref[0] - y)
-    u0 = p[A_KP] * e + p[A_KDSIGN] * p[A_KD] * (z[1] - ref[1])
-    u = (u0 - z[2]) / c0
+    u0 = p[A_KP] * e + p[A_KDSIGN] * p[A_KD] * (z[Z_R] - ref[1])
+    u = (u0 - z[Z_F]) / c0
     umax = p[A_UMAX]
     u = min(max(u, -umax), umax)
     eso_step(z, c0, p[A_L1], p[A_L2], p[A_L3], y, u, h)

@@ -54,7 +54,7 @@ from pydantic import Field
 
 from steerlab.angles import wrap_to_pi
 from steerlab.config_base import FrozenConfig
-from steerlab.control.asa_layout import (N_PARAMS, N_STATE, P_ALPHA, P_ALPHA_ID, P_BETA, P_BETA_ID,
+from steerlab.control.asa_layout import (N_STATE, PARAMS, P_ALPHA, P_ALPHA_ID, P_BETA, P_BETA_ID,
                                          P_F_DELTA, P_GAMMA, P_KD_RULE, P_KP_LOW, P_KS_MAX, P_KS_MIN,
                                          P_L, P_MU, P_N_TI, P_R_MAX, P_RHO_ACC, P_SIGMA2, P_T_DECAY,
                                          P_T_DECAY_ID, P_T_POW_ID, P_TS_MAX, P_TS_MIN, P_U0, P_U_FREEZE,
@@ -67,6 +67,7 @@ from steerlab.control.asa_mras import mras_gain_step, mras_identify_step
 from steerlab.control.asa_reference import lyapunov_p12_p22, reference_model_step
 from steerlab.control.asa_schedule import kd_damping, kd_lq, keeping_kp
 from steerlab.control.registry import ControllerSpec
+from steerlab.control.wave_filter import PARAMS as WF_PARAMS
 from steerlab.control.wave_filter import (F_DELTA, F_PSI, F_R, F_XI, WaveFilterConfig, WaveFilterParams,
                                           wave_filter_init, wave_filter_step)
 from steerlab.errors import InputError, require_finite_range
@@ -110,11 +111,10 @@ class ASA(NamedTuple):
 
     def pack(self) -> np.ndarray:
         f = "controller"
-        require_finite_range(f"{f}.L", self.L, 0.0, 2000.0, lo_open=True)
+        # checks named by the scenario's field (knots, degrees, bounds that depend on other
+        # fields); the rest are the bounds declared in asa_layout.PARAMS, checked by its pack()
         require_finite_range(f"{f}.cruise_speed", self.U0, 0.0, 50.0, lo_open=True)
         require_finite_range(f"{f}.rate_of_turn", self.r_max, 0.0, rad(10.0), lo_open=True)
-        require_finite_range(f"{f}.mu", self.mu, 1.0, 5.0)
-        require_finite_range(f"{f}.u_max", self.u_max, 0.0, math.pi / 2, lo_open=True)
         uf = self.U_freeze if self.U_freeze > 0.0 else 0.2 * self.U0
         require_finite_range(f"{f}.freeze_speed", uf, 0.0, self.U0, lo_open=True)
         ks_lo, ks_hi = self.K_star_bounds
@@ -129,29 +129,22 @@ class ASA(NamedTuple):
                              f"must be > 0 (got {self.tau_star0!r}): ASA's MRAS identification needs a "
                              "course-stable ship (thesis 4.3.2); give tau_star0 explicitly for this ship")
         require_finite_range(f"{f}.tau_star0", self.tau_star0, ts_lo, ts_hi)
-        for name in ("kp_change", "kp_low", "alpha", "beta", "gamma", "alpha_id", "beta_id"):
-            require_finite_range(f"{f}.{name}", getattr(self, name), 0.0, 1e3)
-        require_finite_range(f"{f}.zeta_change", self.zeta_change, 0.0, 10.0, lo_open=True)
-        require_finite_range(f"{f}.zeta_keep", self.zeta_keep, 0.0, 10.0, lo_open=True)
         if self.kd_rule not in ("lq", "damping"):
             raise InputError(f"{f}.kd_rule", f"must be 'lq' or 'damping', got {self.kd_rule!r}")
-        for name in ("T_decay", "T_decay_id", "T_pow_id"):
-            require_finite_range(f"{f}.{name}", getattr(self, name), 0.0, 1e7, lo_open=True)
         require_finite_range(f"{f}.change_threshold", self.threshold, 0.0, math.pi, lo_open=True)
         require_finite_range(f"{f}.hold_time_constants", self.n_hold, 0.0, 1e3)
         require_finite_range(f"{f}.integral_time_constants", self.n_ti, 0.0, 1e4, lo_open=True)
         require_finite_range(f"{f}.accel_margin", self.rho_acc, 0.0, 1.0, lo_open=True)
         require_finite_range(f"{f}.rudder_limit_factor", self.f_delta, 0.0, 100.0, lo_open=True)
-        require_finite_range(f"{f}.sigma2", self.sigma2, 0.0, 1.0, lo_open=True)
         wf = self.wave_filter.pack(f"{f}.wave_filter")
-        rest = [self.L, self.U0, uf, self.mu, self.r_max, self.u_max, self.zeta_change, self.kp_change,
-                self.kp_low, 0.0 if self.kd_rule == "lq" else 1.0, self.zeta_keep, self.alpha, self.beta,
-                self.gamma, self.alpha_id, self.beta_id, self.T_decay, self.T_decay_id, self.threshold,
-                self.n_hold, ks_lo, ks_hi, ts_lo, ts_hi, self.n_ti, self.rho_acc, self.f_delta,
-                1.0 if self.use_estimator else 0.0, self.sigma2, self.T_pow_id]
-        p = np.concatenate([wf, np.array(rest, dtype=np.float64)])
-        assert p.shape[0] == N_PARAMS
-        return p
+        own = {n: getattr(self, n) for n in ("L", "U0", "mu", "r_max", "u_max", "zeta_change", "kp_change",
+                                             "kp_low", "zeta_keep", "alpha", "beta", "gamma", "alpha_id",
+                                             "beta_id", "T_decay", "T_decay_id", "threshold", "n_hold", "n_ti",
+                                             "rho_acc", "f_delta", "sigma2", "T_pow_id")}
+        return PARAMS.pack({**{f"wave_filter.{n}": v for n, v in zip(WF_PARAMS.names, wf)}, **own, "U_freeze": uf,
+                            "kd_rule": 0.0 if self.kd_rule == "lq" else 1.0, "K_star_min": ks_lo,
+                            "K_star_max": ks_hi, "tau_star_min": ts_lo, "tau_star_max": ts_hi,
+                            "use_estimator": 1.0 if self.use_estimator else 0.0})
 
     def init_state(self, x0, ref0) -> np.ndarray:
         """Course keeping at the initial order; filter at the measured state; K*, tau* initial."""

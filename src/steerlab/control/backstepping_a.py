@@ -44,20 +44,46 @@ from typing import Literal, NamedTuple, Optional
 
 import numba
 import numpy as np
-from pydantic import Field
+from pydantic import Field, create_model
 
 from steerlab.angles import wrap_to_pi
 from steerlab.config_base import FrozenConfig
 from steerlab.control.registry import ControllerSpec
 from steerlab.control.van_leeuwen_design import design_model, yaw_accel
-from steerlab.errors import require_finite_range
-from steerlab.ships.van_leeuwen import N_SET, vl_drift, vl_gain
+from steerlab.errors import InputError
+from steerlab.records import Field as RecordField
+from steerlab.records import Layout
+from steerlab.ships.van_leeuwen import N_SET, SET, vl_drift, vl_gain
 
-# packed parameters (shared with version B)
-B_K1, B_K2, B_K3, B_K4, B_TR, B_MU, B_IRDOT, B_UMAX, B_TU = 0, 1, 2, 3, 4, 5, 6, 7, 8
-B_SET = 9
-N_PARAMS = B_SET + N_SET
-N_STATE = 1   # previous yaw rate, for the r' estimate on ships without an rdot state [rad/s]
+
+def _gain(i: int, doc: str, default: float) -> RecordField:
+    return RecordField(f"K{i}", f"k{i}", "1/s", f"backstepping gain k{i} > 0 [per time unit of the gains], {doc}",
+                       lo=0.0, hi=1e6, lo_open=True, default=default)
+
+
+# packed parameters (shared with version B): the gains and design data, then the design model's
+# Van Leeuwen set (ships.van_leeuwen.SET, radian form) at B_SET
+PARAMS = Layout("controller", "B_", [
+    _gain(1, "eqs (18), (27) (Table 3, ballast, A: 0.020568)", 0.020568),
+    _gain(2, "eq (28) (Table 3, ballast, A: 176.3781)", 176.3781),
+    _gain(3, "eq (25) (Table 3, ballast, A: 2.545)", 2.545),
+    _gain(4, "eq (26), version B only (ignored by A)", 1.0),
+    RecordField("TR", "T_R", "s", "steering-gear time constant T_R of (7) (version B; the gear's T_sg)",
+                lo=0.0, lo_open=True),
+    RecordField("MU", "mu", "1/s", "mu = U / L of the design (ship speed over length)", lo=0.0, lo_open=True),
+    RecordField("IRDOT", "i_rdot", "-", "index of rdot in the plant state; -1: estimate r' from the yaw rate"),
+    RecordField("UMAX", "u_max", "rad", "output limit (scenario default: the gear's limit)", lo=0.0, lo_open=True),
+    RecordField("TU", "time_unit", "s", "unit of time of the gains: 1 s, or L/U (gain_time = 'ship')",
+                lo=0.0, lo_open=True),
+]).then("design", SET)
+PARAMS.export(globals())   # B_K1 = 0, ..., B_TU = 8, B_DESIGN_T1 = 9, ..., B_DESIGN_A3 = 15
+B_SET = PARAMS.index("design.T1")   # offset of the design set, read by vl_drift/vl_gain as p[B_SET + S_*]
+N_PARAMS = PARAMS.size
+STATE = Layout("controller state", "Z_", [
+    RecordField("R_PREV", "r_prev", "rad/s", "previous yaw rate, for the r' estimate on ships without an rdot "
+                "state (van_leeuwen_design.yaw_accel)"),
+], size_name="N_STATE")
+STATE.export(globals())    # Z_R_PREV = 0, N_STATE = 1
 
 
 class Backstepping(NamedTuple):
@@ -75,16 +101,15 @@ class Backstepping(NamedTuple):
     time_unit: float = 1.0    #: [s] unit of time of the gains: 1 s, or L/U (ship time)
 
     def pack(self) -> np.ndarray:
-        for name in ("k1", "k2", "k3", "k4"):
-            require_finite_range(f"controller.{name}", getattr(self, name), 0.0, 1e6, lo_open=True)
-        require_finite_range("controller.T_R", self.T_R, 0.0, lo_open=True)
-        require_finite_range("ship.speed", self.mu, 0.0, lo_open=True)
-        require_finite_range("controller.u_max", self.u_max, 0.0, lo_open=True)
-        return np.array([self.k1, self.k2, self.k3, self.k4, self.T_R, self.mu, self.i_rdot,
-                         self.u_max, self.time_unit, *self.design], dtype=np.float64)
+        rec = self._asdict()
+        design = rec.pop("design")
+        if len(design) != N_SET:
+            raise InputError("controller.design", f"needs the {N_SET} values of a Van Leeuwen set, got {len(design)}")
+        rec.update(("design." + n, v) for n, v in zip(SET.names, design))
+        return PARAMS.pack(rec)
 
     def init_state(self, x0, ref0) -> np.ndarray:
-        return np.array([x0[5]])
+        return STATE.pack(r_prev=x0[5])
 
 
 @numba.njit(cache=True)
@@ -107,7 +132,7 @@ def backstepping_errors(p, x, ref, rd):
 @numba.njit(cache=True)
 def backstepping_a_update(z, p, t, x, ref, h):
     """One sample of law (25): the rudder order [rad]."""
-    rd = yaw_accel(z, 0, p[B_IRDOT], x, h)
+    rd = yaw_accel(z, Z_R_PREV, p[B_IRDOT], x, h)
     z1, z2, z3, z1d, z2d, a2d = backstepping_errors(p, x, ref, rd)
     mu = p[B_MU]
     tu3 = p[B_TU] ** 3
@@ -117,19 +142,25 @@ def backstepping_a_update(z, p, t, x, ref, h):
     return min(max(u, -umax), umax)
 
 
-class BacksteppingAConfig(FrozenConfig):
-    """``[controller] type = "backstepping_a"``: gains [1/s] (Table 3, ballast, by default)."""
+def config_fields(type_name: str, gains=("k1", "k2", "k3"), defaults=None) -> dict:
+    """The scenario fields of both versions: gains from :data:`PARAMS` (bounds, unit), the design
+    options at the edge."""
+    return dict(
+        type=(Literal[type_name], ...),
+        **PARAMS.config_fields(gains, defaults=defaults),
+        design_loading=(Optional[str], Field(None, description="Van Leeuwen ships: loading of the design model")),
+        design_T2=(Optional[float], Field(None, ge=0.001, le=1e3,
+                                          description="[s], 0.001-1000 s, other ships; default gear T_sg")),
+        gain_time=(Literal["s", "ship"], Field("s", description="time unit of the gains: 1 s or L/U")),
+        u_max_deg=(Optional[float], Field(None, gt=0.0, le=90.0, description="default: gear limit")),
+        sample_time=(Optional[float], Field(None, gt=0.0, le=60.0, description="default: dt")))
 
-    type: Literal["backstepping_a"]
-    k1: float = Field(0.020568, gt=0.0, le=1e6)
-    k2: float = Field(176.3781, gt=0.0, le=1e6)
-    k3: float = Field(2.545, gt=0.0, le=1e6)
-    design_loading: Optional[str] = Field(None, description="Van Leeuwen ships: loading of the design model")
-    design_T2: Optional[float] = Field(None, ge=0.001, le=1e3,
-                                      description="[s], 0.001-1000 s, other ships; default gear T_sg")
-    gain_time: Literal["s", "ship"] = Field("s", description="time unit of the gains: 1 s or L/U")
-    u_max_deg: Optional[float] = Field(None, gt=0.0, le=90.0, description="default: gear limit")
-    sample_time: Optional[float] = Field(None, gt=0.0, le=60.0, description="default: dt")
+
+BacksteppingAConfig = create_model(
+    "BacksteppingAConfig", __base__=FrozenConfig,
+    __doc__='``[controller] type = "backstepping_a"``: gains [1/s] (Table 3, ballast, by default).',
+    **config_fields("backstepping_a"))
+BacksteppingAConfig.__module__ = __name__
 
 
 def make(cfg, ctx, k4: float = 1.0) -> tuple[Backstepping, np.ndarray]:

@@ -34,14 +34,13 @@ limited to ``u_max``. Gains [1/s], Table 3 (GA-tuned): ballast ``k1..k4 = 5.93, 
 
 from __future__ import annotations
 
-from typing import Literal, Optional
-
 import numba
-from pydantic import Field
+from pydantic import create_model
 
 from steerlab.config_base import FrozenConfig
 from steerlab.control.backstepping_a import (B_IRDOT, B_K1, B_K2, B_K3, B_K4, B_MU, B_SET, B_TR,
-                                             B_TU, B_UMAX, N_STATE, backstepping_errors, make)
+                                             B_TU, B_UMAX, N_STATE, Z_R_PREV, backstepping_errors,
+                                             config_fields, make)
 from steerlab.control.registry import ControllerSpec
 from steerlab.control.van_leeuwen_design import yaw_accel
 from steerlab.ships.van_leeuwen import vl_drift, vl_drift_partials, vl_gain
@@ -50,7 +49,7 @@ from steerlab.ships.van_leeuwen import vl_drift, vl_drift_partials, vl_gain
 @numba.njit(cache=True)
 def backstepping_b_update(z, p, t, x, ref, h):
     """One sample of law (26): the rudder order [rad]."""
-    rd = yaw_accel(z, 0, p[B_IRDOT], x, h)
+    rd = yaw_accel(z, Z_R_PREV, p[B_IRDOT], x, h)
     z1, z2, z3, z1d, z2d, a2d = backstepping_errors(p, x, ref, rd)
     k1 = p[B_K1]
     k2 = p[B_K2]
@@ -77,20 +76,12 @@ def backstepping_b_update(z, p, t, x, ref, h):
     return min(max(u, -umax), umax)
 
 
-class BacksteppingBConfig(FrozenConfig):
-    """``[controller] type = "backstepping_b"``: gains [1/s] (Table 3, ballast, by default)."""
-
-    type: Literal["backstepping_b"]
-    k1: float = Field(5.93, gt=0.0, le=1e6)
-    k2: float = Field(184.252, gt=0.0, le=1e6)
-    k3: float = Field(0.001, gt=0.0, le=1e6)
-    k4: float = Field(0.001, gt=0.0, le=1e6)
-    design_loading: Optional[str] = Field(None, description="Van Leeuwen ships: loading of the design model")
-    design_T2: Optional[float] = Field(None, ge=0.001, le=1e3,
-                                      description="[s], 0.001-1000 s, other ships; default gear T_sg")
-    gain_time: Literal["s", "ship"] = Field("s", description="time unit of the gains: 1 s or L/U")
-    u_max_deg: Optional[float] = Field(None, gt=0.0, le=90.0, description="default: gear limit")
-    sample_time: Optional[float] = Field(None, gt=0.0, le=60.0, description="default: dt")
+BacksteppingBConfig = create_model(
+    "BacksteppingBConfig", __base__=FrozenConfig,
+    __doc__='``[controller] type = "backstepping_b"``: gains [1/s] (Table 3, ballast, by default).',
+    **config_fields("backstepping_b", ("k1", "k2", "k3", "k4"),
+                    defaults={"k1": 5.93, "k2": 184.252, "k3": 0.001, "k4": 0.001}))
+BacksteppingBConfig.__module__ = __name__
 
 
 def build(cfg: BacksteppingBConfig, ctx):

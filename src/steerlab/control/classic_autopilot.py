@@ -50,46 +50,65 @@ from typing import Literal, NamedTuple, Optional
 
 import numba
 import numpy as np
-from pydantic import Field
+from pydantic import Field, create_model
 
 from steerlab.angles import wrap_to_pi
 from steerlab.config_base import FrozenConfig
 from steerlab.control.registry import ControllerSpec
-from steerlab.errors import InputError, require_finite_range
+from steerlab.errors import InputError
+from steerlab.records import Field as RecordField
+from steerlab.records import Layout
 from steerlab.units import rad
 
-C_KP, C_KI, C_KD, C_UMAX, C_WEATHER, C_ON_ORDER, C_TF, C_ECC = range(8)
-N_PARAMS = 8
-N_STATE = 2  # [integral of the heading error (rad s), low-pass filtered order (rad)]
+PARAMS = Layout("controller", "C_", [
+    RecordField("KP", "Kp", "rad/rad", "'rudder' action (van Amerongen 1982, Fig. 3.3)", lo=0.0, default=1.0),
+    RecordField("KI", "Ki", "1/s", "'automatic permanent helm' (integral) action (Fig. 3.3)", lo=0.0,
+                default=0.002),
+    RecordField("KD", "Kd", "s", "'counter-rudder' action, on the measured yaw rate (Fig. 3.3)", lo=0.0,
+                default=20.0),
+    RecordField("UMAX", "u_max", "rad", "'rudder limiter' (scenario default: the gear's limit)",
+                lo=0.0, lo_open=True, default=rad(35.0)),
+    RecordField("WEATHER", "weather", "rad", "'weather' dead-band half-width w of db_w (0 = none)",
+                lo=0.0, hi=math.pi / 2, default=0.0),
+    RecordField("ON_ORDER", "on_order", "-", "1: the dead band acts on the rudder order, 0: on the error",
+                lo=0.0, hi=1.0, default=0.0),
+    RecordField("TF", "lowpass_T", "s", "low-pass time constant T_f, a = exp(-h/T_f) (0 = none)",
+                lo=0.0, default=0.0),
+    RecordField("ECC", "course_change", "rad", "|error| above which the integral is frozen "
+                "(course changing; thesis Sec. 4: 5 deg)", lo=0.0, hi=math.pi, lo_open=True, default=rad(5.0)),
+], size_name="N_PARAMS")
+PARAMS.export(globals())   # C_KP = 0, C_KI, C_KD, C_UMAX, C_WEATHER, C_ON_ORDER, C_TF, C_ECC = 7, N_PARAMS = 8
+STATE = Layout("controller state", "Z_", [
+    RecordField("INT", "integral", "rad s", "integral I of the (dead-banded) heading error e_w"),
+    RecordField("LP", "u_filtered", "rad", "low-pass filtered order u_f"),
+], size_name="N_STATE")
+STATE.export(globals())    # Z_INT = 0, Z_LP = 1, N_STATE = 2
 
 WEATHER_ON = ("error", "order")
 
 
-class ClassicAutopilot(NamedTuple):
-    """Classic autopilot settings (SI)."""
+def _default(name: str) -> float:
+    return PARAMS.fields[PARAMS.index(name)].default
 
-    Kp: float = 1.0                 #: "rudder" [rad/rad]
-    Ki: float = 0.002               #: "permanent helm" [1/s]
-    Kd: float = 20.0                #: "counter rudder" [s]
-    u_max: float = rad(35.0)        #: "rudder limiter" [rad]
-    weather: float = 0.0            #: dead-band half-width [rad] (0 = none)
-    weather_on: str = "error"       #: "error" or "order"
-    lowpass_T: float = 0.0          #: low-pass time constant [s] (0 = none)
-    course_change: float = rad(5.0)  #: heading error beyond which the integrator is frozen [rad]
+
+class ClassicAutopilot(NamedTuple):
+    """Classic autopilot settings (SI; fields and bounds declared in :data:`PARAMS`)."""
+
+    Kp: float = _default("Kp")                        #: "rudder" [rad/rad]
+    Ki: float = _default("Ki")                        #: "permanent helm" [1/s]
+    Kd: float = _default("Kd")                        #: "counter rudder" [s]
+    u_max: float = _default("u_max")                  #: "rudder limiter" [rad]
+    weather: float = _default("weather")              #: dead-band half-width [rad] (0 = none)
+    weather_on: str = "error"                         #: "error" or "order"
+    lowpass_T: float = _default("lowpass_T")          #: low-pass time constant [s] (0 = none)
+    course_change: float = _default("course_change")  #: heading error beyond which the integrator is frozen [rad]
 
     def pack(self) -> np.ndarray:
-        require_finite_range("controller.Kp", self.Kp, 0.0)
-        require_finite_range("controller.Ki", self.Ki, 0.0)
-        require_finite_range("controller.Kd", self.Kd, 0.0)
-        require_finite_range("controller.u_max", self.u_max, 0.0, lo_open=True)
-        require_finite_range("controller.weather", self.weather, 0.0, math.pi / 2)
-        require_finite_range("controller.lowpass_T", self.lowpass_T, 0.0)
-        require_finite_range("controller.course_change", self.course_change, 0.0, math.pi, lo_open=True)
         if self.weather_on not in WEATHER_ON:
             raise InputError("controller.weather_on", f"must be one of {WEATHER_ON}, got {self.weather_on!r}")
-        return np.array([self.Kp, self.Ki, self.Kd, self.u_max, self.weather,
-                         1.0 if self.weather_on == "order" else 0.0, self.lowpass_T,
-                         self.course_change], dtype=np.float64)
+        return PARAMS.pack(Kp=self.Kp, Ki=self.Ki, Kd=self.Kd, u_max=self.u_max, weather=self.weather,
+                           on_order=1.0 if self.weather_on == "order" else 0.0, lowpass_T=self.lowpass_T,
+                           course_change=self.course_change)
 
     def init_state(self, x0, ref0) -> np.ndarray:
         return np.zeros(N_STATE)
@@ -111,12 +130,12 @@ def classic_autopilot_update(z, p, t, x, ref, h):
     e = wrap_to_pi(ref[0] - x[2])
     on_order = p[C_ON_ORDER] != 0.0
     e_w = e if on_order else dead_band(e, p[C_WEATHER])
-    u_pid = p[C_KP] * e_w + p[C_KI] * z[0] - p[C_KD] * (x[5] - ref[1])
+    u_pid = p[C_KP] * e_w + p[C_KI] * z[Z_INT] - p[C_KD] * (x[5] - ref[1])
     tf = p[C_TF]
     if tf > 0.0:
         a = math.exp(-h / tf)
-        z[1] = a * z[1] + (1.0 - a) * u_pid
-        u_f = z[1]
+        z[Z_LP] = a * z[Z_LP] + (1.0 - a) * u_pid
+        u_f = z[Z_LP]
     else:
         u_f = u_pid
     u_d = dead_band(u_f, p[C_WEATHER]) if on_order else u_f
@@ -124,24 +143,23 @@ def classic_autopilot_update(z, p, t, x, ref, h):
     u = min(max(u_d, -umax), umax)
     turning = ref[1] != 0.0 or abs(e) > p[C_ECC]
     if not turning and (u == u_d or e_w * u_d < 0.0):
-        z[0] += e_w * h
+        z[Z_INT] += e_w * h
     return u
 
 
-class ClassicAutopilotConfig(FrozenConfig):
-    """``[controller] type = "classic_autopilot"`` (degrees only at this edge)."""
-
-    type: Literal["classic_autopilot"]
-    Kp: float = Field(1.0, ge=0.0, le=1e4, description="'rudder' [rad/rad]")
-    Ki: float = Field(0.002, ge=0.0, le=1e4, description="'permanent helm' [1/s]")
-    Kd: float = Field(20.0, ge=0.0, le=1e5, description="'counter rudder' [s]")
-    u_max_deg: Optional[float] = Field(None, gt=0.0, le=90.0, description="'rudder limiter'; default: gear limit")
-    weather_deg: float = Field(0.0, ge=0.0, le=30.0, description="'weather' dead-band half-width [deg]")
-    weather_on: Literal["error", "order"] = "error"
-    lowpass_T: float = Field(0.0, ge=0.0, le=1e4, description="low-pass time constant [s]; 0 = off")
-    course_change_deg: float = Field(5.0, gt=0.0, le=180.0,
-                                     description="|error| above which the integral is frozen [deg]")
-    sample_time: Optional[float] = Field(None, gt=0.0, le=60.0, description="default: dt")
+ClassicAutopilotConfig = create_model(
+    "ClassicAutopilotConfig", __base__=FrozenConfig,
+    __doc__='``[controller] type = "classic_autopilot"`` (degrees only at this edge).',
+    type=(Literal["classic_autopilot"], ...),
+    **PARAMS.config_fields(("Kp", "Ki", "Kd"), upper={"Kp": 1e4, "Ki": 1e4, "Kd": 1e5}),
+    u_max_deg=(Optional[float], Field(None, gt=0.0, le=90.0, description="'rudder limiter'; default: gear limit")),
+    weather_deg=(float, Field(0.0, ge=0.0, le=30.0, description="'weather' dead-band half-width [deg]")),
+    weather_on=(Literal["error", "order"], "error"),
+    **PARAMS.config_fields(("lowpass_T",), upper={"lowpass_T": 1e4}),
+    course_change_deg=(float, Field(5.0, gt=0.0, le=180.0,
+                                    description="|error| above which the integral is frozen [deg]")),
+    sample_time=(Optional[float], Field(None, gt=0.0, le=60.0, description="default: dt")))
+ClassicAutopilotConfig.__module__ = __name__
 
 
 def build(cfg: ClassicAutopilotConfig, ctx):

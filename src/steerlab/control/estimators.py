@@ -21,6 +21,14 @@ import numba
 import numpy as np
 
 from steerlab.angles import wrap_to_pi
+from steerlab.records import Field, Layout
+
+ESO = Layout("ESO state", "E_", [
+    Field("PSI", "psi_hat", "rad", "xh1: heading estimate, eq (7a)"),
+    Field("R", "r_hat", "rad/s", "xh2: yaw-rate estimate, eq (7a)"),
+    Field("F", "f_hat", "rad/s^2", "xh3: total-disturbance estimate (x3 of eq 7)"),
+], size_name="N_ESO")
+ESO.export(globals())    # E_PSI = 0, E_R = 1, E_F = 2, N_ESO = 3
 
 PAPER_L = (1.0484, 0.44955, 0.001)
 """Observer gains of Zwierzewicz et al. (2021), Section 5."""
@@ -94,11 +102,11 @@ def check_discrete_eso(L, h: float, field: str = "controller.L") -> None:
 
 @numba.njit(cache=True)
 def eso_step(xh, c0, l1, l2, l3, y, u, h):
-    """Advance the ESO estimate ``xh = [x1, x2, x3]`` in place by one Euler step of (7a)."""
-    e = wrap_to_pi(y - xh[0])
-    x1 = xh[0]
-    x2 = xh[1]
-    x3 = xh[2]
-    xh[0] = wrap_to_pi(x1 + h * (x2 + l1 * e))
-    xh[1] = x2 + h * (x3 + c0 * u + l2 * e)
-    xh[2] = x3 + h * (l3 * e)
+    """Advance the ESO estimate ``xh`` (layout :data:`ESO`) in place by one Euler step of (7a)."""
+    e = wrap_to_pi(y - xh[E_PSI])
+    x1 = xh[E_PSI]
+    x2 = xh[E_R]
+    x3 = xh[E_F]
+    xh[E_PSI] = wrap_to_pi(x1 + h * (x2 + l1 * e))
+    xh[E_R] = x2 + h * (x3 + c0 * u + l2 * e)
+    xh[E_F] = x3 + h * (l3 * e)

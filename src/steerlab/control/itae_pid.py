@@ -71,22 +71,42 @@ from typing import Literal, NamedTuple, Optional
 
 import numba
 import numpy as np
-from pydantic import Field
+from pydantic import Field, create_model
 
 from steerlab.angles import wrap_to_pi
 from steerlab.config_base import FrozenConfig
 from steerlab.control.design_model import nomoto_design_model
 from steerlab.control.registry import ControllerSpec
 from steerlab.errors import InputError, require_finite_range
+from steerlab.records import Field as RecordField
+from steerlab.records import Layout
 from steerlab.units import knots_to_ms, rad
 
 ITAE_C1 = 1.75
 POLYNOMIALS = {"dorf": 2.15, "eq6": 1.0}
 """``c2`` of M(s) = s^3 + 1.75 w0 s^2 + c2 w0^2 s + w0^3 for each reading of the paper."""
 
-I_WN, I_KM, I_TM, I_VM, I_SCHED, I_VMIN, I_C2, I_UMAX, I_AW = range(9)
-N_PARAMS = 9
-N_STATE = 3  # [pre-filtered set-point psi_p (rad), its rate (rad/s), integral of eps (rad s)]
+PARAMS = Layout("controller", "I_", [
+    RecordField("WN", "omega_0", "rad/s", "ITAE natural frequency omega_0 = 5 / t_r, eq (8)", lo=0.0, lo_open=True),
+    RecordField("KM", "k_m", "1/s", "Nomoto gain at the design speed, eq (1)-(2)", lo=0.0, lo_open=True),
+    RecordField("TM", "T_m", "s", "Nomoto time constant at the design speed, eq (1)-(2)", lo=0.0, lo_open=True),
+    RecordField("VM", "V_m", "m/s", "design speed V_m of the scheduling, eq (2)", lo=0.0, lo_open=True),
+    RecordField("SCHED", "schedule", "-", "1: schedule k, T on the surge speed x[3] by eq (2)", lo=0.0, hi=1.0),
+    RecordField("VMIN", "v_min_fraction", "-", "scheduling speed floor, fraction of V_m", lo=0.0, hi=1.0,
+                lo_open=True, default=0.3),
+    RecordField("C2", "c2", "-", "c2 of M(s), eq (6): 2.15 (Dorf, eqs 10-11) or 1 (eq 6 as printed)",
+                lo=0.0, lo_open=True),
+    RecordField("UMAX", "u_max", "rad", "output limit (scenario default: the gear's limit)", lo=0.0, lo_open=True),
+    RecordField("AW", "anti_windup", "-", "1: clamping anti-windup of steerlab.control.pid (not in the paper)",
+                lo=0.0, hi=1.0),
+], size_name="N_PARAMS")
+PARAMS.export(globals())   # I_WN = 0, I_KM, I_TM, I_VM, I_SCHED, I_VMIN, I_C2, I_UMAX, I_AW = 8, N_PARAMS = 9
+STATE = Layout("controller state", "Z_", [
+    RecordField("PSI_P", "psi_p", "rad", "pre-filtered set-point, output of G_p (11)"),
+    RecordField("R_P", "r_p", "rad/s", "rate of the pre-filtered set-point"),
+    RecordField("INT", "integral", "rad s", "integral I of the pre-filtered error eps"),
+], size_name="N_STATE")
+STATE.export(globals())    # Z_PSI_P = 0, Z_R_P = 1, Z_INT = 2, N_STATE = 3
 
 
 def itae_gains(t_r: float, k: float, T: float, polynomial: str = "dorf") -> tuple[float, float, float]:
@@ -123,7 +143,7 @@ class ItaePID(NamedTuple):
     T_m: float                      #: Nomoto time constant at the design speed [s]
     V_m: float                      #: design speed [m/s]
     schedule: bool = True           #: schedule on the surge speed x[3] (eq 2)
-    v_min_fraction: float = 0.3     #: scheduling speed floor, fraction of V_m
+    v_min_fraction: float = PARAMS.fields[I_VMIN].default  #: scheduling speed floor, fraction of V_m
     polynomial: str = "dorf"        #: "dorf" (c2 = 2.15) or "eq6" (c2 = 1)
     u_max: float = rad(35.0)        #: output limit [rad]
     anti_windup: bool = False       #: clamping anti-windup (not in the paper)
@@ -137,19 +157,17 @@ class ItaePID(NamedTuple):
 
     def pack(self) -> np.ndarray:
         self.gains()   # validates t_r, k_m, T_m, polynomial
-        require_finite_range("controller.design_speed", self.V_m, 0.0, lo_open=True)
-        require_finite_range("controller.v_min_fraction", self.v_min_fraction, 0.0, 1.0, lo_open=True)
-        require_finite_range("controller.u_max", self.u_max, 0.0, lo_open=True)
+        rec = PARAMS.pack(omega_0=5.0 / self.t_r, k_m=self.k_m, T_m=self.T_m, V_m=self.V_m,
+                          schedule=float(self.schedule), v_min_fraction=self.v_min_fraction,
+                          c2=POLYNOMIALS[self.polynomial], u_max=self.u_max, anti_windup=float(self.anti_windup))
         if self.schedule:
             # the slowest scheduled speed has the largest T: the pre-filter must stay stable there
             self.gains(self.v_min_fraction * self.V_m)
-        return np.array([5.0 / self.t_r, self.k_m, self.T_m, self.V_m, float(self.schedule),
-                         self.v_min_fraction, POLYNOMIALS[self.polynomial], self.u_max,
-                         float(self.anti_windup)], dtype=np.float64)
+        return rec
 
     def init_state(self, x0, ref0) -> np.ndarray:
         """Pre-filter at rest on the initial set-point; no integral."""
-        return np.array([ref0[0], 0.0, 0.0])
+        return STATE.pack(psi_p=ref0[0], r_p=0.0, integral=0.0)
 
 
 @numba.njit(cache=True)
@@ -167,41 +185,42 @@ def itae_pid_update(z, p, t, x, ref, h):
     h2 = w0 * w0 * w0 * T / k
     h3 = (ITAE_C1 * w0 * T - 1.0) / k
     # PID (3) on the pre-filtered error, derivative from the pre-filter's rate
-    eps = wrap_to_pi(z[0] - x[2])
-    ud = h1 * eps + h2 * z[2] + h3 * (z[1] - x[5])
+    eps = wrap_to_pi(z[Z_PSI_P] - x[2])
+    ud = h1 * eps + h2 * z[Z_INT] + h3 * (z[Z_R_P] - x[5])
     umax = p[I_UMAX]
     u = min(max(ud, -umax), umax)
     if p[I_AW] == 0.0 or u == ud or eps * ud < 0.0:
-        z[2] += eps * h
+        z[Z_INT] += eps * h
     # pre-filter (11): a2 y'' + a1 y' + y = psi_d, Tustin step relative to y
     a2 = h3 / h2
     a1 = h1 / h2
-    d = wrap_to_pi(ref[0] - z[0])              # input relative to the present output
+    d = wrap_to_pi(ref[0] - z[Z_PSI_P])        # input relative to the present output
     q = 0.5 * h / a2
     m11 = 1.0 + q * a1
     det = m11 + 0.5 * h * q
-    rhs0 = 0.5 * h * z[1]
-    rhs1 = (1.0 - q * a1) * z[1] + 2.0 * q * d
-    z[0] = wrap_to_pi(z[0] + (m11 * rhs0 + 0.5 * h * rhs1) / det)
-    z[1] = (rhs1 - q * rhs0) / det
+    rhs0 = 0.5 * h * z[Z_R_P]
+    rhs1 = (1.0 - q * a1) * z[Z_R_P] + 2.0 * q * d
+    z[Z_PSI_P] = wrap_to_pi(z[Z_PSI_P] + (m11 * rhs0 + 0.5 * h * rhs1) / det)
+    z[Z_R_P] = (rhs1 - q * rhs0) / det
     return u
 
 
-class ItaePIDConfig(FrozenConfig):
-    """``[controller] type = "itae_pid"`` (degrees and knots only at this edge)."""
-
-    type: Literal["itae_pid"]
-    t_r: float = Field(53.0, ge=1.0, le=1e5, description="2 % settling time [s], 1-1e5 s (paper: 38, 48, 53 s)")
-    K: Optional[float] = Field(None, gt=0.0, le=100.0, description="design k_m [1/s]; default: ship's Nomoto K")
-    T: Optional[float] = Field(None, gt=0.0, le=1e5, description="design T_m [s]; default: ship's Nomoto T")
-    design_speed_kn: Optional[float] = Field(None, ge=0.01, le=40.0,
-                                             description="V_m of eq (2) [kn]; default: ship.speed_kn")
-    schedule: bool = True
-    v_min_fraction: float = Field(0.3, gt=0.0, le=1.0, description="scheduling speed floor / V_m")
-    polynomial: Literal["dorf", "eq6"] = "dorf"
-    anti_windup: bool = False
-    u_max_deg: Optional[float] = Field(None, gt=0.0, le=90.0, description="default: gear limit")
-    sample_time: Optional[float] = Field(None, gt=0.0, le=60.0, description="default: dt")
+ItaePIDConfig = create_model(
+    "ItaePIDConfig", __base__=FrozenConfig,
+    __doc__='``[controller] type = "itae_pid"`` (degrees and knots only at this edge).',
+    type=(Literal["itae_pid"], ...),
+    t_r=(float, Field(53.0, ge=1.0, le=1e5, description="2 % settling time [s], 1-1e5 s (paper: 38, 48, 53 s)")),
+    K=(Optional[float], Field(None, gt=0.0, le=100.0, description="design k_m [1/s]; default: ship's Nomoto K")),
+    T=(Optional[float], Field(None, gt=0.0, le=1e5, description="design T_m [s]; default: ship's Nomoto T")),
+    design_speed_kn=(Optional[float], Field(None, ge=0.01, le=40.0,
+                                            description="V_m of eq (2) [kn]; default: ship.speed_kn")),
+    schedule=(bool, True),
+    **PARAMS.config_fields(("v_min_fraction",)),
+    polynomial=(Literal["dorf", "eq6"], "dorf"),
+    anti_windup=(bool, False),
+    u_max_deg=(Optional[float], Field(None, gt=0.0, le=90.0, description="default: gear limit")),
+    sample_time=(Optional[float], Field(None, gt=0.0, le=60.0, description="default: dt")))
+ItaePIDConfig.__module__ = __name__
 
 
 def build(cfg: ItaePIDConfig, ctx):

@@ -45,19 +45,45 @@ from typing import Literal, NamedTuple, Optional, Union
 
 import numba
 import numpy as np
-from pydantic import Field, field_validator
+from pydantic import Field, create_model, field_validator
 
 from steerlab.angles import wrap_to_pi
 from steerlab.config_base import FrozenConfig
-from steerlab.control.nonlinear_eso import fal, nleso_gains_bandwidth, nleso_step
+from steerlab.control.nonlinear_eso import NLESO, fal, nleso_gains_bandwidth, nleso_step
 from steerlab.control.registry import ControllerSpec
-from steerlab.control.tracking_differentiator import td_step
+from steerlab.control.tracking_differentiator import TD, td_step
 from steerlab.errors import InputError, require_finite_range
+from steerlab.records import Field as RecordField
+from steerlab.records import Layout
 
-(N_B, N_BETA1, N_BETA2, N_BETA3, N_A01, N_D01, N_A02, N_D02, N_K1, N_K2, N_A1, N_D1, N_A2,
- N_D2, N_R, N_H0, N_UMAX) = range(17)
-N_PARAMS = 17
-N_STATE = 5   # TD [v1 (rad), v2 (rad/s)], ESO [z1 (rad), z2 (rad/s), z3 (rad/s^2)]
+
+def _fal_exponent(const, name, doc, default):
+    return RecordField(const, name, "-", f"fal exponent {doc}", lo=0.0, hi=10.0, lo_open=True, default=default)
+
+
+PARAMS = Layout("controller", "N_", [
+    RecordField("B", "b", "1/s^2", "rudder gain b of psi'' = f + b u, eq (20)", lo=0.0, lo_open=True),
+    RecordField("BETA1", "beta1", "1/s", "ESO gain beta01 of (24)", lo=0.0, lo_open=True),
+    RecordField("BETA2", "beta2", "rad^(1-a01)/s^2", "ESO gain beta02 of (24)", lo=0.0, lo_open=True),
+    RecordField("BETA3", "beta3", "rad^(1-a02)/s^3", "ESO gain beta03 of (24)", lo=0.0, lo_open=True),
+    _fal_exponent("A01", "a01", "a01 of the ESO, (24) (paper: 0.5)", 0.5),
+    RecordField("D01", "d01", "rad", "fal linear zone delta01 of the ESO, (24)-(25)", lo=0.0, lo_open=True),
+    _fal_exponent("A02", "a02", "a02 of the ESO, (24) (paper: 0.25)", 0.25),
+    RecordField("D02", "d02", "rad", "fal linear zone delta02 of the ESO, (24)-(25)", lo=0.0, lo_open=True),
+    RecordField("K1", "k1", "rad^(1-a1)", "NLSEF gain k1 of (26)", lo=0.0),
+    RecordField("K2", "k2", "rad s^a2 / rad^a2", "NLSEF gain k2 of (26)", lo=0.0),
+    _fal_exponent("A1", "a1", "a1 of the NLSEF, (26) (paper: 0.75)", 0.75),
+    RecordField("D1", "d1", "rad", "fal linear zone delta1 of the NLSEF, (26)", lo=0.0, lo_open=True),
+    _fal_exponent("A2", "a2", "a2 of the NLSEF, (26) (paper: 2.75 as printed)", 2.75),
+    RecordField("D2", "d2", "rad/s", "fal linear zone delta2 of the NLSEF, (26)", lo=0.0, lo_open=True),
+    RecordField("R", "r_td", "rad/s^2", "TD tracking speed factor r of (21)-(22)", lo=0.0, lo_open=True,
+                default=0.01),
+    RecordField("H0", "h0", "s", "TD filtering factor h0 of (22)", lo=0.0, lo_open=True, default=1.0),
+    RecordField("UMAX", "u_max", "rad", "output limit (scenario default: the gear's limit)", lo=0.0, lo_open=True),
+], size_name="N_PARAMS")
+PARAMS.export(globals())   # N_B = 0, N_BETA1..3, N_A01, N_D01, N_A02, N_D02, N_K1, ..., N_UMAX = 16, N_PARAMS = 17
+STATE = Layout("controller state", "Z_", TD.fields + NLESO.fields, size_name="N_STATE")
+STATE.export(globals())    # TD: Z_V1 = 0, Z_V2 = 1; ESO: Z_Z1 = 2, Z_Z2 = 3, Z_Z3 = 4; N_STATE = 5
 
 
 class TimeScaled(NamedTuple):
@@ -101,22 +127,15 @@ class NonlinearADRC(NamedTuple):
     u_max: float
 
     def pack(self) -> np.ndarray:
-        require_finite_range("controller.b", self.b, 0.0, lo_open=True)
-        for i, v in enumerate(self.beta):
-            require_finite_range(f"controller.beta[{i}]", v, 0.0, lo_open=True)
-        for n in ("k1", "k2"):
-            require_finite_range(f"controller.{n}", getattr(self, n), 0.0)
-        for n in ("a01", "a02", "a1", "a2"):
-            require_finite_range(f"controller.{n}", getattr(self, n), 0.0, 10.0, lo_open=True)
-        for n in ("d01", "d02", "d1", "d2", "r_td", "h0", "u_max"):
-            require_finite_range(f"controller.{n}", getattr(self, n), 0.0, lo_open=True)
-        return np.array([self.b, *self.beta, self.a01, self.d01, self.a02, self.d02, self.k1,
-                         self.k2, self.a1, self.d1, self.a2, self.d2, self.r_td, self.h0,
-                         self.u_max], dtype=np.float64)
+        if len(self.beta) != 3:
+            raise InputError("controller.beta", f"needs 3 observer gains, got {len(self.beta)}")
+        rec = self._asdict()
+        rec.update(zip(("beta1", "beta2", "beta3"), rec.pop("beta")))
+        return PARAMS.pack(rec)
 
     def init_state(self, x0, ref0) -> np.ndarray:
         """TD at the initial set heading, ESO at the measured heading and rate, no disturbance."""
-        return np.array([ref0[0], 0.0, x0[2], x0[5], 0.0])
+        return STATE.pack(v1=ref0[0], v2=0.0, z1=x0[2], z2=x0[5], z3=0.0)
 
 
 @numba.njit(cache=True)
@@ -128,56 +147,54 @@ def nlsef(e1, e2, p):
 @numba.njit(cache=True)
 def nonlinear_adrc_update(z, p, t, x, ref, h):
     """One sample of (27): TD, NLSEF on the current estimate, then the ESO with the applied order."""
-    td_step(z, 0, ref[0], p[N_R], p[N_H0], h)
+    td_step(z, Z_V1, ref[0], p[N_R], p[N_H0], h)
     b = p[N_B]
-    u0 = nlsef(wrap_to_pi(z[0] - z[2]), z[1] - z[3], p)
-    u = u0 - z[4] / b
+    u0 = nlsef(wrap_to_pi(z[Z_V1] - z[Z_Z1]), z[Z_V2] - z[Z_Z2], p)
+    u = u0 - z[Z_Z3] / b
     umax = p[N_UMAX]
     u = min(max(u, -umax), umax)
-    nleso_step(z, 2, b, p[N_BETA1], p[N_BETA2], p[N_BETA3], p[N_A01], p[N_D01], p[N_A02],
+    nleso_step(z, Z_Z1, b, p[N_BETA1], p[N_BETA2], p[N_BETA3], p[N_A01], p[N_D01], p[N_A02],
                p[N_D02], x[2], u, h)
     return u
 
 
-class NonlinearADRCConfig(FrozenConfig):
-    """``[controller] type = "nonlinear_adrc"`` (SI: rad, rad/s, s)."""
-
-    type: Literal["nonlinear_adrc"]
-    b: Union[float, Literal["estimate", "exact"]] = "exact"
-    omega_c: float = Field(0.05, gt=0.0, le=100.0, description="NLSEF bandwidth [rad/s]")
-    omega_o: float = Field(0.5, gt=0.0, le=100.0, description="ESO bandwidth [rad/s]")
-    k1: Optional[float] = Field(None, ge=0.0, le=1e9)
-    k2: Optional[float] = Field(None, ge=0.0, le=1e9)
-    beta: Optional[tuple[float, float, float]] = None
-    reference_b: Optional[float] = Field(None, gt=0.0, description="[1/s^2] re-tune k, beta, b by (31)")
-    a01: float = Field(0.5, gt=0.0, le=10.0)
-    a02: float = Field(0.25, gt=0.0, le=10.0)
-    delta01: float = Field(0.1, ge=1e-4, le=10.0)
-    delta02: float = Field(0.1, ge=1e-4, le=10.0)
-    a1: float = Field(0.75, gt=0.0, le=10.0)
-    a2: float = Field(2.75, gt=0.0, le=10.0)
-    delta1: float = Field(0.1, ge=1e-4, le=10.0)
-    delta2: float = Field(0.1, ge=1e-4, le=10.0)
-    r_td: float = Field(0.01, gt=0.0, le=1e6, description="TD tracking speed factor [rad/s^2]")
-    h0: float = Field(1.0, gt=0.0, le=1e3, description="TD filtering factor [s]")
-    u_max_deg: Optional[float] = Field(None, gt=0.0, le=90.0)
-    sample_time: Optional[float] = Field(None, gt=0.0, le=60.0)
-
-    @field_validator("b", mode="before")
-    @classmethod
-    def _b_number_or_method(cls, v):
-        if isinstance(v, str) and v in ("estimate", "exact"):
-            return v
-        if isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) and v > 0:
-            return float(v)
-        raise ValueError(f"must be a finite positive number [1/s^2], 'estimate' or 'exact'; got {v!r}")
-
-    @field_validator("beta")
-    @classmethod
-    def _beta_positive(cls, v):
-        if v is not None and not all(math.isfinite(x) and x > 0 for x in v):
-            raise ValueError("observer gains must be finite and > 0")
+def _b_number_or_method(cls, v):
+    if isinstance(v, str) and v in ("estimate", "exact"):
         return v
+    if isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) and v > 0:
+        return float(v)
+    raise ValueError(f"must be a finite positive number [1/s^2], 'estimate' or 'exact'; got {v!r}")
+
+
+def _beta_positive(cls, v):
+    if v is not None and not all(math.isfinite(x) and x > 0 for x in v):
+        raise ValueError("observer gains must be finite and > 0")
+    return v
+
+
+NonlinearADRCConfig = create_model(
+    "NonlinearADRCConfig", __base__=FrozenConfig,
+    __doc__='``[controller] type = "nonlinear_adrc"`` (SI: rad, rad/s, s).',
+    __validators__={"_b_number_or_method": field_validator("b", mode="before")(_b_number_or_method),
+                    "_beta_positive": field_validator("beta")(_beta_positive)},
+    type=(Literal["nonlinear_adrc"], ...),
+    b=(Union[float, Literal["estimate", "exact"]], "exact"),
+    omega_c=(float, Field(0.05, gt=0.0, le=100.0, description="NLSEF bandwidth [rad/s]")),
+    omega_o=(float, Field(0.5, gt=0.0, le=100.0, description="ESO bandwidth [rad/s]")),
+    k1=(Optional[float], Field(None, ge=0.0, le=1e9)),
+    k2=(Optional[float], Field(None, ge=0.0, le=1e9)),
+    beta=(Optional[tuple[float, float, float]], None),
+    reference_b=(Optional[float], Field(None, gt=0.0, description="[1/s^2] re-tune k, beta, b by (31)")),
+    **PARAMS.config_fields(("a01", "a02")),
+    delta01=(float, Field(0.1, ge=1e-4, le=10.0)),
+    delta02=(float, Field(0.1, ge=1e-4, le=10.0)),
+    **PARAMS.config_fields(("a1", "a2")),
+    delta1=(float, Field(0.1, ge=1e-4, le=10.0)),
+    delta2=(float, Field(0.1, ge=1e-4, le=10.0)),
+    **PARAMS.config_fields(("r_td", "h0"), upper={"r_td": 1e6, "h0": 1e3}),
+    u_max_deg=(Optional[float], Field(None, gt=0.0, le=90.0)),
+    sample_time=(Optional[float], Field(None, gt=0.0, le=60.0)))
+NonlinearADRCConfig.__module__ = __name__
 
 
 def build(cfg: NonlinearADRCConfig, ctx):

@@ -27,6 +27,14 @@ import numpy as np
 
 from steerlab.angles import wrap_to_pi
 from steerlab.control.estimators import eso_gains_bandwidth
+from steerlab.records import Field, Layout
+
+NLESO = Layout("NLESO state", "E_", [
+    Field("Z1", "z1", "rad", "heading estimate z1 of (24)"),
+    Field("Z2", "z2", "rad/s", "yaw-rate estimate z2 of (24)"),
+    Field("Z3", "z3", "rad/s^2", "total-disturbance estimate z3 of (24)"),
+], size_name="N_NLESO")
+NLESO.export(globals())  # E_Z1 = 0, E_Z2 = 1, E_Z3 = 2, N_NLESO = 3
 
 
 @numba.njit(cache=True)
@@ -46,11 +54,12 @@ def nleso_gains_bandwidth(omega_o: float, a01: float, delta01: float, a02: float
 
 @numba.njit(cache=True)
 def nleso_step(zh, i, b, beta1, beta2, beta3, a01, d01, a02, d02, y, u, h):
-    """Advance ``[z1, z2, z3] = zh[i:i+3]`` in place by one Euler step of (24); ``y`` a heading [rad]."""
-    z1 = zh[i]
-    z2 = zh[i + 1]
-    z3 = zh[i + 2]
+    """Advance the estimate (layout :data:`NLESO`) held at offset ``i`` of ``zh`` in place by one
+    Euler step of (24); ``y`` a heading [rad]."""
+    z1 = zh[i + E_Z1]
+    z2 = zh[i + E_Z2]
+    z3 = zh[i + E_Z3]
     e = wrap_to_pi(z1 - y)
-    zh[i] = wrap_to_pi(z1 + h * (z2 - beta1 * e))
-    zh[i + 1] = z2 + h * (z3 - beta2 * fal(e, a01, d01) + b * u)
-    zh[i + 2] = z3 + h * (-beta3 * fal(e, a02, d02))
+    zh[i + E_Z1] = wrap_to_pi(z1 + h * (z2 - beta1 * e))
+    zh[i + E_Z2] = z2 + h * (z3 - beta2 * fal(e, a01, d01) + b * u)
+    zh[i + E_Z3] = z3 + h * (-beta3 * fal(e, a02, d02))

@@ -43,12 +43,33 @@ from steerlab.angles import wrap_to_pi
 from steerlab.config_base import FrozenConfig
 from steerlab.control.registry import ControllerSpec
 from steerlab.control.van_leeuwen_design import design_model, linear_design_matrices, yaw_accel
-from steerlab.errors import InputError, require_finite_range
+from steerlab.errors import InputError
+from steerlab.records import Field as RecordField
+from steerlab.records import Layout
+from steerlab.ships import van_leeuwen as vl
 from steerlab.units import rad
 
-S_K, S_H, S_ETA, S_PHI, S_HB, S_IRDOT, S_UMAX = 0, 4, 8, 9, 10, 11, 12
-N_PARAMS = 13
-N_STATE = 1   # previous yaw rate (r' estimate on ships without an rdot state) [rad/s]
+_PER_ERROR = ("rad/rad", "s", "s^2", "rad/rad")   # rad per unit of x~ = [psi error, r error, r', delta], eq (12)
+PARAMS = Layout("controller", "S_", [
+    *(RecordField(f"K{i + 1}", f"k{i + 1}", u,
+                  f"designed gain k{i + 1} of u_eq = -k^T x~, eq (14) (poles {{0, poles}} by acker)")
+      for i, u in enumerate(_PER_ERROR)),
+    *(RecordField(f"H{i + 1}", f"h{i + 1}", u,
+                  f"designed surface weight h{i + 1} of s = h^T x~, eq (12) (left null vector, h1 = 1)")
+      for i, u in enumerate(_PER_ERROR)),
+    RecordField("ETA", "eta", "rad/s", "switching gain: reaching rate of s, eqs (15)-(17) (Table 5: 0.19289 deg/s)",
+                lo=0.0),
+    RecordField("PHI", "phi", "rad", "boundary-layer width, eq (17) (Table 5: 1.3685 deg)", lo=0.0, lo_open=True),
+    RecordField("HB", "hb", "1/s", "h^T b of the design model (non-zero)"),
+    RecordField("IRDOT", "i_rdot", "-", "index of rdot in the plant state; -1: estimate r' from the yaw rate"),
+    RecordField("UMAX", "u_max", "rad", "output limit (scenario default: the gear's limit)", lo=0.0, lo_open=True),
+], size_name="N_PARAMS")
+PARAMS.export(globals())   # S_K1..S_K4 = 0..3, S_H1..S_H4 = 4..7, S_ETA = 8, ..., S_UMAX = 12, N_PARAMS = 13
+STATE = Layout("controller state", "Z_", [
+    RecordField("R_PREV", "r_prev", "rad/s", "previous yaw rate, for the r' estimate on ships without an rdot "
+                "state (van_leeuwen_design.yaw_accel)"),
+], size_name="N_STATE")
+STATE.export(globals())    # Z_R_PREV = 0, N_STATE = 1
 
 
 def sliding_surface_design(A, b, poles):
@@ -88,29 +109,28 @@ class SlidingMode(NamedTuple):
     u_max: float
 
     def pack(self) -> np.ndarray:
-        require_finite_range("controller.eta", self.eta, 0.0)
-        require_finite_range("controller.phi", self.phi, 0.0, lo_open=True)
-        require_finite_range("controller.u_max", self.u_max, 0.0, lo_open=True)
-        for i, v in enumerate((*self.k, *self.h, self.hb)):
-            require_finite_range(f"controller.design[{i}]", v)
-        return np.array([*self.k, *self.h, self.eta, self.phi, self.hb, self.i_rdot,
-                         self.u_max], dtype=np.float64)
+        for name, v in (("k", self.k), ("h", self.h)):
+            if len(v) != 4:
+                raise InputError(f"controller.{name}", f"needs 4 values (one per design state), got {len(v)}")
+        return PARAMS.pack(**{f"k{i + 1}": v for i, v in enumerate(self.k)},
+                           **{f"h{i + 1}": v for i, v in enumerate(self.h)},
+                           eta=self.eta, phi=self.phi, hb=self.hb, i_rdot=self.i_rdot, u_max=self.u_max)
 
     def init_state(self, x0, ref0) -> np.ndarray:
-        return np.array([x0[5]])
+        return STATE.pack(r_prev=x0[5])
 
 
 @numba.njit(cache=True)
 def sliding_mode_update(z, p, t, x, ref, h):
     """One sample of law (17): the rudder order [rad]."""
-    rd = yaw_accel(z, 0, p[S_IRDOT], x, h)
+    rd = yaw_accel(z, Z_R_PREV, p[S_IRDOT], x, h)
     e1 = wrap_to_pi(x[2] - ref[0])
     e2 = x[5] - ref[1]
     e4 = x[x.shape[0] - 1]
-    s = p[S_H] * e1 + p[S_H + 1] * e2 + p[S_H + 2] * rd + p[S_H + 3] * e4
+    s = p[S_H1] * e1 + p[S_H2] * e2 + p[S_H3] * rd + p[S_H4] * e4
     q = s / p[S_PHI]
     sat = min(max(q, -1.0), 1.0)
-    u = -(p[S_K] * e1 + p[S_K + 1] * e2 + p[S_K + 2] * rd + p[S_K + 3] * e4) \
+    u = -(p[S_K1] * e1 + p[S_K2] * e2 + p[S_K3] * rd + p[S_K4] * e4) \
         - p[S_ETA] / p[S_HB] * sat
     umax = p[S_UMAX]
     return min(max(u, -umax), umax)
@@ -145,7 +165,7 @@ def build(cfg: SlidingModeConfig, ctx):
     A, b = linear_design_matrices(s, mu, T_R)
     poles = cfg.poles
     if poles is None:
-        T2 = s[1] / mu   # dimensional second time constant [s]
+        T2 = s[vl.S_T2] / mu   # dimensional second time constant [s] (T2* of the set)
         poles = (-0.05, -1.0 / T2, -1.0 / T_R)
     k, h = sliding_surface_design(A, b, poles)
     hb = float(h @ b)

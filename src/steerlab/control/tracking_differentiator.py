@@ -23,6 +23,13 @@ import math
 import numba
 
 from steerlab.angles import wrap_to_pi
+from steerlab.records import Field, Layout
+
+TD = Layout("TD state", "TD_", [
+    Field("V1", "v1", "rad", "tracked heading v1 of (21)"),
+    Field("V2", "v2", "rad/s", "its rate v2 of (21)"),
+], size_name="N_TD")
+TD.export(globals())     # TD_V1 = 0, TD_V2 = 1, N_TD = 2
 
 
 @numba.njit(cache=True)
@@ -43,10 +50,10 @@ def fst(x1, x2, r, h0):
 
 @numba.njit(cache=True)
 def td_step(v, i, v_target, r, h0, h):
-    """Advance the TD state ``[v1, v2] = v[i:i+2]`` (a heading [rad] and its rate [rad/s]) in
-    place by one Euler step of (21)."""
-    v1 = v[i]
-    v2 = v[i + 1]
+    """Advance the TD state (layout :data:`TD`: a heading [rad] and its rate [rad/s]) held at
+    offset ``i`` of ``v`` in place by one Euler step of (21)."""
+    v1 = v[i + TD_V1]
+    v2 = v[i + TD_V2]
     a = fst(wrap_to_pi(v1 - v_target), v2, r, h0)
-    v[i] = wrap_to_pi(v1 + h * v2)
-    v[i + 1] = v2 + h * a
+    v[i + TD_V1] = wrap_to_pi(v1 + h * v2)
+    v[i + TD_V2] = v2 + h * a
