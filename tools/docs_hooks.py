@@ -224,7 +224,7 @@ def _run_script(script: Path, cache: Path, shared: bytes) -> tuple[Path, Path | 
         raise PluginError(f"docs gallery: {script.name} failed (exit {proc.returncode}):\n{proc.stderr[-2000:]}")
     made = work / f"{script.stem}.png"
     for old in cache.glob(f"{script.stem}-*"):
-        if old.is_file():
+        if old.is_file() and key not in old.name:
             old.unlink()
     if made.exists():
         os.replace(made, png)
@@ -245,8 +245,16 @@ def gallery_figures() -> dict[str, tuple[Path | None, str]]:
     scripts = gallery_scripts()
     shared = _shared_key()
     workers = max(1, min(len(scripts), os.cpu_count() or 1))
-    with concurrent.futures.ThreadPoolExecutor(workers) as pool:
-        done = list(pool.map(lambda s: _run_script(s, cache, shared), scripts))
+    # one build at a time draws into the cache (e.g. two pytest-xdist workers building the
+    # site): the second waits, then finds the figures current
+    with open(cache / ".lock", "w") as lock:
+        try:
+            import fcntl
+            fcntl.flock(lock, fcntl.LOCK_EX)
+        except ImportError:                 # no fcntl (Windows): no lock
+            pass
+        with concurrent.futures.ThreadPoolExecutor(workers) as pool:
+            done = list(pool.map(lambda s: _run_script(s, cache, shared), scripts))
     return {s.name: (png, note) for s, png, note in done}
 
 
