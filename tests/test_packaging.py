@@ -44,3 +44,38 @@ def test_docs_cited_by_the_bench_exist():
     assert cited, C_REFERENCE_NOTE
     for c in cited:
         assert (REPO / c).exists(), f"bench cites {c}, which is not in the repository"
+
+
+def test_project_urls_point_at_the_intended_public_address():
+    urls = PROJECT["project"]["urls"]
+    assert {"Homepage", "Documentation", "Source", "Issues"} <= set(urls)
+    assert all(u.startswith("https://github.com/steerlab/steerlab") for u in urls.values())
+    # the address is a placeholder until publication, and the README and changelog say so
+    for doc in ("README.md", "CHANGELOG.md"):
+        text = (REPO / doc).read_text(encoding="utf-8")
+        assert "https://github.com/steerlab/steerlab" in text and "placeholder" in text, doc
+
+
+def test_built_metadata_shows_author_licence_and_urls(tmp_path):
+    # what `pip show steerlab` prints comes from this core metadata (built from a copy of the
+    # project files, so the work tree gets no egg-info)
+    import shutil
+    import subprocess
+    import sys
+
+    proj = tmp_path / "proj"
+    (proj / "src" / "steerlab").mkdir(parents=True)
+    for name in ("pyproject.toml", "README.md", "LICENSE"):
+        shutil.copy(REPO / name, proj / name)
+    (proj / "src" / "steerlab" / "__init__.py").write_text("")
+    (proj / "src" / "steerlab" / "py.typed").write_text("")
+    (tmp_path / "meta").mkdir()
+    proc = subprocess.run([sys.executable, "-c", "from setuptools import setup; setup()", "egg_info",
+                           "--egg-base", str(tmp_path / "meta")], cwd=proj, capture_output=True, text=True,
+                          timeout=300)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    meta = (tmp_path / "meta" / "steerlab.egg-info" / "PKG-INFO").read_text(encoding="utf-8")
+    assert "Author: the steerlab maintainers" in meta
+    assert re.search(r"^License(-Expression)?: MIT$", meta, re.M)
+    for key in ("Homepage", "Documentation", "Source", "Issues"):
+        assert re.search(rf"^Project-URL: {key}, https://github\.com/steerlab/steerlab", meta, re.M), key

@@ -3,25 +3,20 @@
 ``check_ship(spec)`` and ``check_controller(spec)`` build a short scenario with the component
 (esso + pid as the partner unless given), compile its kernel once, and check, in order:
 
-========================  =============================================================
-rule                      how it is checked
-========================  =============================================================
-``declared sizes``        ship: ``len(state_names) == len(state_units) == n_states``;
-                          controller: ``n_state`` equals the size of ``init_state``
-``record size``           the kernel runs once as plain Python (``py_func``) on records of
-                          exactly the packed size: numpy bounds-checks every index, so a
-                          kernel that reads past its parameter record, its state or the
-                          plant state is named (numba does not check bounds: compiled, it
-                          would read the neighbouring memory silently)
-``writes only its own``   ship: ``rhs`` writes ``dx[:n_states]`` only (the rudder's
-                          derivative is the gear's), checked with a NaN guard
-``no allocation``         the compiled kernel (LLVM IR) calls no allocator (``np.empty``,
-                          ``np.zeros``, array expressions ...): kernels run millions of
-                          times per second inside the compiled loops and the batch lanes
-``compiles``              numba compiles the kernel for the engine's argument types
-``parity``                the readable and the compiled engine give the same run
-                          (rtol = atol = 1e-12) on the short scenario
-========================  =============================================================
+* ``declared sizes``: ship: ``len(state_names) == len(state_units) == n_states``;
+  controller: ``n_state`` equals the size of ``init_state``;
+* ``record size``: the kernel runs once as plain Python (``py_func``) on records of exactly
+  the packed size: numpy bounds-checks every index, so a kernel that reads past its
+  parameter record, its state or the plant state is named (numba does not check bounds:
+  compiled, it would read the neighbouring memory silently);
+* ``writes only its own``: ship: ``rhs`` writes ``dx[:n_states]`` only (the rudder's
+  derivative is the gear's), checked with a NaN guard;
+* ``no allocation``: the compiled kernel (LLVM IR) calls no allocator (``np.empty``,
+  ``np.zeros``, array expressions ...): kernels run millions of times per second inside the
+  compiled loops and the batch lanes;
+* ``compiles``: numba compiles the kernel for the engine's argument types;
+* ``parity``: the readable and the compiled engine give the same run (rtol = atol = 1e-12)
+  on the short scenario.
 
 A violation raises :class:`~steerlab.errors.InputError` with one line naming the component
 and the rule, e.g. ``controller 'my_pid': rule 'no allocation': the compiled kernel

@@ -176,11 +176,13 @@ def controller(type: str, *, ship=None, speed_kn=None, nomoto=None, b2=None, gea
     ----------
     type : str
         Controller name, e.g. ``"pid"``, ``"adrc"``, ``"lq_pd"``, ``"sliding_mode"``.
-    ship, speed_kn : str, float
-        Design from catalogue ship ``ship`` at ``speed_kn`` [kn] ...
-    nomoto : (K [1/s], T [s])
-        ... or from a first-order Nomoto model alone (``b2`` defaults to K/T [1/s^2]) ...
-        (or neither, for laws that need no model, e.g. a fixed-gain ``pid``).
+    ship : str, optional
+        Design from catalogue ship ``ship`` (``steerlab ships``) at ``speed_kn`` ...
+    speed_kn : float, optional
+        ... the ship's speed [kn] ...
+    nomoto : tuple of float, optional
+        ``(K [1/s], T [s])``: ... or from a first-order Nomoto model alone (``b2`` defaults
+        to K/T [1/s^2]) ... (or neither, for laws that need no model, e.g. a fixed-gain ``pid``).
     b2 : float, optional
         Rudder efficiency [1/s^2] for laws that use it (ADRC's ``c0 = "estimate"/"exact"``).
     gear : None, SteeringGear or dict of ``[gear]`` keys
