@@ -93,3 +93,47 @@ def test_ship_checks():
         check_ship(replace(esso, name="esso_alloc_t", rhs=rhs_alloc))
     _one_line_naming(err, "no allocation", "esso_alloc_t")
     assert "esso_alloc_t" not in SHIPS
+
+
+_CACHED_ALLOCATING = '''
+import numba, numpy as np
+@numba.njit(cache=True)
+def law(z, p, t, x, ref, h):
+    tmp = np.zeros(2)
+    tmp[0] = p[0] * (ref[0] - x[2])
+    return tmp[0]
+'''
+
+_CHECK_IT = '''
+import sys
+sys.path.insert(0, sys.argv[1])
+from dataclasses import replace
+from typing import Literal
+from pydantic import create_model
+import cached_alloc_law
+from steerlab.control.pid import PIDConfig
+from steerlab.control.registry import get_controller
+from steerlab.errors import InputError
+from steerlab.testing import check_controller
+cfg = create_model("CfgCachedAlloc", __base__=PIDConfig, type=(Literal["cached_alloc_t"], ...))
+try:
+    check_controller(replace(get_controller("pid"), name="cached_alloc_t", config=cfg,
+                             update=cached_alloc_law.law))
+    print("PASSED")
+except InputError as err:
+    print(str(err))
+'''
+
+
+def test_an_allocating_kernel_loaded_from_numba_disk_cache_is_still_caught(tmp_path):
+    """numba returns no IR for code it loaded from its disk cache; the check compiles a fresh copy."""
+    import subprocess
+    import sys
+
+    (tmp_path / "cached_alloc_law.py").write_text(_CACHED_ALLOCATING)
+    for _ in range(2):                               # the second process loads the kernel from the cache
+        out = subprocess.run([sys.executable, "-c", _CHECK_IT, str(tmp_path)], capture_output=True,
+                             text=True, timeout=600)
+        assert out.returncode == 0, out.stderr
+        assert "no allocation" in out.stdout, out.stdout
+    assert list(tmp_path.rglob("*.nbi"))              # it really was disk-cached

@@ -45,9 +45,17 @@ def _fail(kind: str, name: str, rule: str, msg: str):
 
 
 def _allocates(dispatcher) -> bool:
-    """Whether any compiled signature of ``dispatcher`` calls the NRT allocator."""
+    """Whether any compiled signature of ``dispatcher`` calls the NRT allocator.
+
+    Inspected on a fresh, uncached compile of the same function: numba returns no IR for code
+    it loaded from its disk cache (a ``cache=True`` kernel compiled in an earlier process), which
+    would let an allocating kernel pass."""
+    import numba
+
+    fresh = numba.njit(dispatcher.py_func)
     for sig in dispatcher.signatures:
-        ir = dispatcher.inspect_llvm(sig)
+        fresh.compile(sig)
+        ir = fresh.inspect_llvm(sig)
         if any(a in ir for a in _ALLOCATORS):
             return True
     return False
