@@ -314,3 +314,30 @@ def test_config_fields_defaults_replace_the_declared_default_only():
     fields = LAYOUT.config_fields(("Kp", "T"), defaults={"T": 30.0})
     assert fields["T"][1].default == 30.0 and fields["Kp"][1].default is None
     assert [m.gt for m in fields["T"][1].metadata if hasattr(m, "gt")] == [0.0]
+
+
+def _literal_state_or_reference_indices(path):
+    """``x[<int>]`` / ``ref[<int>]`` in code (not in strings or comments) of ``path``."""
+    import io
+    import tokenize
+
+    toks = list(tokenize.generate_tokens(io.StringIO(path.read_text(encoding="utf-8")).readline))
+    out = []
+    for a, b, c, d in zip(toks, toks[1:], toks[2:], toks[3:]):
+        if (a.type == tokenize.NAME and a.string in ("x", "xf", "xs", "ref") and b.string == "["
+                and c.type == tokenize.NUMBER and d.string == "]"):
+            out.append(f"{path.name}:{a.start[0]}: {a.string}[{c.string}]")
+    return out
+
+
+def test_controllers_guidance_and_loops_read_plant_state_and_reference_by_name():
+    """The plant state (ships/state.py) and the reference vector are read through their
+    generated constants (x[IPSI], ref[REF_PSI]) in every controller, guidance kernel and loop."""
+    from pathlib import Path
+
+    src = Path(__file__).resolve().parent.parent / "src" / "steerlab"
+    paths = [*sorted((src / "control").glob("*.py")), *sorted((src / "guidance").glob("*.py")),
+             src / "sim" / "driver_template.py", src / "trials" / "rate_hold.py",
+             src / "trials" / "zigzag_logic.py", src / "gym" / "plant_batch.py"]
+    found = [hit for p in paths for hit in _literal_state_or_reference_indices(p)]
+    assert not found, found

@@ -32,7 +32,8 @@ import numpy as np
 
 from steerlab.control.registry import get_controller
 from steerlab.errors import InputError
-from steerlab.guidance.reference_vector import initial_reference
+from steerlab.guidance.reference_vector import REF_PSI, REF_R, initial_reference
+from steerlab.ships.state import IPSI, IR, IU
 
 #: keyword arguments of :func:`controller` that describe the loop, not the law
 LOOP_ARGS = ("ship", "speed_kn", "nomoto", "b2", "gear", "dt", "ship_options", "length_m")
@@ -105,9 +106,9 @@ class Controller:
 
     # ----------------------------------------------------------- plant-state layout
     def _fill(self, x, heading, yaw_rate, rudder, speed):
-        x[2] = _finite("heading", heading)
-        x[3] = self.speed if speed is None else _finite("speed", speed)
-        x[5] = _finite("yaw_rate", yaw_rate)
+        x[IPSI] = _finite("heading", heading)
+        x[IU] = self.speed if speed is None else _finite("speed", speed)
+        x[IR] = _finite("yaw_rate", yaw_rate)
         x[self._nx - 1] = self._last if rudder is None else _finite("rudder", rudder)
 
     def reset(self, heading=0.0, yaw_rate=0.0, heading_ref=None, yaw_rate_ref=0.0, rudder=0.0, speed=None):
@@ -118,7 +119,7 @@ class Controller:
         x = np.full(self._nx, np.nan)
         self._last = 0.0
         self._fill(x, heading, yaw_rate, rudder, speed)
-        psi_ref = x[2] if heading_ref is None else _finite("heading_ref", heading_ref)
+        psi_ref = x[IPSI] if heading_ref is None else _finite("heading_ref", heading_ref)
         z0 = np.asarray(self.design.init_state(x, (psi_ref, _finite("yaw_rate_ref", yaw_rate_ref))),
                         dtype=np.float64)
         if z0.shape != (self.spec.n_state,):
@@ -149,8 +150,8 @@ class Controller:
 
     def _update(self, t, x, heading_ref, yaw_rate_ref):
         ref = self._ref
-        ref[0] = _finite("heading_ref", heading_ref)
-        ref[1] = _finite("yaw_rate_ref", yaw_rate_ref)
+        ref[REF_PSI] = _finite("heading_ref", heading_ref)
+        ref[REF_R] = _finite("yaw_rate_ref", yaw_rate_ref)
         u = float(self.spec.update(self.state, self.params, _finite("t", t), x, ref, self.sample_time))
         self._last = u
         return u

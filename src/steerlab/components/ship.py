@@ -28,6 +28,7 @@ from steerlab.environment.channels import CHANNEL_NAMES, N_CHANNELS
 from steerlab.errors import InputError, require_finite_range
 from steerlab.ships.registry import get_ship
 from steerlab.units import knots_to_ms
+from steerlab.ships.state import IPSI, IR, IU, IX, IY
 
 
 def disturbance_row(disturbance) -> np.ndarray:
@@ -92,10 +93,10 @@ class Ship:
         turning at ``yaw_rate`` [rad/s] with the rudder at ``rudder`` [rad]; ``t = 0``. Returns ``self``."""
         x = self.state
         x[:] = 0.0
-        x[0], x[1] = (require_finite_range("position", v) for v in position)
-        x[2] = require_finite_range("heading", heading)
-        x[3] = self.speed
-        x[5] = require_finite_range("yaw_rate", yaw_rate)
+        x[IX], x[IY] = (require_finite_range("position", v) for v in position)
+        x[IPSI] = require_finite_range("heading", heading)
+        x[IU] = self.speed
+        x[IR] = require_finite_range("yaw_rate", yaw_rate)
         x[-1] = require_finite_range("rudder", rudder, -self.gear.delta_max, self.gear.delta_max)
         self.t = 0.0
         self._t0, self._k, self._h = 0.0, 0, None

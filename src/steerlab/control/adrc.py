@@ -44,6 +44,8 @@ from steerlab.errors import InputError, require_finite_range
 from steerlab.records import Field as RecordField
 from steerlab.records import Layout
 from steerlab.units import rad
+from steerlab.ships.state import IPSI, IR
+from steerlab.guidance.reference_vector import REF_PSI, REF_R
 
 PARAMS = Layout("controller", "A_", [
     RecordField("C0", "c0", "1/s^2", "rudder efficiency b2 of (37), steerlab's sign (non-zero)"),
@@ -110,16 +112,16 @@ class ADRC(NamedTuple):
 
     def init_state(self, x0, ref0) -> np.ndarray:
         """ESO starts at the measured heading and yaw rate with no disturbance estimate."""
-        return STATE.pack(psi_hat=x0[2], r_hat=x0[5], f_hat=0.0)
+        return STATE.pack(psi_hat=x0[IPSI], r_hat=x0[IR], f_hat=0.0)
 
 
 @numba.njit(cache=True)
 def adrc_update(z, p, t, x, ref, h):
     """One ADRC sample: law (7d) on the current estimate, then the ESO (7a) advances."""
-    y = x[2]
+    y = x[IPSI]
     c0 = p[A_C0]
-    e = wrap_to_pi(ref[0] - y)
-    u0 = p[A_KP] * e + p[A_KDSIGN] * p[A_KD] * (z[Z_R] - ref[1])
+    e = wrap_to_pi(ref[REF_PSI] - y)
+    u0 = p[A_KP] * e + p[A_KDSIGN] * p[A_KD] * (z[Z_R] - ref[REF_R])
     u = (u0 - z[Z_F]) / c0
     umax = p[A_UMAX]
     u = min(max(u, -umax), umax)

@@ -72,6 +72,8 @@ from steerlab.control.wave_filter import (F_DELTA, F_PSI, F_R, F_XI, WaveFilterC
                                           wave_filter_init, wave_filter_step)
 from steerlab.errors import InputError, require_finite_range
 from steerlab.units import knots_to_ms, rad
+from steerlab.ships.state import IPSI, IR, IU
+from steerlab.guidance.reference_vector import REF_PSI
 
 
 class ASA(NamedTuple):
@@ -150,17 +152,17 @@ class ASA(NamedTuple):
         """Course keeping at the initial order; filter at the measured state; K*, tau* initial."""
         z = np.zeros(N_STATE)
         delta0 = float(x0[len(x0) - 1])
-        wave_filter_init(z, float(x0[2]), float(x0[5]), delta0)
+        wave_filter_init(z, float(x0[IPSI]), float(x0[IR]), delta0)
         z[Z_MODE] = 0.0
         z[Z_PSI_SET] = float(ref0[0])
-        z[Z_PSI_M] = float(x0[2])
-        z[Z_R_M] = float(x0[5])
+        z[Z_PSI_M] = float(x0[IPSI])
+        z[Z_R_M] = float(x0[IR])
         z[Z_T_START] = 0.0
         z[Z_T_REACHED] = -1.0
         z[Z_A] = 1.0 / self.tau_star0
         z[Z_B] = self.K_star0 / self.tau_star0
-        U = float(x0[3]) if float(x0[3]) > 0.0 else self.U0
-        z[Z_RM_ID] = float(x0[5]) * self.L / U
+        U = float(x0[IU]) if float(x0[IU]) > 0.0 else self.U0
+        z[Z_RM_ID] = float(x0[IR]) * self.L / U
         z[Z_DELTA_LIM] = self.u_max
         return z
 
@@ -170,10 +172,10 @@ def asa_update(z, p, t, x, ref, h):
     """One ASA sample: returns the rudder order [rad]; updates ``z`` in place (see module doc)."""
     nx = x.shape[0]
     delta_act = x[nx - 1]
-    psi = x[2]
-    r = x[5]
+    psi = x[IPSI]
+    r = x[IR]
     u_freeze = p[P_U_FREEZE]
-    U = x[3]
+    U = x[IU]
     frozen = U < u_freeze
     Us = max(U, u_freeze)
     LU = p[P_L] / Us
@@ -193,7 +195,7 @@ def asa_update(z, p, t, x, ref, h):
         psi_h = psi
         r_h = r
     # 2. mode logic
-    asa_mode_step(z, p, t, ref[0], psi_h, r_h, Ks, taus, LU, U0U)
+    asa_mode_step(z, p, t, ref[REF_PSI], psi_h, r_h, Ks, taus, LU, U0U)
     adapt = (not frozen) and z[Z_SAT] < 0.5
     u_max = p[P_U_MAX]
     if z[Z_MODE] == MODE_CHANGING:

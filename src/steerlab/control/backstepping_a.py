@@ -54,6 +54,8 @@ from steerlab.errors import InputError
 from steerlab.records import Field as RecordField
 from steerlab.records import Layout
 from steerlab.ships.van_leeuwen import N_SET, SET, vl_drift, vl_gain
+from steerlab.ships.state import IPSI, IR
+from steerlab.guidance.reference_vector import REF_PSI, REF_R
 
 
 def _gain(i: int, doc: str, default: float) -> RecordField:
@@ -109,7 +111,7 @@ class Backstepping(NamedTuple):
         return PARAMS.pack(rec)
 
     def init_state(self, x0, ref0) -> np.ndarray:
-        return STATE.pack(r_prev=x0[5])
+        return STATE.pack(r_prev=x0[IR])
 
 
 @numba.njit(cache=True)
@@ -119,8 +121,8 @@ def backstepping_errors(p, x, ref, rd):
     k1 = p[B_K1]
     k2 = p[B_K2]
     tu = p[B_TU]
-    z1 = wrap_to_pi(x[2] - ref[0])
-    z2 = (x[5] - ref[1]) * tu + k1 * z1
+    z1 = wrap_to_pi(x[IPSI] - ref[REF_PSI])
+    z2 = (x[IR] - ref[REF_R]) * tu + k1 * z1
     z1d = z2 - k1 * z1
     alpha2 = -k2 * z2 - z1 - k1 * z1d
     z3 = rd * tu * tu - alpha2
@@ -136,7 +138,7 @@ def backstepping_a_update(z, p, t, x, ref, h):
     z1, z2, z3, z1d, z2d, a2d = backstepping_errors(p, x, ref, rd)
     mu = p[B_MU]
     tu3 = p[B_TU] ** 3
-    f = vl_drift(p, B_SET, mu, x[5], rd) * tu3
+    f = vl_drift(p, B_SET, mu, x[IR], rd) * tu3
     u = (-p[B_K3] * z3 - z2 - f + a2d) / (vl_gain(p, B_SET, mu) * tu3)
     umax = p[B_UMAX]
     return min(max(u, -umax), umax)

@@ -44,6 +44,7 @@ from steerlab.control.backstepping_a import (B_IRDOT, B_K1, B_K2, B_K3, B_K4, B_
 from steerlab.control.registry import ControllerSpec
 from steerlab.control.van_leeuwen_design import yaw_accel
 from steerlab.ships.van_leeuwen import vl_drift, vl_drift_partials, vl_gain
+from steerlab.ships.state import IR
 
 
 @numba.njit(cache=True)
@@ -56,7 +57,7 @@ def backstepping_b_update(z, p, t, x, ref, h):
     k3 = p[B_K3]
     mu = p[B_MU]
     tu = p[B_TU]
-    r = x[5]
+    r = x[IR]
     x4 = x[x.shape[0] - 1]
     g = vl_gain(p, B_SET, mu) * tu * tu * tu
     f = vl_drift(p, B_SET, mu, r, rd) * tu * tu * tu

@@ -59,6 +59,8 @@ from steerlab.errors import InputError
 from steerlab.records import Field as RecordField
 from steerlab.records import Layout
 from steerlab.units import rad
+from steerlab.ships.state import IPSI, IR
+from steerlab.guidance.reference_vector import REF_PSI, REF_R
 
 PARAMS = Layout("controller", "C_", [
     RecordField("KP", "Kp", "rad/rad", "'rudder' action (van Amerongen 1982, Fig. 3.3)", lo=0.0, default=1.0),
@@ -127,10 +129,10 @@ def dead_band(x, w):
 @numba.njit(cache=True)
 def classic_autopilot_update(z, p, t, x, ref, h):
     """One sample of the classic autopilot; returns the rudder order [rad] (see module doc)."""
-    e = wrap_to_pi(ref[0] - x[2])
+    e = wrap_to_pi(ref[REF_PSI] - x[IPSI])
     on_order = p[C_ON_ORDER] != 0.0
     e_w = e if on_order else dead_band(e, p[C_WEATHER])
-    u_pid = p[C_KP] * e_w + p[C_KI] * z[Z_INT] - p[C_KD] * (x[5] - ref[1])
+    u_pid = p[C_KP] * e_w + p[C_KI] * z[Z_INT] - p[C_KD] * (x[IR] - ref[REF_R])
     tf = p[C_TF]
     if tf > 0.0:
         a = math.exp(-h / tf)
@@ -141,7 +143,7 @@ def classic_autopilot_update(z, p, t, x, ref, h):
     u_d = dead_band(u_f, p[C_WEATHER]) if on_order else u_f
     umax = p[C_UMAX]
     u = min(max(u_d, -umax), umax)
-    turning = ref[1] != 0.0 or abs(e) > p[C_ECC]
+    turning = ref[REF_R] != 0.0 or abs(e) > p[C_ECC]
     if not turning and (u == u_d or e_w * u_d < 0.0):
         z[Z_INT] += e_w * h
     return u

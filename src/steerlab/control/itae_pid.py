@@ -81,6 +81,8 @@ from steerlab.errors import InputError, require_finite_range
 from steerlab.records import Field as RecordField
 from steerlab.records import Layout
 from steerlab.units import knots_to_ms, rad
+from steerlab.ships.state import IPSI, IR, IU
+from steerlab.guidance.reference_vector import REF_PSI
 
 ITAE_C1 = 1.75
 POLYNOMIALS = {"dorf": 2.15, "eq6": 1.0}
@@ -178,15 +180,15 @@ def itae_pid_update(z, p, t, x, ref, h):
     T = p[I_TM]
     if p[I_SCHED] != 0.0:                      # eq (2) on the present surge speed
         vm = p[I_VM]
-        v = max(x[3], p[I_VMIN] * vm)
+        v = max(x[IU], p[I_VMIN] * vm)
         k = k * v / vm
         T = T * vm / v
     h1 = p[I_C2] * w0 * w0 * T / k
     h2 = w0 * w0 * w0 * T / k
     h3 = (ITAE_C1 * w0 * T - 1.0) / k
     # PID (3) on the pre-filtered error, derivative from the pre-filter's rate
-    eps = wrap_to_pi(z[Z_PSI_P] - x[2])
-    ud = h1 * eps + h2 * z[Z_INT] + h3 * (z[Z_R_P] - x[5])
+    eps = wrap_to_pi(z[Z_PSI_P] - x[IPSI])
+    ud = h1 * eps + h2 * z[Z_INT] + h3 * (z[Z_R_P] - x[IR])
     umax = p[I_UMAX]
     u = min(max(ud, -umax), umax)
     if p[I_AW] == 0.0 or u == ud or eps * ud < 0.0:
@@ -194,7 +196,7 @@ def itae_pid_update(z, p, t, x, ref, h):
     # pre-filter (11): a2 y'' + a1 y' + y = psi_d, Tustin step relative to y
     a2 = h3 / h2
     a1 = h1 / h2
-    d = wrap_to_pi(ref[0] - z[Z_PSI_P])        # input relative to the present output
+    d = wrap_to_pi(ref[REF_PSI] - z[Z_PSI_P])        # input relative to the present output
     q = 0.5 * h / a2
     m11 = 1.0 + q * a1
     det = m11 + 0.5 * h * q

@@ -55,6 +55,8 @@ from steerlab.control.tracking_differentiator import TD, td_step
 from steerlab.errors import InputError, require_finite_range
 from steerlab.records import Field as RecordField
 from steerlab.records import Layout
+from steerlab.ships.state import IPSI, IR
+from steerlab.guidance.reference_vector import REF_PSI
 
 
 def _fal_exponent(const, name, doc, default):
@@ -135,7 +137,7 @@ class NonlinearADRC(NamedTuple):
 
     def init_state(self, x0, ref0) -> np.ndarray:
         """TD at the initial set heading, ESO at the measured heading and rate, no disturbance."""
-        return STATE.pack(v1=ref0[0], v2=0.0, z1=x0[2], z2=x0[5], z3=0.0)
+        return STATE.pack(v1=ref0[0], v2=0.0, z1=x0[IPSI], z2=x0[IR], z3=0.0)
 
 
 @numba.njit(cache=True)
@@ -147,14 +149,14 @@ def nlsef(e1, e2, p):
 @numba.njit(cache=True)
 def nonlinear_adrc_update(z, p, t, x, ref, h):
     """One sample of (27): TD, NLSEF on the current estimate, then the ESO with the applied order."""
-    td_step(z, Z_V1, ref[0], p[N_R], p[N_H0], h)
+    td_step(z, Z_V1, ref[REF_PSI], p[N_R], p[N_H0], h)
     b = p[N_B]
     u0 = nlsef(wrap_to_pi(z[Z_V1] - z[Z_Z1]), z[Z_V2] - z[Z_Z2], p)
     u = u0 - z[Z_Z3] / b
     umax = p[N_UMAX]
     u = min(max(u, -umax), umax)
     nleso_step(z, Z_Z1, b, p[N_BETA1], p[N_BETA2], p[N_BETA3], p[N_A01], p[N_D01], p[N_A02],
-               p[N_D02], x[2], u, h)
+               p[N_D02], x[IPSI], u, h)
     return u
 
 

@@ -26,6 +26,8 @@ from steerlab.control.registry import ControllerSpec
 from steerlab.records import Field as RecordField
 from steerlab.records import Layout
 from steerlab.units import rad
+from steerlab.ships.state import IPSI, IR
+from steerlab.guidance.reference_vector import REF_PSI, REF_R
 
 PARAMS = Layout("controller", "C_", [
     RecordField("KP", "Kp", "rad/rad", "proportional gain (Zwierzewicz et al. 2021, Sec. 7: 3.81)",
@@ -54,8 +56,8 @@ PID = PARAMS.record_type("PID", {"init_state": _init_state})
 @numba.njit(cache=True)
 def pid_update(z, p, t, x, ref, h):
     """One PID sample; returns the rudder order [rad] and advances the integral ``z[Z_INT]``."""
-    e = wrap_to_pi(ref[0] - x[2])
-    ud = p[C_KP] * e + p[C_KI] * z[Z_INT] - p[C_KD] * (x[5] - ref[1])
+    e = wrap_to_pi(ref[REF_PSI] - x[IPSI])
+    ud = p[C_KP] * e + p[C_KI] * z[Z_INT] - p[C_KD] * (x[IR] - ref[REF_R])
     umax = p[C_UMAX]
     u = min(max(ud, -umax), umax)
     if u == ud or e * ud < 0.0:

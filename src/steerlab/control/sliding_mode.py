@@ -48,6 +48,8 @@ from steerlab.records import Field as RecordField
 from steerlab.records import Layout
 from steerlab.ships import van_leeuwen as vl
 from steerlab.units import rad
+from steerlab.ships.state import IPSI, IR
+from steerlab.guidance.reference_vector import REF_PSI, REF_R
 
 _PER_ERROR = ("rad/rad", "s", "s^2", "rad/rad")   # rad per unit of x~ = [psi error, r error, r', delta], eq (12)
 PARAMS = Layout("controller", "S_", [
@@ -117,15 +119,15 @@ class SlidingMode(NamedTuple):
                            eta=self.eta, phi=self.phi, hb=self.hb, i_rdot=self.i_rdot, u_max=self.u_max)
 
     def init_state(self, x0, ref0) -> np.ndarray:
-        return STATE.pack(r_prev=x0[5])
+        return STATE.pack(r_prev=x0[IR])
 
 
 @numba.njit(cache=True)
 def sliding_mode_update(z, p, t, x, ref, h):
     """One sample of law (17): the rudder order [rad]."""
     rd = yaw_accel(z, Z_R_PREV, p[S_IRDOT], x, h)
-    e1 = wrap_to_pi(x[2] - ref[0])
-    e2 = x[5] - ref[1]
+    e1 = wrap_to_pi(x[IPSI] - ref[REF_PSI])
+    e2 = x[IR] - ref[REF_R]
     e4 = x[x.shape[0] - 1]
     s = p[S_H1] * e1 + p[S_H2] * e2 + p[S_H3] * rd + p[S_H4] * e4
     q = s / p[S_PHI]

@@ -32,6 +32,7 @@ import numpy as np
 
 from steerlab.errors import InputError
 from steerlab.ships import van_leeuwen as vl
+from steerlab.ships.state import IR
 
 
 def design_model(ctx, design_loading: str | None, T2: float | None):
@@ -88,6 +89,6 @@ def yaw_accel(z, iz, i_rdot, x, h):
     of the yaw rate over the sample ``h`` (the previous rate is kept in ``z[iz]``)."""
     if i_rdot >= 0.0:
         return x[int(i_rdot)]
-    rd = (x[5] - z[iz]) / h
-    z[iz] = x[5]
+    rd = (x[IR] - z[iz]) / h
+    z[iz] = x[IR]
     return rd

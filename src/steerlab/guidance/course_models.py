@@ -50,6 +50,7 @@ import numpy as np
 from steerlab.angles import wrap_to_pi
 from steerlab.control.asa_reference import series_model_step
 from steerlab.errors import InputError, require_finite_range
+from steerlab.guidance.reference_vector import REF_PSI, REF_R, REF_RDOT
 
 KIND_RATE_LIMITED = 1
 KIND_THIRD_ORDER = 2
@@ -124,18 +125,18 @@ def course_model_guidance(t, x, g, z, ref, h):
         psi = z[0]
         r = z[1]
         _, acc = series_model_step(z, 0, 1, e, g[1], g[2], g[3], g[4], h)
-        ref[0] = wrap_to_pi(psi)
-        ref[1] = r
-        ref[2] = acc
+        ref[REF_PSI] = wrap_to_pi(psi)
+        ref[REF_R] = r
+        ref[REF_RDOT] = acc
     else:
         w = g[1]
         c = 2.0 * g[2] + 1.0
         psi = z[0]
         r = z[1]
         a = z[2]
-        ref[0] = wrap_to_pi(psi)
-        ref[1] = r
-        ref[2] = a
+        ref[REF_PSI] = wrap_to_pi(psi)
+        ref[REF_R] = r
+        ref[REF_RDOT] = a
         jerk = w * w * w * e - c * w * w * r - c * w * a
         r_max = g[3]
         a_max = g[4]

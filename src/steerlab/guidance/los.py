@@ -42,6 +42,8 @@ import numpy as np
 
 from steerlab.angles import wrap_to_pi
 from steerlab.errors import InputError, require_finite_range
+from steerlab.ships.state import IX, IY
+from steerlab.guidance.reference_vector import REF_LEG, REF_PSI, REF_R, REF_RDOT, REF_RPM, REF_XTE
 
 G_WP = 5
 N_STATE = 3
@@ -140,8 +142,8 @@ def los_guidance(t, x, g, z, ref, h):
     R = g[1]
     n = int(g[2])
     ns = int(g[3])
-    px = x[0]
-    py = x[1]
+    px = x[IX]
+    py = x[IY]
     k = int(z[0])
     while k < n - 2:
         dxn = g[G_WP + 2 * k + 2] - px
@@ -159,11 +161,11 @@ def los_guidance(t, x, g, z, ref, h):
     ca = math.cos(alpha)
     sa = math.sin(alpha)
     e = -(px - xa) * sa + (py - ya) * ca
-    ref[0] = los_heading(alpha, e, delta_la)
-    ref[1] = 0.0
-    ref[2] = 0.0
-    ref[4] = e
-    ref[5] = k
+    ref[REF_PSI] = los_heading(alpha, e, delta_la)
+    ref[REF_R] = 0.0
+    ref[REF_RDOT] = 0.0
+    ref[REF_XTE] = e
+    ref[REF_LEG] = k
     # arrival at the last waypoint (the berth) and the propeller plan
     dxb = g[G_WP + 2 * n - 2] - px
     dyb = g[G_WP + 2 * n - 1] - py
@@ -173,9 +175,9 @@ def los_guidance(t, x, g, z, ref, h):
         if dist <= r_stop or dxb * ca + dyb * sa <= 0.0:
             z[2] = 1.0
     if z[2] != 0.0:
-        ref[5] = n - 1
+        ref[REF_LEG] = n - 1
     if ns == 0:
-        ref[3] = -1.0
+        ref[REF_RPM] = -1.0
         return
     s = int(z[1])
     o = G_WP + 2 * n
@@ -185,6 +187,6 @@ def los_guidance(t, x, g, z, ref, h):
     if z[2] != 0.0:
         ref[3] = 0.0
     elif s == 0:
-        ref[3] = -1.0
+        ref[REF_RPM] = -1.0
     else:
         ref[3] = g[o + ns + s - 1]

@@ -18,6 +18,7 @@ import numpy as np
 
 from steerlab.angles import wrap_to_pi
 from steerlab.errors import InputError, require_finite_range
+from steerlab.guidance.reference_vector import REF_PSI, REF_R
 
 
 def course_schedule(psi0: float, changes=(), rate_max: float = 0.0) -> np.ndarray:
@@ -62,8 +63,8 @@ def course_reference(t, g, ref):
             else:
                 psi = psi + math.copysign(reach, step)
                 r = math.copysign(rate, step)
-    ref[0] = wrap_to_pi(psi)
-    ref[1] = r
+    ref[REF_PSI] = wrap_to_pi(psi)
+    ref[REF_R] = r
 
 
 @numba.njit(cache=True)

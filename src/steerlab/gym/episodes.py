@@ -28,6 +28,7 @@ import numpy as np
 
 from steerlab.errors import InputError, require_finite_range
 from steerlab.units import rad
+from steerlab.ships.state import IPSI
 
 TASKS = ("course_keeping", "course_change", "track_following")
 
@@ -160,7 +161,7 @@ class Episodes:
         self.rew[lanes] = 0.0
         self._reset(lanes, self.X, self.PS, self.GZ, self.REF, self._x0, self._ps0, self.gz0, self._ref0, offsets,
                     self.gd, self.control_dt, self.rpm_slot, self.obs)
-        return [{"sea_seed": sea_seeds[q], "initial_heading": float(self.X[i, 2])}
+        return [{"sea_seed": sea_seeds[q], "initial_heading": float(self.X[i, IPSI])}
                 for q, i in enumerate(lanes.tolist())]
 
     # ----------------------------------------------------------------- step

@@ -34,8 +34,9 @@ import numba
 import numpy as np
 
 from steerlab.angles import wrap_to_pi
-from steerlab.guidance.reference_vector import REF_RPM
+from steerlab.guidance.reference_vector import REF_PSI, REF_RPM
 from steerlab.sim.kernels import plant_step
+from steerlab.ships.state import IPSI, IR
 
 
 REWARDS = ("speed_loss", "itae", "iae")
@@ -72,7 +73,7 @@ def finisher(guide):
         for q in range(nx):
             if not np.isfinite(x[q]):
                 ok = False
-        if not abs(x[5]) <= R_MAX:
+        if not abs(x[IR]) <= R_MAX:
             ok = False
         bad[i] = not ok
         if ok:
@@ -80,10 +81,10 @@ def finisher(guide):
             g(K[i] * dt, x, gd, GZ[i], ref, h_env)
             if rpm_slot >= 0 and ref[REF_RPM] >= 0.0:
                 PS[i, rpm_slot] = ref[REF_RPM]
-            e = wrap(ref[0] - x[2])
+            e = wrap(ref[REF_PSI] - x[IPSI])
             d = x[nx - 1]
             obs[i, 0] = e
-            obs[i, 1] = x[5]
+            obs[i, 1] = x[IR]
             obs[i, 2] = d
             if reward == REWARD_SPEED_LOSS:
                 rew[i] = -(e * e + lam * d * d) * h_env
@@ -166,7 +167,7 @@ def resetter(guide):
         for q in range(idx.shape[0]):
             i = idx[q]
             X[i, :] = x0
-            X[i, 2] += offsets[q]
+            X[i, IPSI] += offsets[q]
             PS[i, :] = ps
             GZ[i, :] = gz0
             REF[i, :] = ref0
@@ -181,6 +182,6 @@ def resetter(guide):
 @numba.njit
 def observe(x, psi_ref, out):
     """The observation ``[wrap(psi_ref - psi), r, delta]`` of plant state ``x``."""
-    out[0] = wrap_to_pi(psi_ref - x[2])
-    out[1] = x[5]
+    out[0] = wrap_to_pi(psi_ref - x[IPSI])
+    out[1] = x[IR]
     out[2] = x[x.shape[0] - 1]

@@ -16,6 +16,7 @@ import numpy as np
 
 from steerlab.environment.channels import N_CHANNELS
 from steerlab.steering_gear import SteeringGear
+from steerlab.ships.state import IPSI, IR, IU
 
 _PG = SteeringGear(delta_max=np.pi / 2, rate_max=100.0, T_sg=1.0, dead_zone=0.0).pack()
 
@@ -35,9 +36,9 @@ def simulate_response(ship_rhs, n_states: int, ps: np.ndarray, delta: np.ndarray
     second-order models).
     """
     x = np.zeros(n_states + 1)
-    x[2] = psi0
-    x[3] = speed
-    x[5] = r0
+    x[IPSI] = psi0
+    x[IU] = speed
+    x[IR] = r0
     if extra0 is not None:
         x[6:n_states] = extra0
     n = delta.shape[0]

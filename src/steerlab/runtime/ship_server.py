@@ -28,6 +28,7 @@ from steerlab.errors import InputError, require_finite_range
 from steerlab.runtime import protocol as P
 from steerlab.runtime.link_filter import LinkFilter
 from steerlab.runtime.udp import LOOPBACK, open_udp, send
+from steerlab.ships.state import IPSI, IR, IU, IV, IX, IY
 
 
 @dataclass(frozen=True)
@@ -173,7 +174,7 @@ class ShipServer:
 
     def state(self) -> P.State:
         x = self.x
-        return P.State(self.t_sim, x[0], x[1], math.remainder(x[2], 2 * math.pi), x[5], x[3], x[4],
+        return P.State(self.t_sim, x[IX], x[IY], math.remainder(x[IPSI], 2 * math.pi), x[IR], x[IU], x[IV],
                        x[-1], self.rpm, self.delta_cmd, self.status)
 
     def apply_command(self, cmd: P.Command) -> None:

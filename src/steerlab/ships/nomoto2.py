@@ -41,6 +41,7 @@ from pydantic import Field, model_validator
 from steerlab.config_base import FrozenConfig
 from steerlab.environment.channels import W_RUDDER, W_YAW_MOMENT
 from steerlab.ships.kinematics import earth_velocity
+from steerlab.ships.state import IPSI, IR, IU
 
 P_K, P_T1, P_T2, P_T3 = 0, 1, 2, 3
 N_PARAMS = 4
@@ -52,9 +53,9 @@ STATE_UNITS = ("m", "m", "rad", "m/s", "m/s", "rad/s", "rad/s^2")
 @numba.njit(cache=True)
 def nomoto2_rhs(t, x, delta, w, p, dx):
     """Derivatives of ``[x_n, y_e, psi, u, v, r, z]`` (see the module docstring)."""
-    psi = x[2]
-    u = x[3]
-    r = x[5]
+    psi = x[IPSI]
+    u = x[IU]
+    r = x[IR]
     z = x[6]
     t12 = p[P_T1] * p[P_T2]
     a = (p[P_T1] + p[P_T2]) / t12

@@ -34,7 +34,7 @@ from pydantic import Field
 from steerlab.config_base import FrozenConfig
 from steerlab.environment.channels import W_RUDDER, W_YAW_MOMENT
 from steerlab.ships.spiral_polynomial import spiral_polynomial
-from steerlab.ships.state import PLANAR_NAMES, PLANAR_UNITS
+from steerlab.ships.state import IPSI, IR, IU, PLANAR_NAMES, PLANAR_UNITS
 from steerlab.ships.kinematics import earth_velocity
 
 P_K, P_T, P_N0, P_N1, P_N2, P_N2A, P_N3 = 0, 1, 2, 3, 4, 5, 6
@@ -45,9 +45,9 @@ DEG = 180.0 / math.pi
 @numba.njit(cache=True)
 def norrbin_rhs(t, x, delta, w, p, dx):
     """Derivatives of ``[x_n, y_e, psi, u, v, r]`` (see the module docstring)."""
-    psi = x[2]
-    u = x[3]
-    r = x[5]
+    psi = x[IPSI]
+    u = x[IU]
+    r = x[IR]
     earth_velocity(psi, u, 0.0, w, dx)
     dx[2] = r
     dx[3] = 0.0

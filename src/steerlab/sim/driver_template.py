@@ -39,10 +39,11 @@ import numba
 import numpy as np
 
 from steerlab.angles import wrap_to_pi
-from steerlab.guidance.reference_vector import N_REF, REF_LEG, REF_RPM, REF_XTE
+from steerlab.guidance.reference_vector import N_REF, REF_LEG, REF_PSI, REF_RPM, REF_XTE
 from steerlab.metrics_online import accumulate
 from steerlab.sim.kernels import _fused, _jit_fused, rk4_stage, rk4_update
 from steerlab.steering_gear import gear_clamp, gear_rate
+from steerlab.ships.state import IPSI, IR
 
 # ---- bindings: replaced in every generated driver ----
 SHIP_RHS = None       # ship kernel rhs(t, x, delta, w, ps, dx)
@@ -112,15 +113,15 @@ def replay_rudder(x, delta, ps, pg, dt, w, psi_out, r_out, work):
     has diverged: it stops and the rest is NaN."""
     n = delta.shape[0]
     nd = x.shape[0] - 1
-    psi_out[0] = x[2]
-    r_out[0] = x[5]
+    psi_out[0] = x[IPSI]
+    r_out[0] = x[IR]
     for k in range(n - 1):
         d = 0.5 * (delta[k] + delta[k + 1])
         x[nd] = d
         rk4(k * dt, x, d, w, ps, pg, dt, work[0], work[1], work[2], work[3], work[4])
-        psi_out[k + 1] = x[2]
-        r_out[k + 1] = x[5]
-        if not (abs(x[5]) < 10.0):      # diverged: stop, mark the rest
+        psi_out[k + 1] = x[IPSI]
+        r_out[k + 1] = x[IR]
+        if not (abs(x[IR]) < 10.0):      # diverged: stop, mark the rest
             for j in range(k + 2, n):
                 psi_out[j] = np.nan
                 r_out[j] = np.nan
@@ -146,7 +147,7 @@ def loop(x, z, ps, pg, pc, gd, gz, w, dt, nc, n_steps, rec_every, out_x, out_cmd
             reference(t, x, gd, gz, ref, h)
             if rpm_slot >= 0 and ref[RPM] >= 0.0:
                 ps[rpm_slot] = ref[RPM]
-        e = wrap(ref[0] - x[2])
+        e = wrap(ref[REF_PSI] - x[IPSI])
         if sample:
             cmd = update(z, pc, t, x, ref, h)
         kc += 1
@@ -304,7 +305,7 @@ def group(X, Z, PS, PG, PC, GD, GZ, W, w_index, i0, n_act, dt, nc, n_steps, rec_
                 if rpm_slot >= 0 and REF[g, RPM] >= 0.0:
                     PS[i, rpm_slot] = REF[g, RPM]
                     PL[rpm_slot, g] = REF[g, RPM]
-            E[g] = wrap(REF[g, 0] - XL[2, g])
+            E[g] = wrap(REF[g, REF_PSI] - XL[IPSI, g])
             if sample:
                 CMD[g] = update(Z[i], PC[i], t, XL[:, g], REF[g], h)
         kc += 1

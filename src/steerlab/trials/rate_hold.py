@@ -24,6 +24,8 @@ import math
 import numba
 import numpy as np
 
+from steerlab.ships.state import IR
+
 R_KP, R_KI, R_UMAX, R_N, R_TABLE = 1, 2, 3, 4, 5
 
 
@@ -37,7 +39,7 @@ def rate_hold_update(z, p, t, x, ref, h):
             r_set = p[R_TABLE + 2 * i + 1]
         else:
             break
-    e = r_set - x[5]
+    e = r_set - x[IR]
     ud = p[R_KP] * e + p[R_KI] * z[0]
     umax = p[R_UMAX]
     u = min(max(ud, -umax), umax)

@@ -23,6 +23,7 @@ import numba
 import numpy as np
 
 from steerlab.angles import wrap_to_pi
+from steerlab.ships.state import IPSI
 
 Z_T0, Z_DELTA, Z_PSI_S, Z_PSI0 = 1, 2, 3, 4
 N_PARAMS = 5
@@ -33,7 +34,7 @@ def zigzag_update(z, p, t, x, ref, h):
     """Zig-zag rudder order [rad]; ``z[0]`` holds the present order (see the module docstring)."""
     if t < p[Z_T0]:
         return 0.0
-    e = wrap_to_pi(x[2] - p[Z_PSI0])
+    e = wrap_to_pi(x[IPSI] - p[Z_PSI0])
     a = abs(p[Z_DELTA])
     if z[0] > 0.0 and e >= p[Z_PSI_S]:
         z[0] = -a
