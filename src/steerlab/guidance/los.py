@@ -185,8 +185,8 @@ def los_guidance(t, x, g, z, ref, h):
         s += 1
     z[1] = s
     if z[2] != 0.0:
-        ref[3] = 0.0
+        ref[REF_RPM] = 0.0
     elif s == 0:
         ref[REF_RPM] = -1.0
     else:
-        ref[3] = g[o + ns + s - 1]
+        ref[REF_RPM] = g[o + ns + s - 1]
