@@ -23,6 +23,8 @@ DECLARED = {
     "steerlab.ships.state": ("PLANAR", "I", "N_PLANAR"),
     "steerlab.ships.esso_3dof": ("PARAMS", "P_", "N_PARAMS"),
     "steerlab.ships.nomoto1": ("PARAMS", "P_", "N_PARAMS"),
+    "steerlab.ships.nomoto2": [("PARAMS", "P_", "N_PARAMS"), ("STATE", "", "N_STATES")],
+    "steerlab.ships.norrbin": ("PARAMS", "P_", "N_PARAMS"),
     "steerlab.ships.bech": [("PARAMS", "P_", "N_PARAMS"), ("STATE", "", "N_STATES")],
     "steerlab.ships.van_leeuwen": [("SET", "S_", "N_SET"), ("PARAMS", "P_", "N_PARAMS"), ("STATE", "", "N_STATES")],
     "steerlab.ships.rpm_schedule": ("RATE", "R_", "N_RATE_HEAD"),

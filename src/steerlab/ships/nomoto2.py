@@ -40,14 +40,24 @@ from pydantic import Field, model_validator
 
 from steerlab.config_base import FrozenConfig
 from steerlab.environment.channels import W_RUDDER, W_YAW_MOMENT
+from steerlab.records import Field as RecordField
+from steerlab.records import Layout
 from steerlab.ships.kinematics import earth_velocity
-from steerlab.ships.state import IPSI, IR, IU
+from steerlab.ships.state import IPSI, IR, IU, IV, ship_state
 
-P_K, P_T1, P_T2, P_T3 = 0, 1, 2, 3
-N_PARAMS = 4
-N_STATES = 7
-STATE_NAMES = ("x_n", "y_e", "psi", "u", "v", "r", "z")
-STATE_UNITS = ("m", "m", "rad", "m/s", "m/s", "rad/s", "rad/s^2")
+PARAMS = Layout("ship", "P_", [
+    RecordField("K", "K", "1/s", "gain (Nomoto 1957; van Amerongen 1982 eq 2.14)"),
+    RecordField("T1", "T1", "s", "time constant, non-zero; < 0: course-unstable"),
+    RecordField("T2", "T2", "s", "time constant"),
+    RecordField("T3", "T3", "s", "zero time constant (rudder derivative term)"),
+], size_name="N_PARAMS")
+PARAMS.export(globals())         # P_K = 0, P_T1 = 1, P_T2 = 2, P_T3 = 3, N_PARAMS = 4
+STATE = ship_state("ship state", "I_", [
+    RecordField("Z", "z", "rad/s^2", "observable-canonical state z = r' + a r - b T3 delta"),
+])
+STATE.export(globals())          # the planar IX..IR, I_Z = 6, N_STATES = 7
+STATE_NAMES = STATE.names
+STATE_UNITS = STATE.units
 
 
 @numba.njit(cache=True)
@@ -56,17 +66,17 @@ def nomoto2_rhs(t, x, delta, w, p, dx):
     psi = x[IPSI]
     u = x[IU]
     r = x[IR]
-    z = x[6]
+    z = x[I_Z]
     t12 = p[P_T1] * p[P_T2]
     a = (p[P_T1] + p[P_T2]) / t12
     b = p[P_K] / t12
     d = delta + w[W_RUDDER]
     earth_velocity(psi, u, 0.0, w, dx)
-    dx[2] = r
-    dx[3] = 0.0
-    dx[4] = 0.0
-    dx[5] = z - a * r + b * p[P_T3] * d + w[W_YAW_MOMENT]
-    dx[6] = b * d - r / t12
+    dx[IPSI] = r
+    dx[IU] = 0.0
+    dx[IV] = 0.0
+    dx[IR] = z - a * r + b * p[P_T3] * d + w[W_YAW_MOMENT]
+    dx[I_Z] = b * d - r / t12
 
 
 class Nomoto2Options(FrozenConfig):
@@ -87,7 +97,7 @@ class Nomoto2Options(FrozenConfig):
 
 def pack_params(K: float, T1: float, T2: float, T3: float) -> np.ndarray:
     """The packed record ``[K, T1, T2, T3]`` (SI)."""
-    return np.array([K, T1, T2, T3], dtype=np.float64)
+    return PARAMS.pack(K=K, T1=T1, T2=T2, T3=T3)
 
 
 def pack(speed: float, rpm=None, options: Nomoto2Options | None = None) -> np.ndarray:

@@ -33,12 +33,22 @@ from pydantic import Field
 
 from steerlab.config_base import FrozenConfig
 from steerlab.environment.channels import W_RUDDER, W_YAW_MOMENT
-from steerlab.ships.spiral_polynomial import spiral_polynomial
-from steerlab.ships.state import IPSI, IR, IU, PLANAR_NAMES, PLANAR_UNITS
+from steerlab.records import Field as RecordField
+from steerlab.records import Layout
 from steerlab.ships.kinematics import earth_velocity
+from steerlab.ships.spiral_polynomial import spiral_polynomial
+from steerlab.ships.state import IPSI, IR, IU, IV, PLANAR_NAMES, PLANAR_UNITS
 
-P_K, P_T, P_N0, P_N1, P_N2, P_N2A, P_N3 = 0, 1, 2, 3, 4, 5, 6
-N_PARAMS = 7
+PARAMS = Layout("ship", "P_", [
+    RecordField("K", "K", "1/s", "gain (Norrbin; van Amerongen 1982 Sec. 2.3.2)"),
+    RecordField("T", "T", "s", "time constant, non-zero"),
+    RecordField("N0", "n0", "rad/s", "H_N(0): yaw rate the zero rudder holds (asymmetry)"),
+    RecordField("N1", "n1", "-", "linear term of H_N (+1 course-stable, -1 unstable)"),
+    RecordField("N2", "n2", "s", "r^2 term of H_N"),
+    RecordField("N2A", "n2a", "s", "r|r| term of H_N"),
+    RecordField("N3", "n3", "s^2", "r^3 term of H_N"),
+], size_name="N_PARAMS")
+PARAMS.export(globals())         # P_K = 0, P_T = 1, P_N0 = 2, ..., P_N3 = 6, N_PARAMS = 7
 DEG = 180.0 / math.pi
 
 
@@ -49,16 +59,16 @@ def norrbin_rhs(t, x, delta, w, p, dx):
     u = x[IU]
     r = x[IR]
     earth_velocity(psi, u, 0.0, w, dx)
-    dx[2] = r
-    dx[3] = 0.0
-    dx[4] = 0.0
+    dx[IPSI] = r
+    dx[IU] = 0.0
+    dx[IV] = 0.0
     h = spiral_polynomial(r, p[P_N0], p[P_N1], p[P_N2], p[P_N2A], p[P_N3])
-    dx[5] = (p[P_K] * (delta + w[W_RUDDER]) - h) / p[P_T] + w[W_YAW_MOMENT]
+    dx[IR] = (p[P_K] * (delta + w[W_RUDDER]) - h) / p[P_T] + w[W_YAW_MOMENT]
 
 
 def pack_params(K, T, n0=0.0, n1=1.0, n2=0.0, n2a=0.0, n3=0.0) -> np.ndarray:
     """The packed record ``[K, T, n0, n1, n2, n2a, n3]`` (SI, r in rad/s)."""
-    return np.array([K, T, n0, n1, n2, n2a, n3], dtype=np.float64)
+    return PARAMS.pack(K=K, T=T, n0=n0, n1=n1, n2=n2, n2a=n2a, n3=n3)
 
 
 def from_degree_polynomial(a0=0.0, a1=1.0, a2=0.0, a2a=0.0, a3=0.0) -> dict:
