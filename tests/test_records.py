@@ -326,7 +326,7 @@ def _literal_state_or_reference_indices(path):
     toks = list(tokenize.generate_tokens(io.StringIO(path.read_text(encoding="utf-8")).readline))
     out = []
     for a, b, c, d in zip(toks, toks[1:], toks[2:], toks[3:]):
-        if (a.type == tokenize.NAME and a.string in ("x", "xf", "xs", "ref") and b.string == "["
+        if (a.type == tokenize.NAME and a.string in ("x", "x0", "xf", "xs", "ref") and b.string == "["
                 and c.type == tokenize.NUMBER and d.string == "]"):
             out.append(f"{path.name}:{a.start[0]}: {a.string}[{c.string}]")
     return out
@@ -342,4 +342,23 @@ def test_controllers_guidance_and_loops_read_plant_state_and_reference_by_name()
              src / "sim" / "driver_template.py", src / "trials" / "rate_hold.py",
              src / "trials" / "zigzag_logic.py", src / "gym" / "plant_batch.py"]
     found = [hit for p in paths for hit in _literal_state_or_reference_indices(p)]
+    assert not found, found
+
+
+# files where a name of the scan means something else than the plant state or the reference
+NOT_PLANT_STATE = {
+    "waves_thesis.py": "x0 is the wave filter's own 2-state, not the plant's",
+    "gauss_markov.py": "x is the Gauss-Markov sequence",
+    "kernel_refs.py": "ref is a kernel reference tuple",
+    "zwierzewicz2021.py": "ref[i] is run i's logged reference heading array",
+}
+
+
+def test_no_literal_plant_state_or_reference_index_anywhere_in_the_package():
+    """The whole package reads and writes the plant state and the reference vector by name."""
+    from pathlib import Path
+
+    src = Path(__file__).resolve().parent.parent / "src" / "steerlab"
+    found = [hit for p in sorted(src.rglob("*.py")) if p.name not in NOT_PLANT_STATE
+             for hit in _literal_state_or_reference_indices(p)]
     assert not found, found

@@ -32,6 +32,7 @@ import contextlib
 import numpy as np
 
 from steerlab.errors import InputError
+from steerlab.guidance.reference_vector import N_REF, REF_PSI
 
 _ALLOCATORS = ("NRT_MemInfo_alloc", "NRT_MemInfo_new", "NRT_Allocate")
 PARITY_TOL = 1e-12
@@ -163,8 +164,8 @@ def _check_controller(spec, kind, name, ship, cfg, duration):
         raise
     setup = build(d.scenario)
     z, p, x = setup.z0.copy(), setup.pc.copy(), setup.x0.copy()
-    ref = np.zeros(6)
-    ref[0] = d.ref0[0]
+    ref = np.zeros(N_REF)
+    ref[REF_PSI] = d.ref0[0]
     h = setup.nc * setup.dt
     _py_bounds(kind, name, spec.update.py_func, (z.copy(), p, 0.0, x.copy(), ref.copy(), h),
                {"parameter record": (1, p.shape[0]), "state": (0, z.shape[0]), "plant state": (3, x.shape[0])})

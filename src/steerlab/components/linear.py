@@ -31,6 +31,7 @@ import numpy as np
 from steerlab.errors import InputError, require_finite_range
 from steerlab.ships.registry import get_ship
 from steerlab.units import knots_to_ms
+from steerlab.ships.state import IU
 
 _REL_STEP = 1e-7
 
@@ -121,7 +122,7 @@ def linear_model(ship, speed_kn=None, ship_options=None) -> dict:
         ps = np.asarray(spec.pack(speed, None, opts), dtype=np.float64)
         names_all = tuple(spec.state_names)
         x0 = np.zeros(spec.n_states)
-        x0[3] = speed
+        x0[IU] = speed
         d0 = straight_rudder(spec, speed, opts)
         Af, Bf = jacobian(spec.rhs, x0, d0, ps)
         keep = _steering_states(Af, names_all)

@@ -30,6 +30,7 @@ from steerlab.environment.wave_superposition import (WaveComponents, encounter_s
                                                      wave_elevation, wave_yaw_acceleration)
 from steerlab.environment.waves import EQ39_DEN, EQ39_NUM
 from steerlab.environment.waves_thesis import theoretical_psd
+from steerlab.ships.state import IU
 
 SMOOTH = 5
 
@@ -69,7 +70,7 @@ def wave_analysis(scenario, setup) -> dict | None:
     """
     env = scenario.environment
     dt, n = setup.dt, setup.n_steps + 1
-    speed = float(setup.x0[3])
+    speed = float(setup.x0[IU])
     model = env.wave.model if env.wave is not None else "none"
     if env.waves:
         model = "eq39"

@@ -46,7 +46,7 @@ import numpy as np
 from steerlab.angles import wrap_to_2pi, wrap_to_pi
 from steerlab.errors import InputError, require_finite_range
 from steerlab.guidance.reference_models import course_reference, course_schedule
-from steerlab.guidance.reference_vector import REF_LEG, REF_PSI, REF_XTE, initial_reference
+from steerlab.guidance.reference_vector import REF_LEG, REF_PSI, REF_R, REF_XTE, initial_reference
 from steerlab.runtime import protocol as P
 from steerlab.runtime.alarms import ARRIVAL, LINK, OFF_COURSE, AlarmBoard
 from steerlab.runtime.link_filter import LinkFilter
@@ -253,7 +253,7 @@ class Autopilot:
         if self.psi_set is not None and abs(wrap_to_pi(psi - self.psi_set)) < 1e-9 and self.gd is not None:
             return
         self.psi_set = psi
-        start = self.ref[0] if self.gd is not None else psi
+        start = self.ref[REF_PSI] if self.gd is not None else psi
         if self.gd is None and self.latest is not None:
             start = self.latest.psi
         self.gd = course_schedule(float(start), [(max(t, 0.0), psi)], self.config.turn_rate)
@@ -344,7 +344,7 @@ class Autopilot:
             else:
                 self.mode = "standby"
             dev = abs(wrap_to_pi(psi - self.psi_set))
-            if dev <= cfg.off_course_limit and abs(wrap_to_pi(self.ref[0] - self.psi_set)) < 1e-6:
+            if dev <= cfg.off_course_limit and abs(wrap_to_pi(self.ref[REF_PSI] - self.psi_set)) < 1e-6:
                 self.off_course_armed = True
             self.alarms.set(OFF_COURSE, self.off_course_armed and dev > cfg.off_course_limit, t,
                             f"heading off the set course by more than {deg(cfg.off_course_limit):g} deg")
@@ -367,8 +367,8 @@ class Autopilot:
             "u": st.u if link_ok else math.nan,
             "x_n": st.x_n if link_ok else math.nan, "y_e": st.y_e if link_ok else math.nan,
             "psi_set_deg": deg(self.psi_set) if self.psi_set is not None else math.nan,
-            "psi_ref_deg": deg(self.ref[0]) if self.gd is not None else math.nan,
-            "r_ref_deg_s": deg(self.ref[1]) if self.gd is not None else math.nan,
+            "psi_ref_deg": deg(self.ref[REF_PSI]) if self.gd is not None else math.nan,
+            "r_ref_deg_s": deg(self.ref[REF_R]) if self.gd is not None else math.nan,
             "delta_cmd_deg": deg(cmd) if cmd is not None else math.nan,
             "heading_source": src or "",
             "alarms": ";".join(a["name"] for a in self.alarms.snapshot() if a["active"]),
@@ -415,7 +415,7 @@ class Autopilot:
             "steered_heading": None if self.steered[0] is None else wrap_to_2pi(self.steered[0]),
             "heading_source": self.steered[1], "course_source": self.course_source,
             "set_course": None if self.psi_set is None else wrap_to_2pi(self.psi_set),
-            "reference": None if self.gd is None else wrap_to_2pi(float(self.ref[0])),
+            "reference": None if self.gd is None else wrap_to_2pi(float(self.ref[REF_PSI])),
             "yaw_rate": None if st is None else st.r, "rudder": None if st is None else st.delta,
             "rudder_cmd": self.cmd_sent, "speed": None if st is None else st.u,
             "position": None if st is None else [st.x_n, st.y_e],

@@ -12,6 +12,7 @@ import numpy as np
 
 from steerlab.errors import InputError
 from steerlab.ships.state import IPSI, IR, IU, IV, IX, IY
+from steerlab.guidance.reference_vector import REF_PSI, REF_R
 
 
 def runtime_scenario(scenario, controller: str | None, sample_time: float):
@@ -68,7 +69,7 @@ class ControllerRuntime:
         return x
 
     def reset(self, x, ref) -> None:
-        self.z = np.asarray(self._design.init_state(x, (float(ref[0]), float(ref[1]))), dtype=float).copy()
+        self.z = np.asarray(self._design.init_state(x, (float(ref[REF_PSI]), float(ref[REF_R]))), dtype=float).copy()
 
     def update(self, t: float, x, ref) -> float:
         return float(self.kernel(self.z, self.p, float(t), x, ref, self.h))

@@ -23,6 +23,7 @@ import numpy as np
 
 from steerlab.errors import DivergedError
 from steerlab.units import KNOT
+from steerlab.ships.state import IU
 
 SPIN_LIMIT = 2.0 * math.pi   #: heading away from its reference by more than this [rad]: a spin
 
@@ -38,7 +39,7 @@ def diverged_rows(final_states, acc=None) -> np.ndarray:
 def likely_cause(setup) -> str:
     """A hint naming the scenario's speed against the ship's validity range and its step."""
     lo, hi = setup.ship.speed_range
-    speed = float(setup.x0[3]) if setup.x0.shape[0] > 3 else math.nan
+    speed = float(setup.x0[IU]) if setup.x0.shape[0] > IU else math.nan
     parts = []
     if math.isfinite(speed) and not (lo <= speed <= hi):
         parts.append(f"the speed {speed / KNOT:.3g} kn is outside the validity range of {setup.ship.name!r}: "

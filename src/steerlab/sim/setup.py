@@ -12,12 +12,13 @@ from steerlab.environment.disturbance import Disturbance, build_disturbance
 from steerlab.environment.sea import SeaContext, add_sea, uses_sea
 from steerlab.errors import InputError
 from steerlab.guidance.plan import GuidancePlan, build_guidance
-from steerlab.guidance.reference_vector import initial_reference
+from steerlab.guidance.reference_vector import REF_PSI, REF_R, initial_reference
 from steerlab.sensors.wrapper import SUFFIX as SENSORS_SUFFIX
 from steerlab.sensors.wrapper import sensed_spec, with_sensors
 from steerlab.ships.registry import ShipSpec, get_ship
 from steerlab.steering_gear import SteeringGear
 from steerlab.units import knots_to_ms, rad
+from steerlab.ships.state import IPSI, IU, IX, IY
 
 
 @dataclass(frozen=True)
@@ -152,14 +153,14 @@ class Design:
         if s.n_steps > 50_000_000:
             raise InputError("duration", f"duration/dt = {s.n_steps} steps; allowed at most 50000000")
         x0 = np.zeros(ship.n_states + 1)
-        x0[0], x0[1] = s.guidance.start
-        x0[2] = psi0
-        x0[3] = speed
+        x0[IX], x0[IY] = s.guidance.start
+        x0[IPSI] = psi0
+        x0[IU] = speed
         ref0 = (psi0, 0.0)
         if plan.guide is not None:        # the controller starts on the guidance's first reference
             ref = initial_reference()
             plan.guide(0.0, x0, plan.gd, plan.gz0.copy(), ref, nc * s.dt)
-            ref0 = (float(ref[0]), float(ref[1]))
+            ref0 = (float(ref[REF_PSI]), float(ref[REF_R]))
         z0 = np.asarray(ctrl.init_state(x0, ref0), dtype=float)
         check_state_size(ctrl_spec, z0)
         ws = s.environment.wave_sample_time
@@ -254,5 +255,5 @@ def reference_headings(gd, t) -> np.ndarray:
     out = np.empty(len(t))
     for i, ti in enumerate(t):
         course_reference(float(ti), gd, ref)
-        out[i] = ref[0]
+        out[i] = ref[REF_PSI]
     return out

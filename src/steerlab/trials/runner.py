@@ -34,6 +34,7 @@ from steerlab.steering_gear import SteeringGear
 from steerlab.trials.program import TRIAL_PROGRAM, TrialProgramConfig
 from steerlab.trials.program import build as build_program
 from steerlab.units import KNOT, deg, knots_to_ms, rad
+from steerlab.ships.state import IPSI
 
 DEFAULT_SPEED_KN = 16.0
 IDEAL_GEAR_LAG_STEPS = 1.6
@@ -121,7 +122,7 @@ def trial_setup(cond: TrialConditions, program: TrialProgramConfig, duration: fl
     gear = d.gear if cond.gear else ideal_gear(d.gear, cond.dt)
     prog, pc = build_program(program, d.context(gear=gear, sample_time=cond.dt))
     pg = base.pg if cond.gear else gear.pack()
-    z0 = prog.init_state(base.x0, (base.x0[2], 0.0))
+    z0 = prog.init_state(base.x0, (base.x0[IPSI], 0.0))
     return replace(base, controller=TRIAL_PROGRAM, pc=np.asarray(pc, dtype=float), z0=z0, nc=1, pg=pg,
                    name=f"{program.kind}-{cond.ship}")
 
