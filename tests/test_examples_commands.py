@@ -175,7 +175,7 @@ def _run(label, env_assign, argv, workdir):
         if server is not None:
             server.terminate()
             server.wait(timeout=30)
-    assert proc.returncode == 0, f"{label}\n  ran: steerlab {shlex.join(argv)}\n{proc.stderr[-2000:]}"
+    return argv, proc
 
 
 def test_the_example_files_exist_and_the_parsers_find_the_examples():
@@ -215,4 +215,5 @@ def all_examples():
 @pytest.mark.parametrize("label,env,argv", all_examples(),
                          ids=lambda v: v if isinstance(v, str) else None)
 def test_example_command_runs(label, env, argv, workdir):
-    _run(label, env, argv, workdir)
+    ran, proc = _run(label, env, argv, workdir)
+    assert proc.returncode == 0, f"{label}\n  ran: steerlab {shlex.join(ran)}\n{proc.stderr[-2000:]}"

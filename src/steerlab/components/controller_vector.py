@@ -16,6 +16,7 @@ import numpy as np
 
 from steerlab.errors import InputError
 from steerlab.guidance.reference_vector import initial_reference
+from steerlab.ships.state import IPSI, IR, IU
 
 
 @lru_cache(maxsize=None)
@@ -103,9 +104,9 @@ class ControllerVector:
         """
         n = self.n
         X, R = self._X, self._R
-        X[:, 2] = _column("heading", heading, n)
-        X[:, 3] = self.speed if speed is None else _column("speed", speed, n)
-        X[:, 5] = _column("yaw_rate", yaw_rate, n)
+        X[:, IPSI] = _column("heading", heading, n)
+        X[:, IU] = self.speed if speed is None else _column("speed", speed, n)
+        X[:, IR] = _column("yaw_rate", yaw_rate, n)
         X[:, self._nx - 1] = self._last if rudder is None else _column("rudder", rudder, n)
         R[:, 0] = _column("heading_ref", heading_ref, n)
         R[:, 1] = _column("yaw_rate_ref", yaw_rate_ref, n)

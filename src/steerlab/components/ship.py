@@ -149,12 +149,12 @@ class Ship:
     @property
     def heading(self) -> float:
         """psi [rad]."""
-        return float(self.state[2])
+        return float(self.state[IPSI])
 
     @property
     def yaw_rate(self) -> float:
         """r [rad/s]."""
-        return float(self.state[5])
+        return float(self.state[IR])
 
     @property
     def rudder(self) -> float:

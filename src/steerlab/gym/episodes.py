@@ -29,6 +29,7 @@ import numpy as np
 from steerlab.errors import InputError, require_finite_range
 from steerlab.units import rad
 from steerlab.ships.state import IPSI
+from steerlab.steering_gear import G_DMAX
 
 TASKS = ("course_keeping", "course_change", "track_following")
 
@@ -99,7 +100,7 @@ class Episodes:
         self.task, self.n, self.dt, self.nc, self.lam = task, int(n), float(dt), nc, float(lam)
         self.control_dt = nc * self.dt
         self.offset_max = rad(initial_offset_deg) if task == "course_keeping" else 0.0
-        self.delta_max = float(s0.pg[0])
+        self.delta_max = float(s0.pg[G_DMAX])
         self.state_names = s0.state_names
         self.ship_spec = s0.ship
         self.guide = course_guide if s0.guide is None else s0.guide

@@ -193,24 +193,35 @@ def run(x, z, ps, pg, pc, gd, gz, w, dt, nc, n_steps, rec_every, out_x, out_cmd,
 # ---------------------------------------------------------------- the batch: groups of LANES runs
 
 @_jit_fused
+def load_row(X, PS, PG, i, g, XL, PL, PGL):
+    """Copy row ``i``'s state and ship and gear records into column ``g`` of the scratch."""
+    for q in range(NX):
+        XL[q, g] = X[i, q]
+    for q in range(PS.shape[1]):
+        PL[q, g] = PS[i, q]
+    for q in range(PG.shape[1]):
+        PGL[q, g] = PG[i, q]
+
+
+@_jit_fused
+def store_row(X, i, g, XL):
+    """Copy column ``g``'s state back to row ``i``."""
+    for q in range(NX):
+        X[i, q] = XL[q, g]
+
+
+@_jit_fused
 def load(X, PS, PG, i0, n_act, XL, PL, PGL):
     """Copy the group's states and ship and gear records into the scratch (columns = runs)."""
     for g in range(n_act):
-        i = i0 + g
-        for q in range(NX):
-            XL[q, g] = X[i, q]
-        for q in range(PS.shape[1]):
-            PL[q, g] = PS[i, q]
-        for q in range(PG.shape[1]):
-            PGL[q, g] = PG[i, q]
+        load_row(X, PS, PG, i0 + g, g, XL, PL, PGL)
 
 
 @_jit_fused
 def store(X, i0, n_act, XL):
     """Copy the group's states back."""
     for g in range(n_act):
-        for q in range(NX):
-            X[i0 + g, q] = XL[q, g]
+        store_row(X, i0 + g, g, XL)
 
 
 @_jit_fused
@@ -331,22 +342,14 @@ def load_plants(X, PS, PG, idx, i0, n_act, XL, PL, PGL):
     """Copy the states and ship and gear records of plants ``idx[i0 .. i0 + n_act - 1]`` into
     the group's scratch (columns = plants)."""
     for g in range(n_act):
-        i = idx[i0 + g]
-        for q in range(NX):
-            XL[q, g] = X[i, q]
-        for q in range(PS.shape[1]):
-            PL[q, g] = PS[i, q]
-        for q in range(PG.shape[1]):
-            PGL[q, g] = PG[i, q]
+        load_row(X, PS, PG, idx[i0 + g], g, XL, PL, PGL)
 
 
 @_jit_fused
 def store_plants(X, idx, i0, n_act, XL):
     """Copy the group's states back to plants ``idx[i0 .. i0 + n_act - 1]``."""
     for g in range(n_act):
-        i = idx[i0 + g]
-        for q in range(NX):
-            X[i, q] = XL[q, g]
+        store_row(X, idx[i0 + g], g, XL)
 
 
 @_jit_fused
