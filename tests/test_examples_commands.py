@@ -95,9 +95,19 @@ def doc_examples():
 
 
 def _free_port() -> int:
-    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
+    """A loopback port free for both TCP (--web, --signalk-ws) and UDP (the link): a port free
+    for UDP alone was once taken on TCP by a parallel test worker ("address already in use")."""
+    for _ in range(100):
+        with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as t:
+            t.bind(("127.0.0.1", 0))
+            port = t.getsockname()[1]
+            try:
+                with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as u:
+                    u.bind(("127.0.0.1", port))
+            except OSError:
+                continue
+            return port
+    raise RuntimeError("no loopback port free for both TCP and UDP")
 
 
 def _set(argv, flag, value):
@@ -122,6 +132,9 @@ def _smaller(argv):
         argv = _set(_set(argv, "--generations", 2), "--pop-size", 6)
     if cmd in ("serve-ship", "autopilot"):
         argv = _set(_set(argv, "--duration", 3), "--speedup", 20)
+    if cmd == "serve-ship" and "--bind" not in argv:
+        # the default 127.0.0.1:47110, made a free port by _ports: parallel test workers must not share it
+        argv = argv + ["--bind", "127.0.0.1:47110"]
     if cmd == "cache" and "warm" in argv:
         argv = _set(_set(argv, "--ships", "nomoto1"), "--controllers", "pid")
     return argv
