@@ -6,7 +6,7 @@ import json
 import subprocess
 import sys
 
-HEAVY = ("control", "scipy.signal", "scipy.optimize", "scipy.stats", "matplotlib", "pymoo", "dask",
+HEAVY = ("control", "scipy.linalg", "scipy.signal", "scipy.optimize", "scipy.stats", "matplotlib", "pymoo", "dask",
          "distributed", "websockets", "pyarrow", "pandas", "gymnasium", "pynmea2")
 
 SCRIPT = """
@@ -38,3 +38,32 @@ def test_import_steerlab_imports_only_numpy_and_numba():
                          capture_output=True, text=True, timeout=120)
     assert out.returncode == 0, out.stderr
     assert json.loads(out.stdout) == []
+
+
+BLAS_SCRIPT = """
+import sys
+import numpy as np
+import numba
+import steerlab
+from steerlab.environment.iir_filter import lfilter
+lfilter(np.array([1.0]), np.array([1.0, -0.5]), np.ones(4))       # numba's registries load here
+assert "scipy.linalg" not in sys.modules, "numba's BLAS probe imported scipy.linalg"
+import scipy.linalg
+assert scipy.linalg.cython_blas is sys.modules["scipy.linalg.cython_blas"]
+@numba.njit
+def dot(a, b):
+    return a @ b
+a = np.arange(6.0).reshape(2, 3)
+assert np.array_equal(dot(a, a.T), a @ a.T)                       # numba's BLAS binding works
+assert np.allclose(scipy.linalg.solve(np.eye(2) * 2.0, np.ones(2)), 0.5)
+print("ok")
+"""
+
+
+def test_numbas_blas_probe_skips_the_scipy_linalg_import_and_blas_still_works():
+    """steerlab.numba_blas_probe: the first kernel call does not import scipy.linalg (0.16 s),
+    a later ``import scipy.linalg`` is whole (``cython_blas`` attribute set), and numba's
+    BLAS-backed ``@`` gives numpy's result."""
+    out = subprocess.run([sys.executable, "-c", BLAS_SCRIPT], capture_output=True, text=True, timeout=300)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.strip() == "ok"
