@@ -19,6 +19,8 @@ from steerlab.sim.scenario import scenario_from_dict
 # ``pythonpath`` only reaches this process), whichever checkout an editable install points to.
 _SRC = str(Path(__file__).resolve().parent.parent / "src")
 os.environ["PYTHONPATH"] = os.pathsep.join(p for p in (_SRC, os.environ.get("PYTHONPATH")) if p)
+# figures without a display, in this process (commands run in-process) and in subprocesses
+os.environ.setdefault("MPLBACKEND", "Agg")
 
 BASE = {
     "name": "test",

@@ -2,7 +2,9 @@
 in a ```sh block of README.md and docs/*.md.
 
 Each command is run as printed from a copy of the repository's ``examples/`` folder (the files
-the examples name), with smaller sizes where the command offers them (``--quick``, fewer runs,
+the examples name), through the CLI's entry point :func:`steerlab.cli.main` in the test's own
+process (commands with environment assignments, real-time servers and clients, and the cache
+commands in a new ``python -m steerlab`` process), with smaller sizes where the command offers them (``--quick``, fewer runs,
 generations, repeats; real-time commands for a few ship seconds, faster than real time, on free
 loopback ports; an autopilot gets a ship server of its own). It must exit with 0.
 """
@@ -164,7 +166,45 @@ def _env(env_assign, workdir):
     return env
 
 
+#: commands that run in a process of their own even without environment assignments: real-time
+#: servers and clients (sockets, signals, --duration of wall time) and the cache commands (which
+#: act on the cache directory a process has open)
+OWN_PROCESS = ("serve-ship", "autopilot", "cache")
+
+
+def _in_process(argv, workdir):
+    """``steerlab ARGV`` through :func:`steerlab.cli.main` in this process, from ``workdir``.
+
+    The same entry point ``python -m steerlab`` calls, without a new interpreter's start-up
+    (imports, numba's first use; about 1.5 s of CPU per command). Returns a
+    ``CompletedProcess`` like :func:`subprocess.run`.
+    """
+    import contextlib
+    import io
+    import os
+
+    from steerlab.cli import main
+    from steerlab.sim import drivers
+
+    out, err = io.StringIO(), io.StringIO()
+    cwd, on_compile = os.getcwd(), drivers.on_compile
+    os.chdir(workdir)
+    try:
+        with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+            try:
+                code = main(list(argv))
+            except SystemExit as exc:           # argparse (--help, usage errors)
+                code = exc.code if isinstance(exc.code, int) else (0 if exc.code is None else 2)
+    finally:
+        os.chdir(cwd)
+        drivers.on_compile = on_compile
+    return subprocess.CompletedProcess(["steerlab", *argv], code, out.getvalue(), err.getvalue())
+
+
 def _run(label, env_assign, argv, workdir):
+    if not env_assign and argv[0] not in OWN_PROCESS:
+        argv = _ports(_smaller(argv))
+        return argv, _in_process(argv, workdir)
     env = _env(env_assign, workdir)
     if argv[0] == "cache" and "STEERLAB_CACHE_DIR" not in env_assign:
         # never clear or fill the cache the rest of the suite (and the user) runs on

@@ -20,8 +20,6 @@ from numbers import Integral, Real
 from pathlib import Path
 
 import numpy as np
-from matplotlib.backends.backend_agg import FigureCanvasAgg
-from matplotlib.figure import Figure
 
 from steerlab.environment.channels import W_RUDDER
 from steerlab.metrics import METRIC_UNITS
@@ -62,6 +60,11 @@ def _new_figure(figsize=TIME_SERIES_SIZE):
     fig : matplotlib.figure.Figure
     ax : matplotlib.axes.Axes
     """
+    # matplotlib is imported here, not with the module: a run's figures are drawn in forked
+    # children (run_figure_jobs), which then import it in parallel with the parent's CSV
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
     # fixed margins, not layout="constrained": the constrained layout measures every text twice
     # and was half of the figures' time (0.3 of 0.6 s per run); the margins fit the labels
     fig = Figure(figsize=figsize, dpi=DPI)
@@ -296,6 +299,46 @@ def write_run_figures(out_dir: Path, result, title: str = "") -> list[Path]:
     return [_PLOTTERS[name](out_dir / name, result, title) for name in FIGURE_NAMES]
 
 
+def run_figure_jobs(out_dir: Path, result, title: str = "", processes: int = 2):
+    """The run's figures as :class:`steerlab.forked_jobs.ForkedJobs`, drawn in parallel with
+    whatever the caller does until :meth:`~steerlab.forked_jobs.ForkedJobs.wait`.
+
+    Same files and bytes as :func:`write_run_figures`; use as a context manager around the
+    rest of the output writing::
+
+        with run_figure_jobs(stage, result, title) as figures:
+            result.to_csv(stage / "timeseries.csv")
+        write_run_report(stage, result, metrics, scenario, figures=figures.paths)
+
+    Parameters
+    ----------
+    out_dir : pathlib.Path
+        Output folder (created if missing).
+    result : steerlab.sim.result.Result
+        The run.
+    title : str, optional
+        Prefix of every plot title.
+    processes : int, optional
+        Number of child processes (the figures are dealt out round-robin).
+
+    Returns
+    -------
+    steerlab.forked_jobs.ForkedJobs
+        Not started; ``.paths`` lists the files in :data:`FIGURE_NAMES` order.
+    """
+    import functools
+
+    from steerlab.forked_jobs import ForkedJobs
+
+    out_dir = Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    jobs = [functools.partial(_PLOTTERS[name], out_dir / name, result, title) for name in FIGURE_NAMES]
+    n = max(1, int(processes))
+    forked = ForkedJobs([jobs[i::n] for i in range(n)])
+    forked.paths = [out_dir / name for name in FIGURE_NAMES]
+    return forked
+
+
 # --------------------------------------------------------------------------------------------
 # metrics formatting
 # --------------------------------------------------------------------------------------------
@@ -453,8 +496,13 @@ def _html_scenario(scenario) -> str:
     return f"<h2>Scenario</h2>\n<pre>{_e(_scenario_text(scenario))}</pre>"
 
 
+def report_title(result, scenario=None) -> str:
+    """The page and plot title: the scenario's name, else ``result.meta["name"]``."""
+    return getattr(scenario, "name", None) or result.meta.get("name") or "steerlab run"
+
+
 def write_run_report(out_dir: Path, result, metrics: dict, scenario=None,
-                     title: str | None = None) -> Path:
+                     title: str | None = None, figures: list[Path] | None = None) -> Path:
     """Write the run's figures and a self-contained ``report.html`` into ``out_dir``.
 
     Parameters
@@ -469,6 +517,8 @@ def write_run_report(out_dir: Path, result, metrics: dict, scenario=None,
         Shown (name, description, full settings) when given.
     title : str, optional
         Page and plot title; default: the scenario name, else ``result.meta["name"]``.
+    figures : list of pathlib.Path, optional
+        The figures, already written (:func:`run_figure_jobs`); default: drawn here.
 
     Returns
     -------
@@ -477,8 +527,9 @@ def write_run_report(out_dir: Path, result, metrics: dict, scenario=None,
     """
     out_dir = Path(out_dir)
     if title is None:
-        title = getattr(scenario, "name", None) or result.meta.get("name") or "steerlab run"
-    figures = write_run_figures(out_dir, result, title)
+        title = report_title(result, scenario)
+    if figures is None:
+        figures = write_run_figures(out_dir, result, title)
     description = getattr(scenario, "description", "") if scenario is not None else ""
     name = getattr(scenario, "name", None) or result.meta.get("name", "")
     body = [f"<h1>{_e(title)}</h1>"]
