@@ -54,21 +54,51 @@ def test_the_gallery_has_scripts_and_a_readme_naming_each():
         assert s.name in readme, f"examples/README.md does not describe {s.name}"
 
 
+def _gallery_runs():
+    sys.path.insert(0, str(REPO / "tools"))
+    try:
+        import gallery_runs
+    finally:
+        sys.path.pop(0)
+    return gallery_runs
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize("script", SCRIPTS, ids=lambda p: p.name)
-def test_gallery_script_writes_its_figure(script, tmp_path):
-    proc = subprocess.run([sys.executable, str(script), "--quick", "--out", str(tmp_path)],
-                          capture_output=True, text=True, timeout=600, cwd=tmp_path,
-                          env={**__import__("os").environ, "MPLBACKEND": "Agg"})
-    assert proc.returncode == 0, proc.stderr[-2000:]
+def test_gallery_script_writes_its_figure(script):
+    # the run (python3 examples/NN.py --quick) is shared with the docs build: tools/gallery_runs.py
+    # stores a successful run under a key of the script, the examples' files and steerlab's source
+    run = _gallery_runs().run_script(script, timeout=600)
+    assert run.returncode == 0, run.stderr[-2000:]
     if script.name == "10_rl_episode.py" and importlib.util.find_spec("gymnasium") is None:
-        assert "gymnasium is not installed" in proc.stdout
+        assert "gymnasium is not installed" in run.stdout
         pytest.skip("gymnasium is not installed: 10_rl_episode.py skipped itself with a message")
     if script.name in STDOUT_CHECKS:
-        STDOUT_CHECKS[script.name](proc.stdout)
-    png = tmp_path / f"{script.stem}.png"
-    assert png.exists() and png.stat().st_size > 10_000      # a drawn figure, not an empty canvas
+        STDOUT_CHECKS[script.name](run.stdout)
+    png = run.png
+    assert png is not None and png.exists() and png.stat().st_size > 10_000   # a drawn figure, not an empty canvas
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_a_stored_gallery_run_is_keyed_on_the_script_and_a_failed_run_is_not_stored(tmp_path):
+    gr = _gallery_runs()
+    script = tmp_path / "99_probe.py"
+    script.write_text("import sys\nprint('ran')\nsys.exit(int(open('../exit').read()))\n")
+    cache = tmp_path / "cache"
+    # the script runs in cache/tmp-*/: '../exit' is cache/exit
+    (cache).mkdir()
+    (cache / "exit").write_text("1")
+    first = gr.run_script(script, cache=cache)
+    assert first.returncode == 1 and not first.stored
+    (cache / "exit").write_text("0")
+    second = gr.run_script(script, cache=cache)         # the failure was not stored: it runs again
+    assert second.returncode == 0 and not second.stored and second.stdout == "ran\n"
+    (cache / "exit").write_text("1")
+    third = gr.run_script(script, cache=cache)          # same script and sources: the stored run
+    assert third.stored and third.returncode == 0 and third.stdout == "ran\n"
+    script.write_text(script.read_text() + "# changed\n")
+    fourth = gr.run_script(script, cache=cache)          # the script changed: it runs again
+    assert not fourth.stored and fourth.returncode == 1
 
 
 def test_notebook_has_no_outputs_and_its_code_runs(tmp_path):

@@ -9,9 +9,10 @@ by hand and nothing goes stale:
   test suite makes against independent references;
 * ``gallery.md``: one section per ``examples/NN_*.py`` script (its docstring and its figure)
   and ``examples/README.md``. The figures are drawn during the build by running each script
-  with ``--quick`` (in parallel); they are cached in ``out/docs-gallery/`` (or
+  with ``--quick`` (in parallel); the runs are kept in ``out/docs-gallery/`` (or
   ``$STEERLAB_DOCS_GALLERY_CACHE``) under a key of the script, the examples' files and the
-  library source, so a build after a docs-only change runs nothing;
+  library source (``tools/gallery_runs.py``, shared with the gallery tests), so a build after a
+  docs-only change, or after the test suite, runs nothing;
 * ``changelog.md``: ``CHANGELOG.md``.
 
 Docstrings: reST roles (``:class:`X```) are shown as code (``on_page_content``).
@@ -25,15 +26,17 @@ from __future__ import annotations
 
 import ast
 import concurrent.futures
-import hashlib
 import os
 import re
-import subprocess
 import sys
 from pathlib import Path, PurePosixPath
 
 from mkdocs.exceptions import PluginError
 from mkdocs.structure.files import File
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import gallery_runs  # noqa: E402  (tools/gallery_runs.py, shared with the tests)
+from gallery_runs import gallery_scripts  # noqa: E402,F401
 
 REPO = Path(__file__).resolve().parent.parent
 EXAMPLES = REPO / "examples"
@@ -177,84 +180,25 @@ def page_changelog(repo_url: str) -> str:
 
 
 # ----------------------------------------------------------------- gallery
-def gallery_scripts() -> list[Path]:
-    return sorted(EXAMPLES.glob("[0-9][0-9]_*.py"))
-
-
-def _shared_key() -> bytes:
-    """Hash of what every gallery figure depends on: the examples' shared files and the library
-    source (any change there draws every figure again)."""
-    h = hashlib.sha256()
-    deps = [EXAMPLES / "_common.py", *sorted((EXAMPLES / "scenarios").glob("*")),
-            *sorted((EXAMPLES / "data").glob("*")),
-            *sorted(p for p in (REPO / "src" / "steerlab").rglob("*")
-                    if p.is_file() and p.suffix in (".py", ".toml"))]
-    for p in deps:
-        h.update(str(p.relative_to(REPO)).encode())
-        h.update(p.read_bytes())
-    return h.digest()
-
-
-def _source_key(script: Path, shared: bytes) -> str:
-    """Cache key of one gallery figure: the script and :func:`_shared_key`."""
-    return hashlib.sha256(shared + script.read_bytes()).hexdigest()[:16]
-
-
-def _cache_dir() -> Path:
-    return Path(os.environ.get("STEERLAB_DOCS_GALLERY_CACHE") or REPO / "out" / "docs-gallery")
-
-
-def _run_script(script: Path, cache: Path, shared: bytes) -> tuple[Path, Path | None, str]:
-    """Run one gallery script (``--quick``) unless its cached figure is current; returns
-    ``(script, figure or None, note)``."""
-    key = _source_key(script, shared)
-    png = cache / f"{script.stem}-{key}.png"
-    note_file = cache / f"{script.stem}-{key}.txt"
-    if png.exists():
-        return script, png, ""
-    if note_file.exists():
-        return script, None, note_file.read_text(encoding="utf-8")
-    work = cache / f"tmp-{script.stem}-{os.getpid()}"
-    work.mkdir(parents=True, exist_ok=True)
-    env = {**os.environ, "MPLBACKEND": "Agg",
-           "PYTHONPATH": os.pathsep.join([str(REPO / "src"), os.environ.get("PYTHONPATH", "")]).rstrip(os.pathsep)}
-    proc = subprocess.run([sys.executable, str(script), "--quick", "--out", str(work)], cwd=work, env=env,
-                          capture_output=True, text=True, timeout=900)
-    if proc.returncode != 0:
-        raise PluginError(f"docs gallery: {script.name} failed (exit {proc.returncode}):\n{proc.stderr[-2000:]}")
-    made = work / f"{script.stem}.png"
-    for old in cache.glob(f"{script.stem}-*"):
-        if old.is_file() and key not in old.name:
-            old.unlink()
-    if made.exists():
-        os.replace(made, png)
-        result = (script, png, "")
-    else:                                   # the script skipped itself (an optional extra missing)
-        note_file.write_text(proc.stdout.strip(), encoding="utf-8")
-        result = (script, None, proc.stdout.strip())
-    for f in work.iterdir():
-        f.unlink()
-    work.rmdir()
-    return result
+def _run_script(script: Path) -> tuple[Path, Path | None, str]:
+    """``(script, figure or None, note)`` of the script's ``--quick`` run (:mod:`gallery_runs`:
+    stored under a key of its sources, shared with the test suite)."""
+    run = gallery_runs.run_script(script)
+    if run.returncode != 0:
+        raise PluginError(f"docs gallery: {script.name} failed (exit {run.returncode}):\n{run.stderr[-2000:]}")
+    if run.png is None:                     # the script skipped itself (an optional extra missing)
+        return script, None, run.stdout.strip()
+    return script, run.png, ""
 
 
 def gallery_figures() -> dict[str, tuple[Path | None, str]]:
     """``{script name: (figure or None, note)}``, running the scripts whose figure is stale."""
-    cache = _cache_dir()
-    cache.mkdir(parents=True, exist_ok=True)
     scripts = gallery_scripts()
-    shared = _shared_key()
     workers = max(1, min(len(scripts), os.cpu_count() or 1))
-    # one build at a time draws into the cache (e.g. two pytest-xdist workers building the
-    # site): the second waits, then finds the figures current
-    with open(cache / ".lock", "w") as lock:
-        try:
-            import fcntl
-            fcntl.flock(lock, fcntl.LOCK_EX)
-        except ImportError:                 # no fcntl (Windows): no lock
-            pass
-        with concurrent.futures.ThreadPoolExecutor(workers) as pool:
-            done = list(pool.map(lambda s: _run_script(s, cache, shared), scripts))
+    # each script's run is locked on its own (gallery_runs): two builds, or a build and the
+    # gallery tests, run every script once between them
+    with concurrent.futures.ThreadPoolExecutor(workers) as pool:
+        done = list(pool.map(_run_script, scripts))
     return {s.name: (png, note) for s, png, note in done}
 
 
