@@ -44,6 +44,19 @@ def _merge(base: dict, over: dict) -> dict:
     return out
 
 
+def import_tool(name: str):
+    """A module of the repository's ``tools/`` folder (not a package), e.g. ``docs_hooks``."""
+    import importlib
+    import sys
+
+    tools = str(Path(__file__).resolve().parent.parent / "tools")
+    sys.path.insert(0, tools)
+    try:
+        return importlib.import_module(name)
+    finally:
+        sys.path.remove(tools)
+
+
 def make_scenario_dict(**over) -> dict:
     """The base dict with top-level / nested overrides (``controller`` is replaced whole)."""
     return _merge(BASE, over)

@@ -73,12 +73,9 @@ def test_strict_mode_refuses_a_broken_link(tmp_path):
 
 
 def _hooks():
-    sys.path.insert(0, str(REPO / "tools"))
-    try:
-        import docs_hooks
-    finally:
-        sys.path.pop(0)
-    return docs_hooks
+    from conftest import import_tool
+
+    return import_tool("docs_hooks")
 
 
 def test_links_to_repository_files_go_to_the_repository_and_docs_links_stay_pages():

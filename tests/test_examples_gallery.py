@@ -55,12 +55,9 @@ def test_the_gallery_has_scripts_and_a_readme_naming_each():
 
 
 def _gallery_runs():
-    sys.path.insert(0, str(REPO / "tools"))
-    try:
-        import gallery_runs
-    finally:
-        sys.path.pop(0)
-    return gallery_runs
+    from conftest import import_tool
+
+    return import_tool("gallery_runs")
 
 
 @pytest.mark.slow
