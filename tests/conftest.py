@@ -108,3 +108,14 @@ def pytest_sessionfinish(session, exitstatus):
     reporter = session.config.pluginmanager.get_plugin("terminalreporter")
     if reporter is not None and _real_part_skips(reporter) and session.exitstatus == 0:
         session.exitstatus = 1
+
+
+# ---------------------------------------------------------------- test times, as they finish
+def pytest_runtest_logreport(report):
+    """With ``STEERLAB_TEST_TIMES=FILE``, append ``seconds phase nodeid`` for every test phase
+    as it finishes (all workers append to the same file): where the suite's time goes, readable
+    while it runs (``sort -rn FILE | head``)."""
+    path = os.environ.get("STEERLAB_TEST_TIMES")
+    if path and report.duration >= 0.05:
+        with open(path, "a", encoding="utf-8") as f:
+            f.write(f"{report.duration:.2f} {report.when} {report.nodeid}\n")
