@@ -116,6 +116,7 @@ def pytest_runtest_logreport(report):
     as it finishes (all workers append to the same file): where the suite's time goes, readable
     while it runs (``sort -rn FILE | head``)."""
     path = os.environ.get("STEERLAB_TEST_TIMES")
-    if path and report.duration >= 0.05:
+    # under pytest-xdist the controller gets every worker's reports: write there only
+    if path and report.duration >= 0.05 and not os.environ.get("PYTEST_XDIST_WORKER"):
         with open(path, "a", encoding="utf-8") as f:
             f.write(f"{report.duration:.2f} {report.when} {report.nodeid}\n")
