@@ -15,6 +15,7 @@ EXAMPLES = """examples:
   steerlab cache info                 # where the cache is, how many drivers, how big
   steerlab cache warm                 # compile the common catalogue pairs (progress bar)
   steerlab cache warm --ships esso --controllers pid adrc --batch
+  steerlab cache warm --ships nomoto1 --controllers all   # every controller on one ship
   steerlab cache clear --stale        # drop the entries of other steerlab versions
   STEERLAB_CACHE_DIR=/tmp/slc steerlab cache info"""
 
@@ -29,9 +30,9 @@ def register(sub, formatter_class):
     p.add_argument("action", choices=("info", "clear", "warm"))
     p.add_argument("--stale", action="store_true", help="clear: only other steerlab versions' entries")
     p.add_argument("--ships", nargs="+", default=list(COMMON_SHIPS), metavar="ID",
-                   help=f"warm: ship ids (default: {' '.join(COMMON_SHIPS)})")
+                   help=f"warm: ship ids, or 'all' (default: {' '.join(COMMON_SHIPS)})")
     p.add_argument("--controllers", nargs="+", default=list(COMMON_CONTROLLERS), metavar="TYPE",
-                   help=f"warm: controller types (default: {' '.join(COMMON_CONTROLLERS)})")
+                   help=f"warm: controller types, or 'all' (default: {' '.join(COMMON_CONTROLLERS)})")
     p.add_argument("--batch", action="store_true", help="warm: also the batch engine's loop")
     p.add_argument("--json", action="store_true", help="info: print JSON")
     p.add_argument("--quiet", action="store_true")
@@ -72,7 +73,12 @@ def _warm(args) -> int:
     from steerlab.sim import drivers
     from steerlab.sim.warm import warm_pair
 
-    pairs = [(s, c) for s in args.ships for c in args.controllers]
+    from steerlab.control.registry import CONTROLLERS
+    from steerlab.ships.registry import SHIPS
+
+    ships = sorted(SHIPS) if args.ships == ["all"] else args.ships
+    controllers = sorted(CONTROLLERS) if args.controllers == ["all"] else args.controllers
+    pairs = [(s, c) for s in ships for c in controllers]
     for s, c in pairs:            # validate every name before compiling anything
         get_ship(s)
         get_controller(c)
