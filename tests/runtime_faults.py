@@ -56,6 +56,7 @@ def fault_injection(controller, log, seed: int = 3, speedup: float = 5.0, t_cut:
     during = [r for r in rows if t_cut + 1.5 < r["t"] < t_restore]
     after = [r for r in rows if back is not None and r["t"] >= back["t"]]
     changes = [(t, s) for t, s in server.stats.status_changes if t >= t_cut - 0.1]
+    alarm_t = raised[0] if raised else math.inf
     return {
         "proxy": dict(px.counts),
         "loss_phase": {
@@ -68,15 +69,25 @@ def fault_injection(controller, log, seed: int = 3, speedup: float = 5.0, t_cut:
         },
         "filter": {"autopilot": dict(ap.filter.counts), "ship": dict(server.filter.counts)},
         "t_cut": t_cut, "t_restore": t_restore,
-        "alarm_after_cut_s": (raised[0] - t_cut) if raised else math.inf,
+        "alarm_after_cut_s": alarm_t - t_cut,
+        "stall_s_before_alarm": stalled(rows, t_cut, alarm_t),
         "safe_during_cut": bool(during) and all(r["mode"] == "safe" and r["delta_cmd_deg"] == 0.0 for r in during),
         "ship_held_then_centred": [s for _, s in changes][:2] == [P.STATUS_CMD_HOLD, P.STATUS_CMD_CENTRED],
         "recovered_after_s": (back["t"] - t_restore) if back is not None else math.inf,
+        "stall_s_before_recovery": stalled(rows, t_restore, back["t"] if back is not None else math.inf),
         "alarm_cleared_after_restore": back is not None and any(
             n == LINK and w == "cleared" and t >= t_restore for t, n, w in ap.alarms.history),
         "steering_after_recovery": bool(after) and all(r["mode"] == "auto" for r in after if r["link_ok"]),
         "max_heading_error_deg_end": max((abs(r["psi_deg"] - 20.0) for r in after[-16:]), default=math.nan),
     }
+
+
+def stalled(rows, t0: float, t1: float, h: float = 0.125) -> float:
+    """Ship time [s] in ``[t0, t1]`` during which the process did not run the autopilot's samples
+    (gaps between logged samples beyond the sample time ``h``: a stall of the machine, skipped
+    samples), the slack a loaded machine adds to a delay measured in ship time."""
+    ts = [r["t"] for r in rows if t0 - h <= r["t"] <= t1]
+    return sum(max(0.0, b - a - h) for a, b in zip(ts, ts[1:]))
 
 
 def summary(res: dict) -> str:
@@ -96,6 +107,8 @@ def summary(res: dict) -> str:
         ("5 s cut: safe action (midships) until the link is back", res["safe_during_cut"]),
         ("5 s cut: ship server held the order, then centred the rudder", res["ship_held_then_centred"]),
         ("restore: steering again after [s] (bound 0.5)", f"{res['recovered_after_s']:.3f}"),
+        ("stalls of the test process in those two windows [s]",
+         f"{res['stall_s_before_alarm']:.3f} / {res['stall_s_before_recovery']:.3f}"),
         ("restore: link alarm cleared", res["alarm_cleared_after_restore"]),
         ("after restore: heading error, last 2 s [deg]", f"{res['max_heading_error_deg_end']:.2f}"),
     ]
