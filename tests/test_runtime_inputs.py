@@ -22,7 +22,7 @@ from steerlab.runtime.rejection_report import rejections
 from steerlab.runtime.ship_server import ShipServer
 from steerlab.runtime.udp import open_udp
 from steerlab.sim.scenario import scenario_from_dict
-from test_runtime_e2e import KEY, SCENARIO, SPEEDUP, _read_log, _session, controller  # noqa: F401
+from test_runtime_e2e import KEY, SPEEDUP, _read_log, _session, controller  # noqa: F401  (fixture)
 
 
 def _r(kind, fields):
@@ -104,8 +104,6 @@ def test_rejections_are_counted_per_reason_and_shown_in_status(controller):  # n
 
 
 def test_signed_state_heading_wins_over_nmea_unless_chosen(controller):  # noqa: F811
-    from steerlab.runtime.autopilot import Autopilot
-
     for key, over, want in ((None, False, "nmea"), (KEY, False, "state"), (KEY, True, "nmea")):
         ap = Autopilot(controller, ("127.0.0.1", 9), AutopilotConfig(nmea_heading_over_signed=over),
                        heading=0.0, key=key)
