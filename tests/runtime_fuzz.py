@@ -9,6 +9,8 @@ listeners, the Signal K WebSocket stream) on loopback, lets the autopilot steer,
   then a datagram of 40 lines);
 * **link datagrams** to the autopilot's state port and the ship's command port (signed and
   unsigned states, commands, hellos with bytes replaced, cut or appended; random bytes);
+* **Signal K UDP deltas** to the autopilot's Signal K port (the hostile messages below, and
+  deltas of the writable paths with values of every type);
 * **WebSocket messages** to the autopilot's Signal K stream (the hostile messages of
   ``test_runtime_web_fuzz._fuzz_message``: deep nesting, many-``*`` subscriptions, PUTs...).
 
@@ -39,7 +41,7 @@ from steerlab.runtime.ship_server import ShipServer, ShipServerConfig
 from steerlab.sim.scenario import scenario_from_dict
 
 KEY = b"runtime fuzz key, 32 bytes long!"
-KINDS = ("NMEA lines", "link datagrams", "WebSocket messages")
+KINDS = ("NMEA lines", "link datagrams", "Signal K UDP deltas", "WebSocket messages")
 MAX_BLOCK_S = 0.05      #: no single message may block the event loop longer (issue 15) [s]
 
 _T0 = 1_700_000_000.0
@@ -83,6 +85,24 @@ def link_message(rng: random.Random) -> bytes:
     if rng.random() < 0.3:
         d = d[:rng.randrange(0, len(d) + 1)]
     return bytes(d) + rng.randbytes(rng.randrange(0, 3))
+
+
+def signalk_message(rng: random.Random) -> bytes:
+    """One generated Signal K UDP datagram (seeded): a delta of a writable path with a value of
+    any type, or a hostile message (``test_runtime_web_fuzz._fuzz_message``)."""
+    import json
+
+    from steerlab.runtime.signalk import AUTOPILOT_STATE, TARGET_HEADING
+    from test_runtime_web_fuzz import _fuzz_message
+
+    if rng.random() < 0.5:
+        value = rng.choice((0.3, -0.3, 7.0, -1e308, 1e300, "auto", "standby", "alarm", None, True, [1], {"v": 2}))
+        path = rng.choice((TARGET_HEADING, AUTOPILOT_STATE, "navigation.headingTrue", "", "a" * 300))
+        return json.dumps({"context": rng.choice(("vessels.self", "vessels.x", "*", 5)),
+                           "updates": [{"values": [{"path": path, "value": value}]}]}).encode()
+    msg = _fuzz_message(rng)
+    msg = msg.encode("utf-8", "surrogatepass") if isinstance(msg, str) else msg
+    return msg[:60_000]
 
 
 class _Meter:
@@ -210,6 +230,7 @@ async def fuzz_runtime(controller, scenario: dict, n: int = 1000, seed: int = 15
                    nmea_listen=lo, signalk_listen=lo, signalk_ws=lo)
     meter.wrap(ap, "on_state_datagram", "link datagrams")
     meter.wrap(ap, "on_nmea_datagram", "NMEA lines")
+    meter.wrap(ap, "on_signalk_datagram", "Signal K UDP deltas")
     started = asyncio.Event()
     run = asyncio.create_task(ap.run(0.0, started=lambda a: started.set()))
     await started.wait()
@@ -224,6 +245,7 @@ async def fuzz_runtime(controller, scenario: dict, n: int = 1000, seed: int = 15
     probe = asyncio.create_task(_lag_probe(lags, stop))
     phases = {}
     nmea_port = ap._listeners[0].get_extra_info("sockname")[:2]
+    signalk_port = ap._listeners[1].get_extra_info("sockname")[:2]
     link_targets = [ap.transport.get_extra_info("sockname")[:2], server.address]
     try:
         for kind in KINDS:
@@ -233,6 +255,9 @@ async def fuzz_runtime(controller, scenario: dict, n: int = 1000, seed: int = 15
                 sent = n
             elif kind == "link datagrams":
                 await _udp_phase(kind, link_message, link_targets, n, rng, meter)
+                sent = n
+            elif kind == "Signal K UDP deltas":
+                await _udp_phase(kind, signalk_message, [signalk_port], n, rng, meter)
                 sent = n
             else:
                 url = "ws://%s:%d/signalk/v1/stream?subscribe=none" % tuple(stream.address)
@@ -258,7 +283,7 @@ async def fuzz_runtime(controller, scenario: dict, n: int = 1000, seed: int = 15
                      "max_lag_ms": 1e3 * max(lag, default=0.0), "p99_lag_ms": 1e3 * _pct(lag, 99)}
     out["autopilot"] = {"samples_during_fuzz": ap.samples + ap.skipped - samples0, "skipped": ap.skipped,
                         "loop_exceptions": loop_errors, "nmea": dict(ap.nmea_counts),
-                        "link": dict(ap.filter.counts), "ship_link": dict(server.filter.counts),
+                        "signalk_udp": dict(ap.signalk_counts), "link": dict(ap.filter.counts), "ship_link": dict(server.filter.counts),
                         "signalk_ws": {k: v for k, v in stream.counts.items() if v},
                         "link_alarm": ap.alarms.first_raised("link")}
     return out

@@ -1,5 +1,5 @@
-"""No message blocks the event loop: generated NMEA lines, link datagrams and WebSocket messages
-against a running ship server + autopilot over loopback sockets (CI size: 1 000 of each;
+"""No message blocks the event loop: generated NMEA lines, link datagrams, Signal K UDP deltas and
+WebSocket messages against a running ship server + autopilot over loopback sockets (CI size: 1 000 of each;
 ``benchmarks/fuzz_runtime.py`` runs 10 000 of each and prints the table of docs/reliability.md).
 
 Asserted: no exception (in a handler or reported to the event loop), every message reached its
@@ -30,5 +30,6 @@ def test_thousand_of_each_message_kind_never_raise_nor_block_the_loop(controller
     # the fuzz reached the checks it is meant for (not only the first byte test)
     assert {"out_of_range", "bad_field", "too_many_lines", "malformed", "accepted"} <= set(ap["nmea"])
     assert {"malformed", "bad_mac", "unauthenticated"} <= set(ap["link"])
+    assert {"accepted", "malformed", "out_of_range", "bad_field", "ignored"} <= set(ap["signalk_udp"])
     assert ap["signalk_ws"]["subscriptions"] > 50 and ap["signalk_ws"]["put_refused"] > 10
     assert ap["samples_during_fuzz"] > 20

@@ -285,3 +285,20 @@ def test_warning_for_network_wide_nmea_and_signalk_listen(tmp_path, capsys):
             assert warned in err and "without authentication" in err
         else:
             assert "warning" not in err
+
+
+@pytest.mark.parametrize("connect, host, bind", [("127.0.0.2:47110", "127.0.0.2", "127.0.0.1"),
+                                                 ("[::1]:47110", "::1", "::1"),
+                                                 ("localhost:47110", "localhost", "127.0.0.1")])
+def test_cli_connect_to_a_loopback_ship_binds_loopback_of_its_family(tmp_path, connect, host, bind):
+    """``--connect 127.0.0.2`` or ``[::1]`` sends from loopback of the same family, never 0.0.0.0
+    (the socket-level run over both is ``test_runtime_bind.py``)."""
+    from runtime_scenario import runtime_scenario_toml
+    from steerlab.cli import build_parser
+    from steerlab.commands.autopilot import build_autopilot
+
+    sc = tmp_path / "s.toml"
+    sc.write_text(runtime_scenario_toml("bind", 10.0))
+    ap, _ = build_autopilot(build_parser().parse_args(
+        ["autopilot", "--connect", connect, "--scenario", str(sc), "--log", str(tmp_path / "l.csv")]))
+    assert ap.connect == (host, 47110) and ap.bind == (bind, 0)
