@@ -256,7 +256,7 @@ def _status_ok(*flags) -> None:
 
 def _xte_checked(magnitude, unit: str | None, steer) -> float | None:
     """Cross-track error [m] of a magnitude field and its unit (N nmi, K km), range-checked;
-    None when empty. ``steer`` (L/R) must be given with a non-zero magnitude."""
+    None when empty. ``steer``, the direction to steer, must be ``L``, ``R`` or empty."""
     if magnitude is None or not str(magnitude).strip():
         return None
     m = _num(magnitude)
