@@ -100,6 +100,9 @@ def test_rejections_are_counted_per_reason_and_shown_in_status(controller):  # n
     assert st["nmea"] == {"accepted": 1, "ignored": 1, "out_of_range": 1}
     assert st["signalk"] == {"accepted": 0, "out_of_range": 1, "bad_field": 1, "malformed": 1}
     assert rejections(ap.nmea_counts) == {"out_of_range": 1}   # what the live rejection report prints
+    ap.latest = P.State(0.0, 0.0, 0.0, 0.0, 0.0, 5.0, 0.0, 0.0, math.nan, 0.0, 0)
+    row = ap.sample(0.0)                                       # and the CSV log, every sample
+    assert row["nmea_rejected"] == 1 and row["signalk_rejected"] == 3
     assert ap.psi_set == 0.0 and ap.nmea_heading[0] == pytest.approx(math.radians(10.0))
 
 

@@ -173,7 +173,7 @@ def run(args) -> int:
     finally:
         if not args.quiet:
             print(f"autopilot: {ap.samples} samples, mode {ap.mode}, {ap.skipped} skipped after stalls, "
-                  f"link {dict(ap.filter.counts)}, "
+                  f"link {dict(ap.filter.counts)}, NMEA {dict(ap.nmea_counts)}, Signal K UDP {dict(ap.signalk_counts)}, "
                   f"alarms raised {[n for _, n, w in ap.alarms.history if w == 'raised']}",
                   file=sys.stderr, flush=True)
     return 0

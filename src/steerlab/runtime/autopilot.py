@@ -68,15 +68,23 @@ within the limit, does not trip it)."""
 
 LOG_COLUMNS = ("t", "wall", "t_sim", "state_age", "link_ok", "mode", "psi_deg", "r_deg_s",
                "delta_deg", "u", "x_n", "y_e", "psi_set_deg", "psi_ref_deg", "r_ref_deg_s",
-               "delta_cmd_deg", "heading_source", "alarms", "accepted", "rejected", "xte_m", "leg")
+               "delta_cmd_deg", "heading_source", "alarms", "accepted", "rejected", "xte_m", "leg",
+               "nmea_rejected", "signalk_rejected")
 """CSV log columns (one row per sample; ship time ``t`` [s], degrees at this edge; ``xte_m``
-cross-track error [m], > 0 to starboard of the leg, and ``leg`` only with a route)."""
+cross-track error [m], > 0 to starboard of the leg, and ``leg`` only with a route; ``accepted``,
+``rejected``: link datagrams so far; ``nmea_rejected``, ``signalk_rejected``: NMEA lines and
+Signal K UDP deltas rejected so far, all reasons, rate limiting included)."""
 
 
 def _csv_float(column: str, v: float) -> str:
     """A log value: 6 significant digits, but the wall clock [s since 1970] to the millisecond
     (``%.6g`` wrote ``1.79544e+09``, 10 s resolution)."""
     return f"{v:.3f}" if column == "wall" else f"{v:.6g}"
+
+
+def _rejected(counts) -> int:
+    """Rejections in an input's counts (every key but the normal traffic)."""
+    return sum(v for k, v in counts.items() if k not in ("accepted", "ignored"))
 
 
 @dataclass(frozen=True)
@@ -423,6 +431,7 @@ class Autopilot:
             "accepted": self.filter.counts["accepted"], "rejected": self.filter.rejected(),
             "xte_m": float(self.ref[REF_XTE]) if link_ok and self.route is not None else math.nan,
             "leg": int(self.ref[REF_LEG]) if link_ok and self.route is not None else "",
+            "nmea_rejected": _rejected(self.nmea_counts), "signalk_rejected": _rejected(self.signalk_counts),
         }
         self.last_row = row
         return row
