@@ -97,7 +97,7 @@ def test_off_course_alarm_armed_only_after_reaching_the_course(ctrl):
     ap.set_course(math.radians(30.0), 0.0)      # 30 deg away: turning, no alarm yet
     _feed(ap, 0.0)
     assert ap.sample(0.0)["alarms"] == ""
-    _feed(ap, 1.0, psi=math.radians(25.0))       # within the limit: armed
+    _feed(ap, 1.0, psi=math.radians(26.0))       # within half the limit: armed
     assert ap.sample(1.0)["alarms"] == "" and ap.off_course_armed
     _feed(ap, 2.0, psi=math.radians(15.0))       # 15 deg off: alarm
     assert ap.sample(2.0)["alarms"] == OFF_COURSE

@@ -50,6 +50,12 @@ def register(sub, formatter_class) -> None:
     p.add_argument("--nmea-listen", metavar="HOST:PORT", help="UDP port for HDT/THS heading and APB/RMB/HTC course")
     p.add_argument("--nmea-to", metavar="HOST:PORT", help="send the autopilot's HTD here each sample")
     p.add_argument("--xte-lookahead", type=float, default=500.0, help="cross-track correction lookahead [m]")
+    p.add_argument("--nmea-heading-over-signed", action="store_true",
+                   help="steer by a fresh NMEA HDT/THS heading even when the ship state is signed (--key-file/--key-env); "
+                        "default: the signed state's heading wins over unauthenticated NMEA")
+    p.add_argument("--input-rate", type=float, default=100.0,
+                   help="NMEA / Signal K UDP datagrams accepted per source per ship second (burst as many; "
+                        "more are counted rate_limited; 0: no limit; default 100)")
     p.add_argument("--signalk-listen", metavar="HOST:PORT", help="UDP port for Signal K deltas (target heading, state)")
     p.add_argument("--signalk-to", metavar="HOST:PORT", help="send Signal K autopilot deltas here")
     p.add_argument("--signalk-ws", metavar="HOST:PORT",
@@ -88,7 +94,9 @@ def build_autopilot(args):
     cfg = AutopilotConfig(sample_time=args.sample_time, speedup=args.speedup, watchdog_timeout=args.watchdog,
                           safe_action=args.safe_action, off_course_limit=rad(args.off_course_deg),
                           turn_rate=rad(turn), max_age=args.max_age,
-                          rpm_cmd=math.nan if args.rpm is None else args.rpm, xte_lookahead=args.xte_lookahead)
+                          rpm_cmd=math.nan if args.rpm is None else args.rpm, xte_lookahead=args.xte_lookahead,
+                          nmea_heading_over_signed=args.nmea_heading_over_signed, input_rate=args.input_rate,
+                          input_burst=max(1.0, args.input_rate))
     route = (route_guidance(scenario, ctrl.setup.ship, ctrl.setup.ps, args.route, args.lookahead_L,
                             args.accept_radius) if args.route else None)
     web = parse_hostport(args.web, "--web") if args.web else None
@@ -165,7 +173,7 @@ def run(args) -> int:
     finally:
         if not args.quiet:
             print(f"autopilot: {ap.samples} samples, mode {ap.mode}, {ap.skipped} skipped after stalls, "
-                  f"link {dict(ap.filter.counts)}, "
+                  f"link {dict(ap.filter.counts)}, NMEA {dict(ap.nmea_counts)}, Signal K UDP {dict(ap.signalk_counts)}, "
                   f"alarms raised {[n for _, n, w in ap.alarms.history if w == 'raised']}",
                   file=sys.stderr, flush=True)
     return 0

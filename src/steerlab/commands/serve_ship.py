@@ -168,7 +168,7 @@ def run(args) -> int:
                 print(no_key_warning("serve-ship", f"ANY process that can reach {host}:{port} can send rudder "
                                      "orders (the first sender holds the rudder while it keeps sending: "
                                      "--session-lock)"), file=sys.stderr, flush=True)
-        sources = {"link": lambda: s.filter.counts}
+        sources = {"link": lambda: s.filter.counts, "rpm orders": lambda: s.rpm_counts}
         if s.signalk_stream is not None:
             sources["Signal K stream"] = lambda: s.signalk_stream.counts
         start_rejection_report("serve-ship", args, sources)
@@ -180,4 +180,6 @@ def run(args) -> int:
             c = dict(server.filter.counts)
             print(f"serve-ship: t = {server.t_sim:.2f} s, published {server.stats.published}, "
                   f"commands {server.stats.commands}, link {c}", file=sys.stderr, flush=True)
+            if server.rpm_error:
+                print(f"serve-ship: last {server.rpm_error}", file=sys.stderr, flush=True)
     return 0 if stats is not None else 1

@@ -7,14 +7,19 @@ guidance and the controller kernel, and sends a rudder order. On packet loss the
 **held**; once no valid state has arrived for ``watchdog_timeout`` (default 1 s) the state is no
 longer used: the ``link`` alarm is raised and the **safe action** is ordered (``midships`` or
 ``hold`` the last order). The **off-course** alarm is raised when ``|wrap(psi - psi_set)|``
-exceeds its limit; it is armed only once the heading has come within the limit after a course
-change, so a commanded turn does not trip it.
+exceeds its limit; after a course change it is armed only once the heading has come within
+half the limit (:data:`OFF_COURSE_ARM_FRACTION`) of the new course with the reference settled, so a
+commanded turn does not trip it, not even one exactly as large as the limit (armed at once by the
+old rule "within the limit", the ship's momentum then carried it past the limit).
 
 Guidance: a set course (``--heading``; ``course_reference`` slews the reference at the turn-rate
 limit), a route (the simulator's LOS kernel ``guide(t, x, gd, gz, ref, h)`` called with the
 received state, :mod:`steerlab.runtime.route`; the route is then the only course source) or a
 chart plotter's APB/RMB/HTC sentences (:mod:`steerlab.runtime.nmea`). The heading may come
-from NMEA HDT/THS instead of the state datagram.
+from NMEA HDT/THS instead of the state datagram, but on a signed link (a key) the signed state's
+heading wins unless ``nmea_heading_over_signed`` (``--nmea-heading-over-signed``) is set. NMEA and
+Signal K UDP input is rate limited per source (``input_rate``) and checked (range, status,
+magnetic-only); rejections are counted per reason (``nmea_counts``, ``signalk_counts``).
 
 Plotter course: one source steers, by priority APB > RMB > HTC (the first with a sentence younger
 than ``nmea_timeout``; no alternation when a plotter sends both APB and RMB). **Arrival**: once
@@ -38,7 +43,7 @@ import asyncio
 import csv
 import math
 import time
-from collections import deque
+from collections import Counter, deque
 from dataclasses import dataclass
 
 import numpy as np
@@ -50,22 +55,36 @@ from steerlab.guidance.reference_vector import REF_LEG, REF_PSI, REF_R, REF_XTE,
 from steerlab.runtime import protocol as P
 from steerlab.runtime.alarms import ARRIVAL, LINK, OFF_COURSE, AlarmBoard
 from steerlab.runtime.link_filter import LinkFilter
+from steerlab.runtime.rate_limit import RateLimiter
+from steerlab.runtime.signalk import AUTOPILOT_STATE, TARGET_HEADING
 from steerlab.runtime.udp import local_bind_for, open_udp, send
 from steerlab.units import deg, rad
 
 SAFE_ACTIONS = ("midships", "hold")
+OFF_COURSE_ARM_FRACTION = 0.5
+"""After a course change the off-course alarm arms once the heading is within this fraction of
+its limit of the new set course (a hysteresis band: a heading still swinging on from the turn,
+within the limit, does not trip it)."""
 
 LOG_COLUMNS = ("t", "wall", "t_sim", "state_age", "link_ok", "mode", "psi_deg", "r_deg_s",
                "delta_deg", "u", "x_n", "y_e", "psi_set_deg", "psi_ref_deg", "r_ref_deg_s",
-               "delta_cmd_deg", "heading_source", "alarms", "accepted", "rejected", "xte_m", "leg")
+               "delta_cmd_deg", "heading_source", "alarms", "accepted", "rejected", "xte_m", "leg",
+               "nmea_rejected", "signalk_rejected")
 """CSV log columns (one row per sample; ship time ``t`` [s], degrees at this edge; ``xte_m``
-cross-track error [m], > 0 to starboard of the leg, and ``leg`` only with a route)."""
+cross-track error [m], > 0 to starboard of the leg, and ``leg`` only with a route; ``accepted``,
+``rejected``: link datagrams so far; ``nmea_rejected``, ``signalk_rejected``: NMEA lines and
+Signal K UDP deltas rejected so far, all reasons, rate limiting included)."""
 
 
 def _csv_float(column: str, v: float) -> str:
     """A log value: 6 significant digits, but the wall clock [s since 1970] to the millisecond
     (``%.6g`` wrote ``1.79544e+09``, 10 s resolution)."""
     return f"{v:.3f}" if column == "wall" else f"{v:.6g}"
+
+
+def _rejected(counts) -> int:
+    """Rejections in an input's counts (every key but the normal traffic)."""
+    return sum(v for k, v in counts.items() if k not in ("accepted", "ignored"))
 
 
 @dataclass(frozen=True)
@@ -80,6 +99,11 @@ class AutopilotConfig:
     hello_period: float = 0.5           #: subscription refresh [s]
     rpm_cmd: float = math.nan           #: propeller order [rpm]; NaN: leave the ship's
     nmea_timeout: float = 2.0           #: NMEA heading/course older than this is not used [s]
+    #: steer by a fresh NMEA HDT/THS heading even when the ship state is signed (HMAC); default:
+    #: on a keyed link the signed state's heading wins over the unauthenticated NMEA one
+    nmea_heading_over_signed: bool = False
+    input_rate: float = 100.0           #: NMEA / Signal K UDP datagrams per source per ship second
+    input_burst: float = 100.0          #: token bucket size of that limit [datagrams]
     xte_lookahead: float = 500.0        #: cross-track correction lookahead for RMB/XTE [m]
 
     def validate(self) -> "AutopilotConfig":
@@ -92,8 +116,10 @@ class AutopilotConfig:
         require_finite_range("--turn-rate", self.turn_rate, 0.0, 1.0)
         require_finite_range("--max-age", self.max_age, 0.0, 3600.0)
         if not math.isnan(self.rpm_cmd):
-            require_finite_range("--rpm", self.rpm_cmd, 0.0, 1000.0, lo_open=True)
+            require_finite_range("--rpm", self.rpm_cmd, 0.0, 1000.0)   # 0: propeller stopped
         require_finite_range("--xte-lookahead", self.xte_lookahead, 1.0, 1e5)
+        require_finite_range("--input-rate", self.input_rate, 0.0, 1e6)
+        require_finite_range("--input-burst", self.input_burst, 1.0, 1e6)
         return self
 
 
@@ -165,8 +191,12 @@ class Autopilot:
         self.arrived: dict = {}        # source -> the destination id it reported reached
         self.course_source = None      # what the set course came from last ("APB", "RMB", "HTC", ...)
         self.steered = (None, None)    # (heading [rad] the last sample steered by, its source)
-        self.nmea_counts = {"accepted": 0, "rejected": 0}
-        self.signalk_counts = {"accepted": 0, "rejected": 0}
+        # per reason (steerlab.runtime.nmea.REJECT_REASONS, rate_limited, ...), shown live in
+        # status() and by the rejection report; ``accepted`` and ``ignored`` are normal traffic
+        self.nmea_counts: Counter = Counter(accepted=0)
+        self.signalk_counts: Counter = Counter(accepted=0)
+        self.nmea_limiter = RateLimiter(cfg.input_rate * cfg.speedup, cfg.input_burst)
+        self.signalk_limiter = RateLimiter(cfg.input_rate * cfg.speedup, cfg.input_burst)
         self.track: deque = deque(maxlen=4000)
         self.last_row: dict = {}
         self.nmea_listen = nmea_listen
@@ -205,12 +235,19 @@ class Autopilot:
             self.latest_t = self.clock() if t is None else t
 
     def on_nmea_datagram(self, data: bytes, addr=None, t: float | None = None) -> None:
+        """NMEA 0183 lines (:func:`steerlab.runtime.nmea.steering_inputs`: range, status and
+        plausibility checks), after a per-source rate limit; every line counted by outcome."""
         from steerlab.runtime.nmea import steering_inputs
 
+        if not self.nmea_limiter.allow(addr, time.monotonic()):
+            self.nmea_counts["rate_limited"] += 1
+            return
         t = self.clock() if t is None else t
         got = steering_inputs(data, self.config.xte_lookahead)
         self.nmea_counts["accepted"] += got["accepted"]
-        self.nmea_counts["rejected"] += got["rejected"]
+        if got["ignored"]:
+            self.nmea_counts["ignored"] += got["ignored"]
+        self.nmea_counts.update(got["reasons"])
         if got["heading"] is not None:
             self.nmea_heading = (got["heading"], t)
         if got["course"] is not None:
@@ -223,16 +260,30 @@ class Autopilot:
     def on_signalk_datagram(self, data: bytes, addr=None, t: float | None = None) -> None:
         from steerlab.runtime.signalk import parse_delta
 
+        if not self.signalk_limiter.allow(addr, time.monotonic()):
+            self.signalk_counts["rate_limited"] += 1
+            return
         t = self.clock() if t is None else t
         values = parse_delta(data)
         if values is None:
-            self.signalk_counts["rejected"] += 1
+            self.signalk_counts["malformed"] += 1
+            return
+        target = values.get(TARGET_HEADING)
+        state = values.get(AUTOPILOT_STATE)
+        if target is None and state is None:
+            self.signalk_counts["ignored"] += 1
+            return
+        # the same checks as a PUT (a heading in radians, |value| <= 2 pi; "auto" or "standby")
+        if target is not None and (isinstance(target, bool) or not isinstance(target, (int, float))
+                                   or not math.isfinite(target) or abs(target) > 2 * math.pi):
+            self.signalk_counts["out_of_range"] += 1
+            return
+        if state is not None and state not in ("auto", "standby"):
+            self.signalk_counts["bad_field"] += 1
             return
         self.signalk_counts["accepted"] += 1
-        target = values.get("steering.autopilot.target.headingTrue")
-        if isinstance(target, (int, float)) and math.isfinite(target):
+        if target is not None:
             self.set_course(float(target), t)
-        state = values.get("steering.autopilot.state")
         if state == "auto":
             self.engage(t)
         elif state == "standby":
@@ -296,7 +347,11 @@ class Autopilot:
         return None, None, False
 
     def _heading(self, t: float):
-        if self.nmea_heading is not None and t - self.nmea_heading[1] <= self.config.nmea_timeout:
+        """``(heading [rad], source)``: a fresh NMEA HDT/THS heading, unless the ship state is
+        signed (a key) and ``nmea_heading_over_signed`` is off: then the signed state's heading,
+        so an unauthenticated sender on the NMEA port cannot steer the ship by a false heading."""
+        fresh = self.nmea_heading is not None and t - self.nmea_heading[1] <= self.config.nmea_timeout
+        if fresh and (not self.key or self.config.nmea_heading_over_signed):
             return self.nmea_heading[0], "nmea"
         return self.latest.psi, "state"
 
@@ -344,7 +399,8 @@ class Autopilot:
             else:
                 self.mode = "standby"
             dev = abs(wrap_to_pi(psi - self.psi_set))
-            if dev <= cfg.off_course_limit and abs(wrap_to_pi(self.ref[REF_PSI] - self.psi_set)) < 1e-6:
+            if dev <= OFF_COURSE_ARM_FRACTION * cfg.off_course_limit \
+                    and abs(wrap_to_pi(self.ref[REF_PSI] - self.psi_set)) < 1e-6:
                 self.off_course_armed = True
             self.alarms.set(OFF_COURSE, self.off_course_armed and dev > cfg.off_course_limit, t,
                             f"heading off the set course by more than {deg(cfg.off_course_limit):g} deg")
@@ -375,6 +431,7 @@ class Autopilot:
             "accepted": self.filter.counts["accepted"], "rejected": self.filter.rejected(),
             "xte_m": float(self.ref[REF_XTE]) if link_ok and self.route is not None else math.nan,
             "leg": int(self.ref[REF_LEG]) if link_ok and self.route is not None else "",
+            "nmea_rejected": _rejected(self.nmea_counts), "signalk_rejected": _rejected(self.signalk_counts),
         }
         self.last_row = row
         return row
@@ -421,6 +478,7 @@ class Autopilot:
             "position": None if st is None else [st.x_n, st.y_e],
             "alarms": self.alarms.snapshot(), "controller": self.ctrl.name,
             "link": {k: v for k, v in self.filter.counts.items()},
+            "nmea": dict(self.nmea_counts), "signalk": dict(self.signalk_counts),
             "route": self.route.route.tolist() if self.route is not None else [],
             "track": self._track_summary(),
             "off_course_limit": self.config.off_course_limit,

@@ -16,8 +16,15 @@ In (autopilot): ``HDT``/``THS`` give the heading; ``APB`` ("heading to steer" if
 else "bearing present position to destination"), ``RMB`` (true bearing to destination) and
 ``HTC`` (heading to steer) give the set course. A bearing is corrected for the sentence's own
 cross-track error ``xte`` with direction to steer L/R: ``course = bearing ± atan(xte / lookahead)``.
-``XTE`` is parsed and counted (APB and RMB carry the same error; XTE gives no course). Lines need
-a valid checksum; anything else is counted as rejected, never raised.
+``XTE`` is parsed and counted (APB and RMB carry the same error; XTE gives no course).
+
+Checks (plausibility and range, :func:`steering_inputs`): a line needs a valid checksum; in the
+sentences the autopilot reads, every direction must be a number in [0, 360] deg (a THS heading of
+1e300 or an HTC course of 1e5 is rejected, as is NaN), a cross-track error at most
+:data:`MAX_XTE_NMI`, status and mode letters from the standard's set (``V``, data invalid, rejects;
+THS modes A/E/M/S), and the course a true one (an APB that gives only magnetic bearings is
+rejected as ``magnetic``, never accepted and ignored). Each rejected line is counted once under its
+reason (:data:`REJECT_REASONS`), lines past :data:`MAX_LINES` in one datagram too; nothing raises.
 
 Course source priority (:data:`COURSE_PRIORITY`): **APB > RMB > HTC**. A plotter that sends
 both APB and RMB steers by APB alone (it carries the heading to steer and the leg's bearing);
@@ -31,6 +38,7 @@ from __future__ import annotations
 
 import math
 import time
+from collections import Counter
 
 import pynmea2
 from pynmea2 import TalkerSentence
@@ -41,6 +49,8 @@ from steerlab.guidance.los import los_heading
 EARTH_RADIUS = 6_371_000.0
 MAX_LINE = 96
 MAX_LINES = 32
+MAX_XTE_NMI = 1000.0   #: a larger cross-track error is implausible [nmi]
+THS_VALID_MODES = ("A", "E", "M", "S")   #: autonomous, estimated, manual, simulator (V: invalid)
 TALKER = "II"
 COURSE_PRIORITY = ("APB", "RMB", "HTC")   #: course sources, the first fresh one wins
 DEFAULT_ORIGIN = (54.5, 18.9)
@@ -181,13 +191,6 @@ def _num(x):
     return v if math.isfinite(v) else None
 
 
-def _xte_m(magnitude, unit: str | None) -> float | None:
-    m = _num(magnitude)
-    if m is None:
-        return None
-    return m * (1000.0 if unit == "K" else 1852.0)
-
-
 def _corrected(bearing_deg, xte_m, steer, lookahead: float):
     """The simulator's LOS law (:func:`steerlab.guidance.los.los_heading`) on a plotter's leg
     course (or bearing) and cross-track error: steer ``R`` means the ship is to port of the
@@ -202,30 +205,99 @@ def _corrected(bearing_deg, xte_m, steer, lookahead: float):
     return c
 
 
+class Rejected(ValueError):
+    """A sentence with a valid checksum whose content is not usable: ``reason`` names why
+    (one of :data:`REJECT_REASONS`)."""
+
+    def __init__(self, reason: str):
+        super().__init__(reason)
+        self.reason = reason
+
+
+REJECT_REASONS = {
+    "not_ascii": "the datagram is not ASCII text",
+    "malformed": "not a sentence, a bad checksum, or longer than 96 characters",
+    "too_many_lines": f"a line past the first {MAX_LINES} of one datagram",
+    "missing_field": "the field the autopilot needs is empty",
+    "bad_field": "a number that does not parse, or a status/mode/unit letter outside the standard's set",
+    "out_of_range": f"a direction outside [0, 360] deg or a cross-track error above {MAX_XTE_NMI:g} nmi",
+    "invalid_status": "the sender flags the data invalid (status or mode V)",
+    "magnetic": "a magnetic direction only (the autopilot steers true courses)",
+    "not_heading_mode": "HTC with manual override in use or a steering mode other than heading/track (H, S, T)",
+}
+"""Why a line was rejected (the keys of the rejection counts, :func:`steering_inputs`)."""
+
+
+def _direction(x, required: bool = True):
+    """A direction field [deg] checked: a number in [0, 360] (``360`` = north), or None when
+    empty and not ``required``."""
+    if x is None or (isinstance(x, str) and not x.strip()):
+        if required:
+            raise Rejected("missing_field")
+        return None
+    v = _num(x)
+    if v is None:
+        raise Rejected("bad_field")
+    if not 0.0 <= v <= 360.0:
+        raise Rejected("out_of_range")
+    return v % 360.0
+
+
+def _status_ok(*flags) -> None:
+    """Status letters: ``A`` valid; ``V`` (data invalid) rejects as ``invalid_status``; anything
+    else as ``bad_field``; an empty status is taken as valid (older talkers leave it out)."""
+    for f in flags:
+        f = (f or "").strip()
+        if f == "V":
+            raise Rejected("invalid_status")
+        if f not in ("A", ""):
+            raise Rejected("bad_field")
+
+
+def _xte_checked(magnitude, unit: str | None, steer) -> float | None:
+    """Cross-track error [m] of a magnitude field and its unit (N nmi, K km), range-checked;
+    None when empty. ``steer``, the direction to steer, must be ``L``, ``R`` or empty."""
+    if magnitude is None or not str(magnitude).strip():
+        return None
+    m = _num(magnitude)
+    if m is None or (unit or "N") not in ("N", "K") or (steer or "") not in ("L", "R", ""):
+        raise Rejected("bad_field")
+    if not 0.0 <= m <= MAX_XTE_NMI * (1.852 if unit == "K" else 1.0):
+        raise Rejected("out_of_range")
+    return m * (1000.0 if unit == "K" else 1852.0)
+
+
 def _course_from(s, lookahead: float):
+    """The set course [rad] of an APB, RMB or HTC sentence; raises :class:`Rejected` with the
+    reason when the sentence is flagged invalid, magnetic only, out of range or not a heading
+    command (a plotter's course is never silently dropped)."""
     kind = type(s).__name__
     if kind == "APB":
-        if getattr(s, "status_gen", "A") == "V":
-            return None
-        if getattr(s, "heading_to_dest_type", "") == "T" and _num(getattr(s, "heading_to_dest", None)) is not None:
-            return rad(_num(s.heading_to_dest))
-        xte = _xte_m(s.cross_track_err_mag, s.cross_track_unit)
+        _status_ok(s.status_gen, s.status_cycle_lock)
+        xte = _xte_checked(s.cross_track_err_mag, s.cross_track_unit, s.dir_steer)
+        kinds = (s.heading_to_dest_type, s.bearing_type, s.bearing_pres_dest_type)
+        if any(k not in ("T", "M", "", None) for k in kinds):
+            raise Rejected("bad_field")
+        if s.heading_to_dest_type == "T" and _direction(s.heading_to_dest, False) is not None:
+            return rad(_direction(s.heading_to_dest))
         # the LOS law steers by the leg's course (origin -> destination), as the simulator does
-        if getattr(s, "bearing_type", "") == "T" and _num(getattr(s, "bearing_to_dest", None)) is not None:
-            return _corrected(s.bearing_to_dest, xte, s.dir_steer, lookahead)
-        if getattr(s, "bearing_pres_dest_type", "") != "T":
-            return None
-        return _corrected(s.bearing_pres_dest, xte, s.dir_steer, lookahead)
+        if s.bearing_type == "T" and _direction(s.bearing_to_dest, False) is not None:
+            return _corrected(_direction(s.bearing_to_dest), xte, s.dir_steer, lookahead)
+        if s.bearing_pres_dest_type == "T":
+            return _corrected(_direction(s.bearing_pres_dest), xte, s.dir_steer, lookahead)
+        raise Rejected("magnetic" if "M" in kinds else "missing_field")
     if kind == "RMB":
-        if getattr(s, "status", "A") != "A":
-            return None
-        return _corrected(s.dest_true_bearing, _xte_m(s.cross_track_error, "N"),
-                          s.cte_correction_dir, lookahead)
+        _status_ok(s.status)
+        xte = _xte_checked(s.cross_track_error, "N", s.cte_correction_dir)
+        return _corrected(_direction(s.dest_true_bearing), xte, s.cte_correction_dir, lookahead)
     if kind == "HTC":
-        if getattr(s, "override", "V") == "A" or getattr(s, "steering_mode", "") not in ("H", "S", "T"):
-            return None
-        h = _num(getattr(s, "heading_to_steer", None))
-        return None if h is None else rad(h)
+        if (s.override or "V") not in ("A", "V") or (s.heading_reference or "T") not in ("T", "M"):
+            raise Rejected("bad_field")
+        if s.override == "A" or (s.steering_mode or "") not in ("H", "S", "T"):
+            raise Rejected("not_heading_mode")
+        if s.heading_reference == "M":
+            raise Rejected("magnetic")
+        return rad(_direction(s.heading_to_steer))
     return None
 
 
@@ -241,12 +313,31 @@ def _arrival(s) -> tuple[str, bool]:
 
 
 def _heading_from(s):
+    """Heading [deg] of an HDT or THS sentence, checked (raises :class:`Rejected`); None for
+    other sentences."""
     kind = type(s).__name__
     if kind == "HDT":
-        return None if getattr(s, "hdg_true", "T") not in ("T", "") else _num(s.heading)
+        if (s.hdg_true or "T") != "T":
+            raise Rejected("bad_field")
+        return _direction(s.heading)
     if kind == "THS":
-        return None if getattr(s, "mode", "V") == "V" else _num(s.heading)
+        mode = (s.mode or "").strip()
+        if mode == "V":
+            raise Rejected("invalid_status")
+        if mode not in THS_VALID_MODES:
+            raise Rejected("bad_field")
+        return _direction(s.heading)
     return None
+
+
+def _xte_from(s):
+    """Cross-track error [m] of an XTE sentence (> 0: steer left), checked; None if empty."""
+    _status_ok(s.warning_flag, s.lock_flag)
+    x = _xte_checked(s.cross_track_err_dist, s.dist_units, s.correction_dir)
+    return None if x is None else x * (1.0 if s.correction_dir == "L" else -1.0)
+
+
+USED = ("HDT", "THS", "APB", "RMB", "HTC", "XTE")   #: the sentences the autopilot reads
 
 
 def steering_inputs(data: bytes, lookahead: float = 500.0) -> dict:
@@ -254,41 +345,55 @@ def steering_inputs(data: bytes, lookahead: float = 500.0) -> dict:
     source in the datagram, :data:`COURSE_PRIORITY`), or None.
 
     ``courses`` has the last course of each source: ``{"APB": {"course", "dest", "arrived"}, ...}``;
-    ``course_source`` names the source of ``course``. Counts ``accepted`` (parsed with a valid
-    checksum) and ``rejected`` lines; never raises.
+    ``course_source`` names the source of ``course``. Every non-empty line is counted once:
+    ``accepted`` (a sentence the autopilot reads, :data:`USED`, that passed the checks),
+    ``ignored`` (a valid sentence of another type, e.g. RMC) or rejected: ``reasons`` counts the
+    rejections by reason (:data:`REJECT_REASONS`: range, status, magnetic-only...), ``rejected``
+    is their total. Lines past :data:`MAX_LINES` are counted (``too_many_lines``), not parsed.
+    Never raises.
     """
     out = {"heading": None, "course": None, "course_source": None, "courses": {}, "xte_m": None,
-           "accepted": 0, "rejected": 0}
+           "accepted": 0, "ignored": 0, "rejected": 0, "reasons": Counter()}
+    reasons = out["reasons"]
     try:
         text = bytes(data).decode("ascii")
     except Exception:
-        out["rejected"] += 1
+        reasons["not_ascii"] += 1
+        out["rejected"] = 1
         return out
-    for line in text.splitlines()[:MAX_LINES]:
-        if not line.strip():
-            continue
+    lines = [ln for ln in text.splitlines() if ln.strip()]
+    if len(lines) > MAX_LINES:
+        reasons["too_many_lines"] += len(lines) - MAX_LINES
+    for line in lines[:MAX_LINES]:
         s = parse_line(line)
         if s is None:
-            out["rejected"] += 1
+            reasons["malformed"] += 1
             continue
-        out["accepted"] += 1
+        kind = type(s).__name__
+        if kind not in USED:
+            out["ignored"] += 1
+            continue
         try:
             h = _heading_from(s)
-            if h is not None:
-                out["heading"] = rad(h % 360.0)
             c = _course_from(s, lookahead)
-            if c is not None and math.isfinite(c):
-                dest, arrived = _arrival(s)
-                out["courses"][type(s).__name__] = {"course": c, "dest": dest, "arrived": arrived}
-            if type(s).__name__ == "XTE":
-                x = _xte_m(s.cross_track_err_dist, s.dist_units)
-                if x is not None:
-                    out["xte_m"] = x * (1.0 if s.correction_dir == "L" else -1.0)
-        except Exception:
-            out["rejected"] += 1
-            out["accepted"] -= 1
+            x = _xte_from(s) if kind == "XTE" else None
+        except Rejected as why:
+            reasons[why.reason] += 1
+            continue
+        except Exception:                   # a field pynmea2 could not give: never raise
+            reasons["bad_field"] += 1
+            continue
+        out["accepted"] += 1
+        if h is not None:
+            out["heading"] = rad(h)
+        if c is not None and math.isfinite(c):
+            dest, arrived = _arrival(s)
+            out["courses"][kind] = {"course": c, "dest": dest, "arrived": arrived}
+        if x is not None:
+            out["xte_m"] = x
     for kind in COURSE_PRIORITY:
         if kind in out["courses"]:
             out["course"], out["course_source"] = out["courses"][kind]["course"], kind
             break
+    out["rejected"] = sum(reasons.values())
     return out

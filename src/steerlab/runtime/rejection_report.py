@@ -12,7 +12,7 @@ import asyncio
 import sys
 from collections import Counter
 
-NOT_REJECTIONS = frozenset({"accepted", "clients", "sent", "subscriptions", "put_ok"})
+NOT_REJECTIONS = frozenset({"accepted", "ignored", "clients", "sent", "subscriptions", "put_ok"})
 """Counter keys that count normal traffic, not rejections."""
 
 

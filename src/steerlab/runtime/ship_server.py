@@ -20,6 +20,7 @@ from __future__ import annotations
 import asyncio
 import math
 import time
+from collections import Counter
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -124,6 +125,9 @@ class ShipServer:
         self.ship_options = s.ship.options(scenario.ship.options)
         self.ps = s.ps.copy()
         self.rpm = float(scenario.ship.rpm) if scenario.ship.rpm is not None else math.nan
+        self.rpm_ordered = self.rpm      # the last rpm order seen (applied or not)
+        self.rpm_counts: Counter = Counter(accepted=0)
+        self.rpm_error = ""
         self.x = s.x0.copy()
         self.work = np.empty((5, self.x.shape[0]))
         n_sub = max(1, math.ceil(self.config.publish_period / s.dt - 1e-9))
@@ -180,10 +184,38 @@ class ShipServer:
     def apply_command(self, cmd: P.Command) -> None:
         self.order = float(cmd.delta_cmd)
         self.last_cmd_t = self.t_sim
-        if not math.isnan(cmd.rpm_cmd) and cmd.rpm_cmd != self.rpm:
-            if cmd.rpm_cmd > 0.0:
-                self.ps = self.setup.ship.pack(self.speed, cmd.rpm_cmd, self.ship_options)
-                self.rpm = float(cmd.rpm_cmd)
+        if not math.isnan(cmd.rpm_cmd) and cmd.rpm_cmd != self.rpm_ordered:
+            self.order_rpm(float(cmd.rpm_cmd))
+
+    def order_rpm(self, rpm: float) -> bool:
+        """Apply a propeller order [rev/min] (0 included: the propeller stopped) to the model.
+
+        The ship's own ``pack`` takes it, as a scenario's ``[ship] rpm`` would; a ship indexed
+        by propeller rate (the Capella catalogue entries) takes it as ``[ship.options] rpm``.
+        An order the model refuses (outside its range, e.g. Capella's 110-220 rpm) or that does
+        not change it (a model without a propeller) leaves the ship as it is and is counted in
+        ``rpm_counts`` (``refused`` with the message in ``rpm_error``; ``no_effect``), once per
+        new order value (the autopilot repeats its order in every datagram). Never raises.
+        """
+        self.rpm_ordered = rpm
+        ship = self.setup.ship
+        try:
+            if "rpm" in getattr(ship.options_model, "model_fields", {}):
+                options = ship.options({**dict(self.scenario.ship.options or {}), "rpm": rpm})
+                ps = ship.pack(self.speed, None, options)
+            else:
+                ps = ship.pack(self.speed, rpm, self.ship_options)
+        except InputError as err:
+            self.rpm_counts["refused"] += 1
+            self.rpm_error = f"rpm order {rpm:g} refused: {err}"
+            return False
+        if ps.shape == self.ps.shape and np.array_equal(ps, self.ps, equal_nan=True):
+            self.rpm_counts["no_effect"] += 1
+            return False
+        self.ps = ps
+        self.rpm = rpm
+        self.rpm_counts["accepted"] += 1
+        return True
 
     # ------------------------------------------------------------ I/O
     def on_datagram(self, data: bytes, addr) -> None:
