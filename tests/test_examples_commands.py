@@ -206,8 +206,9 @@ def _run(label, env_assign, argv, workdir):
         argv = _ports(_smaller(argv))
         return argv, _in_process(argv, workdir)
     env = _env(env_assign, workdir)
-    if argv[0] == "cache" and "STEERLAB_CACHE_DIR" not in env_assign:
-        # never clear or fill the cache the rest of the suite (and the user) runs on
+    if argv[0] == "cache" and "clear" in argv and "STEERLAB_CACHE_DIR" not in env_assign:
+        # never clear the cache the rest of the suite (and the user) runs on ('warm' only adds
+        # to it: the same drivers any test would compile, so it may share the warmed cache)
         env["STEERLAB_CACHE_DIR"] = str(workdir / "private-cache")
     argv = _smaller(argv)
     server = None
