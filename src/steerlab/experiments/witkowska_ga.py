@@ -157,9 +157,9 @@ def replay(label: str, loading: str, settings: dict):
     compiled; a one-run batch)."""
     from steerlab.metrics import speed_loss_J
     from steerlab.sim.setup import build
-    from steerlab.sweeps.packed import PackedBatch
+    from steerlab.sim.batch import simulate_batch
 
-    res = PackedBatch.from_setups([build(base_scenario(label, loading, settings))]).run(record_every=10)
+    res = simulate_batch([build(base_scenario(label, loading, settings))], record_every=10)
     return (res.time, np.degrees(res.states[0, :, 2]), np.degrees(res.states[0, :, -1]),
             speed_loss_J(res.acc[0], LAMBDA))
 

@@ -2,7 +2,7 @@ r"""Monte-Carlo over sea realisations: distributions and confidence intervals of
 
 The scenario is run ``n_runs`` times with seeds ``scenario.seed + i`` (each seed a different
 realisation of the sampled disturbances, e.g. the eq-39 coloured noise), in compiled batches
-of up to :data:`CHUNK_RUNS` runs (:class:`~steerlab.sweeps.packed.PackedBatch`). For every metric of
+of up to :data:`CHUNK_RUNS` runs (:class:`~steerlab.sim.batch.PackedBatch`). For every metric of
 :func:`steerlab.metrics.integral_metrics` (exact, from the on-line accumulator) and of
 :func:`steerlab.metrics.step_metrics` plus the final error and the largest rudder angle
 (from the recorded log, every ``record_every`` steps) it reports
@@ -28,7 +28,7 @@ from steerlab.metrics import METRIC_UNITS, R2D, integral_metrics, step_metrics
 from steerlab.progress import runs_progress
 from steerlab.sweeps.conditions import condition_set
 from steerlab.sweeps.executors import LocalExecutor
-from steerlab.sweeps.packed import PackedBatch
+from steerlab.sim.batch import PackedBatch
 
 MAX_RUNS = 100_000
 CHUNK_RUNS = 256
