@@ -27,15 +27,16 @@ from steerlab.config_base import FrozenConfig
 from steerlab.environment.channels import W_RUDDER
 from steerlab.ships.kinematics import earth_velocity
 from steerlab.ships.registry import ShipSpec
-from steerlab.records import Field, Layout
+from steerlab.records import Field as RecordField
+from steerlab.records import Layout
 from steerlab.ships.state import IPSI, IR, IU, IV, PLANAR_NAMES, PLANAR_UNITS
 
 # the parameter record: declared once (name, unit, bounds, doc); the index constants, the
 # length and pack() come from the declaration; the plant state is read by name (ships/state.py)
 PARAMS = Layout("ship", "P_", [
-    Field("K", "K", "1/s", "rudder-to-yaw-rate gain", lo=0.0, lo_open=True),
-    Field("T", "T", "s", "time constant", lo=0.0, lo_open=True),
-    Field("A", "a", "s^2/rad^2", "cubic yaw damping", lo=0.0),
+    RecordField("K", "K", "1/s", "rudder-to-yaw-rate gain", lo=0.0, lo_open=True),
+    RecordField("T", "T", "s", "time constant", lo=0.0, lo_open=True),
+    RecordField("A", "a", "s^2/rad^2", "cubic yaw damping", lo=0.0),
 ], size_name="N_PARAMS")
 PARAMS.export(globals())          # P_K = 0, P_T = 1, P_A = 2, N_PARAMS = 3 (plain ints)
 
