@@ -98,6 +98,7 @@ def test_ship_checks():
     assert "esso_alloc_t" not in SHIPS
 
 
+@pytest.mark.slow          # compiles a batch group for a kernel that cannot be cached (a closure)
 @pytest.mark.skipif(not numba.config.LOOP_VECTORIZE, reason="numba's loop vectoriser is switched off")
 def test_a_kernel_that_breaks_vectorisation_is_one_warning_line():
     """Nomoto 1 plus a C-library call (atan2) in its rhs: the same numbers, but the batch engine
