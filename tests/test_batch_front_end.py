@@ -80,3 +80,18 @@ def test_montecarlo_and_robustness_of_a_los_scenario_go_through_the_one_batch(lo
     rb = run_robustness(sc, [parse_vary("ship.speed_kn=9:11:2", sc)], metric="itae")
     nominal = integral_metrics(direct.acc[0])["itae_deg_s2"]
     assert rb.nominal["metric"] == nominal and rb.metric_values.shape == (2,)
+
+
+def test_montecarlo_of_a_berthing_scenario_goes_through_the_one_batch():
+    """Berthing guidance orders the propeller rate into the batch's own copy of PS: the sweep
+    gives each seed's single-run numbers."""
+    from steerlab.experiments.berthing2019 import PID_PAPER, scenario_dict
+    from steerlab.sim.setup import build_seeds
+    from steerlab.sweeps.montecarlo import run_montecarlo
+
+    sc = scenario_from_dict(scenario_dict(PID_PAPER, wind=True, duration=25.0))
+    mc = run_montecarlo(sc, 2, record_every=10)
+    singles = [simulate(s) for s in build_seeds(sc, [sc.seed, sc.seed + 1])]
+    assert mc.per_run["iae_deg_s"].tolist() == [integral_metrics(r.meta["online_metrics"])["iae_deg_s"]
+                                                for r in singles]
+    assert 300.0 in set(np.round(singles[0].meta["guidance_log"]["rpm_cmd"] * 60.0, 9))
