@@ -210,11 +210,10 @@ def test_kosoko_at_10_kn_diverges_and_says_so(tmp_path):
 
 def test_batch_flags_diverged_runs():
     from steerlab.sim.batch import BatchResult
-    from steerlab.sweeps.packed import BatchOutput
 
     fs = np.array([[0.0, 1.0], [np.nan, 1.0], [0.0, 1.0]])
     acc = np.array([[1.0], [1.0], [np.inf]])
-    assert BatchOutput(acc, fs).diverged.tolist() == [False, True, True]
+    assert BatchResult(acc, fs).diverged.tolist() == [False, True, True]
     br = BatchResult(acc, fs, np.zeros(1), np.zeros((3, 1, 2)), np.zeros((3, 1)), np.zeros((3, 1, 2)), ("a", "b"))
     assert br.diverged.tolist() == [False, True, True]
 
@@ -274,7 +273,7 @@ def test_montecarlo_leaves_diverged_runs_out_and_flags_them():
     """A fake executor returns one diverged run of three: its metrics are NaN, the others count."""
     from steerlab.metrics_online import N_ACC
     from steerlab.sweeps.montecarlo import run_montecarlo
-    from steerlab.sweeps.packed import BatchOutput
+    from steerlab.sim.batch import BatchResult
 
     class Fake:
         def run(self, batch, record_every, progress=None):
@@ -284,7 +283,7 @@ def test_montecarlo_leaves_diverged_runs_out_and_flags_them():
             fs = np.zeros((n, nx))
             fs[1, 4] = np.nan
             states = np.zeros((n, n_rec, nx))
-            return BatchOutput(acc, fs, np.arange(n_rec) * record_every * batch.dt, states,
+            return BatchResult(acc, fs, np.arange(n_rec) * record_every * batch.dt, states,
                                np.zeros((n, n_rec)), np.zeros((n, n_rec, 2)))
 
     res = run_montecarlo(make_scenario(duration=50.0), 3, record_every=10, executor=Fake())

@@ -362,3 +362,51 @@ def test_no_literal_plant_state_or_reference_index_anywhere_in_the_package():
     found = [hit for p in sorted(src.rglob("*.py")) if p.name not in NOT_PLANT_STATE
              for hit in _literal_state_or_reference_indices(p)]
     assert not found, found
+
+
+BATCH_ARRAYS = {"states", "final_states", "X", "XL", "xs", "out_x", "x", "x0", "ref", "out_ref", "w", "W",
+                "disturbance"}
+"""Names of logged or batch arrays whose last axis is the plant state, the reference vector or
+the disturbance channels (``b.states[j, :, IPSI]``, ``X[:, IR]``, ``s.w[:, W_RUDDER]``)."""
+
+
+def _literal_batch_indices(path):
+    """``X[:, 2]``, ``b.states[j, :, 2]``, ``ref[..., 0]`` in ``path``: an array of
+    :data:`BATCH_ARRAYS` indexed on its last axis by a literal int after a slice or ``...``
+    (negative ints, e.g. ``[:, -1]`` for the rudder, last by definition, are allowed)."""
+    import ast
+
+    out = []
+    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        if not (isinstance(node, ast.Subscript) and isinstance(node.slice, ast.Tuple)):
+            continue
+        base = node.value
+        name = base.attr if isinstance(base, ast.Attribute) else base.id if isinstance(base, ast.Name) else None
+        *lead, last = node.slice.elts
+        if (name in BATCH_ARRAYS and isinstance(last, ast.Constant) and type(last.value) is int
+                and any(isinstance(e, ast.Slice) or (isinstance(e, ast.Constant) and e.value is Ellipsis)
+                        for e in lead)):
+            out.append(f"{path.name}:{node.lineno}: {ast.unparse(node)}")
+    return out
+
+
+def test_the_batch_scan_finds_literal_indices(tmp_path):
+    p = tmp_path / "probe.py"
+    p.write_text("a = X[:, 2]\nb = res.states[j, :, 5]\nc = out.ref[..., 1]\nd = X[:, IPSI]\n"
+                 "e = states[:, -1]\nf = route[:, 0]\ng = s.w[:, W_RUDDER]\n", encoding="utf-8")
+    assert [h.split(": ", 1)[1] for h in _literal_batch_indices(p)] == ["X[:, 2]", "res.states[j, :, 5]",
+                                                                       "out.ref[..., 1]"]
+
+
+def test_no_literal_index_into_batch_or_log_arrays_in_the_package_or_the_examples():
+    """Sweeps, experiments, plots, trials, the engines and the examples index logged and batch
+    arrays of plant states, references and disturbances by their generated names."""
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parent.parent
+    paths = [*sorted((root / "src" / "steerlab").rglob("*.py")), *sorted((root / "examples").rglob("*.py"))]
+    found = [hit for p in paths for hit in _literal_batch_indices(p)]
+    assert not found, found
+    # the single-index scan covers the examples too (the user's own modules read by name)
+    found = [hit for p in sorted((root / "examples").rglob("*.py")) for hit in _literal_state_or_reference_indices(p)]
+    assert not found, found

@@ -12,7 +12,7 @@ from steerlab.metrics import compute_metrics
 from steerlab.sim.engine import simulate
 from steerlab.sim.scenario import scenario_from_dict
 from steerlab.sweeps.montecarlo import run_montecarlo
-from steerlab.sweeps.packed import PackedBatch
+from steerlab.sim.batch import PackedBatch
 from steerlab.sweeps.robustness import parse_vary, run_robustness
 
 SEA = {

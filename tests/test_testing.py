@@ -14,7 +14,7 @@ from steerlab.control.pid import PIDConfig
 from steerlab.control.registry import CONTROLLERS, get_controller
 from steerlab.errors import InputError
 from steerlab.ships.registry import SHIPS, get_ship
-from steerlab.testing import check_controller, check_ship
+from steerlab.testing import VectorisationWarning, check_controller, check_ship
 
 
 @numba.njit
@@ -70,12 +70,15 @@ def test_wrong_state_size_is_named():
 def test_a_good_controller_passes_with_parity():
     out = check_controller(_spec("p_law_t", _p_law))
     assert out["parity_max_abs_diff"] <= 1e-12 and "no allocation" in out["rules"]
-    assert check_controller(get_controller("pid"))["n_params"] == 4
+    # a controller runs one run at a time in the batch loop: the ship's stages stay vectorised
+    assert out["warnings"] == [] and out["vectorised_stages"] in (None, 4) and "vectorises" in out["rules"]
+    assert check_controller(get_controller("pid"), vectorisation=False)["n_params"] == 4
 
 
 def test_ship_checks():
-    out = check_ship(get_ship("nomoto1"))
+    out = check_ship(get_ship("nomoto1"), vectorisation=False)   # its stages: tests/test_batch_lanes.py
     assert out["n_states"] == get_ship("nomoto1").n_states and out["parity_max_abs_diff"] <= 1e-12
+    assert "vectorises" not in out["rules"] and out["vectorised_stages"] is None
     esso = get_ship("esso")
     with pytest.raises(InputError) as err:
         check_ship(replace(esso, name="esso_bad_names_t", state_names=esso.state_names[:-1]))
@@ -93,6 +96,36 @@ def test_ship_checks():
         check_ship(replace(esso, name="esso_alloc_t", rhs=rhs_alloc))
     _one_line_naming(err, "no allocation", "esso_alloc_t")
     assert "esso_alloc_t" not in SHIPS
+
+
+@pytest.mark.slow          # compiles a batch group for a kernel that cannot be cached (a closure)
+@pytest.mark.skipif(not numba.config.LOOP_VECTORIZE, reason="numba's loop vectoriser is switched off")
+def test_a_kernel_that_breaks_vectorisation_is_one_warning_line():
+    """Nomoto 1 plus a C-library call (atan2) in its rhs: the same numbers, but the batch engine
+    can no longer run the RK4 stages as vector arithmetic across runs; one line names the rule."""
+    import math
+
+    from steerlab.ships.state import IR
+
+    nomoto = get_ship("nomoto1")
+    inner = nomoto.rhs
+
+    @numba.njit
+    def rhs_libm(t, x, delta, w, p, dx):
+        inner(t, x, delta, w, p, dx)
+        dx[IR] += 1e-12 * math.atan2(x[IR], 1.0)     # libm, once per run: not vectorisable
+
+    spec = replace(nomoto, name="nomoto_libm_t", rhs=rhs_libm)
+    with pytest.warns(VectorisationWarning) as rec:
+        out = check_ship(spec)
+    line = str(rec[0].message)
+    assert "\n" not in line and line.startswith("ship 'nomoto_libm_t': rule 'vectorises': ") and len(line) < 400
+    assert "calls the C library once per run (atan2" in line and out["warnings"] == [line]
+    assert out["parity_max_abs_diff"] <= 1e-12               # a warning: the numbers are right
+    with pytest.raises(InputError) as err:
+        check_ship(spec, strict=True)
+    _one_line_naming(err, "vectorises", "nomoto_libm_t")
+    assert "nomoto_libm_t" not in SHIPS
 
 
 _CACHED_ALLOCATING = '''

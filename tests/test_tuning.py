@@ -190,6 +190,42 @@ def test_parameter_mapping_direct_and_designed():
     assert PC[:, A_KD] == pytest.approx([12 / 100, 12 / 200])
 
 
+def test_wrapped_controller_is_tuned_by_name_at_exactly_that_slot():
+    """pid behind the wave filter and the sensors: ``kd`` is found by name (``inner.inner.Kd``
+    of the composed layout, never by probing slots), a population moves that column only, and
+    each packed row is the record a scenario with that Kd builds (sensor seed slots included)."""
+    from steerlab.sim.setup import build
+    from steerlab.tuning import params as tp
+
+    sc = scenario_from_dict({**LQ_SCENARIO, "duration": 20.0,
+                             "controller": {**LQ_SCENARIO["controller"], "type": "pid+wf", "filter_K": 0.1,
+                                            "filter_T": 50.0},
+                             "sensors": {"heading_noise_std_deg": 0.1}})
+    conds = condition_set(sc, n_seeds=2)
+    spec = conds[0].setup.controller
+    assert spec.name == "pid+wf+sensors"
+    name, slot, _ = tp.record_field(spec.params, "Kd", tp._sensor_depth(spec.name))
+    assert name == "inner.inner.Kd" and slot == spec.params.index("inner.inner.Kd")
+    pm = build_param_map(conds, ["kd", "filter_T"], np.array([[5.0, 50.0], [20.0, 80.0]]))
+    assert [d[0] for d in pm.direct] == [slot, spec.params.index("inner.filter_T")]
+    X = np.array([[12.5, 30.0], [40.0, 70.0]])
+    PC, Z = pm.pack(X)
+    base = np.stack([c.setup.pc for c in conds])
+    moved = np.nonzero((PC.reshape(2, 2, -1) != base[None]).any(axis=(0, 1)))[0]
+    assert moved.tolist() == sorted([slot, spec.params.index("inner.filter_T")])
+    for p_i, (kd, tf) in enumerate(X):
+        for c, cond in enumerate(conds):
+            ref = build(cond.scenario.replace(controller={**cond.scenario.controller.model_dump(), "Kd": kd,
+                                                          "filter_T": tf}))
+            np.testing.assert_array_equal(PC[p_i * 2 + c], ref.pc)
+            np.testing.assert_array_equal(Z[p_i * 2 + c], ref.z0)
+    # a field the design rule also derives other numbers from is designed, not written at its slot
+    nl = condition_set(scenario_from_dict({**LQ_SCENARIO, "duration": 20.0,
+                                           "controller": {"type": "nonlinear_adrc", "b": 0.002}}))
+    pm = build_param_map(nl, ["b"], np.array([[0.001, 0.004]]))
+    assert pm.direct == [None]
+
+
 @pytest.mark.parametrize("names, bounds, field, fragment", [
     (["kq"], [[0, 1]], "--params", "unknown parameter 'kq'"),
     (["kp", "kp"], [[0, 1], [0, 1]], "--params", "named twice"),

@@ -28,18 +28,31 @@ from pydantic import Field
 from steerlab.angles import wrap_to_pi
 from steerlab.config_base import FrozenConfig
 from steerlab.control.registry import ControllerSpec
+from steerlab.guidance.reference_vector import REF_PSI
+from steerlab.records import Field as RecordField
+from steerlab.records import Layout
+from steerlab.ships.state import IPSI
 
-# the parameter record and the state: declared once, used by pack() and the kernel
-C_KP, C_TD, C_TF, C_UMAX = 0, 1, 2, 3
-N_PARAMS = 4
-Z_D = 0
-N_STATE = 1
+# the parameter record and the state: declared once (steerlab.records); the index constants,
+# lengths and pack() come from the declaration, and ControllerSpec(params=PARAMS) lets the
+# tuner find a field's slot by name (Kp; inner.Kp behind the wave filter or [sensors])
+PARAMS = Layout("controller", "C_", [
+    RecordField("KP", "Kp", "rad/rad", "proportional gain", lo=0.0),
+    RecordField("TD", "Td", "s", "derivative time", lo=0.0),
+    RecordField("TF", "Tf", "s", "derivative filter time constant", lo=0.0, lo_open=True),
+    RecordField("UMAX", "u_max", "rad", "output limit", lo=0.0, lo_open=True),
+], size_name="N_PARAMS")
+PARAMS.export(globals())          # C_KP = 0, C_TD = 1, C_TF = 2, C_UMAX = 3, N_PARAMS = 4
+STATE = Layout("controller state", "Z_", [
+    RecordField("D", "d_filtered", "rad", "first-order filter of the heading error"),
+], size_name="N_STATE")
+STATE.export(globals())           # Z_D = 0, N_STATE = 1
 
 
 @numba.njit
 def my_pd_update(z, p, t, x, ref, h):
     """One sample of the law (module docstring); returns the rudder order [rad]."""
-    e = wrap_to_pi(ref[0] - x[2])
+    e = wrap_to_pi(ref[REF_PSI] - x[IPSI])
     d = (e - z[Z_D]) / p[C_TF]                  # filtered derivative [rad/s]
     z[Z_D] += min(h / p[C_TF], 1.0) * (e - z[Z_D])
     u = p[C_KP] * (e + p[C_TD] * d)
@@ -61,11 +74,11 @@ class MyPD:
     """The designed controller: its packed record and its initial state."""
 
     def __init__(self, cfg: MyPDConfig, u_max: float):
-        self.p = np.array([cfg.Kp, cfg.Td, cfg.Tf, u_max], dtype=np.float64)
+        self.p = PARAMS.pack(Kp=cfg.Kp, Td=cfg.Td, Tf=cfg.Tf, u_max=u_max)
 
     def init_state(self, x0, ref0) -> np.ndarray:
         z = np.zeros(N_STATE)
-        z[Z_D] = wrap_to_pi(ref0[0] - x0[2])        # start without a derivative kick
+        z[Z_D] = wrap_to_pi(ref0[0] - x0[IPSI])     # start without a derivative kick (ref0 = (psi, r))
         return z
 
 
@@ -78,4 +91,4 @@ def build(cfg: MyPDConfig, ctx):
 CONTROLLER = ControllerSpec(
     name="my_pd", description="user's PD with a filtered derivative, defined outside steerlab",
     update=my_pd_update, n_state=N_STATE, config=MyPDConfig, build=build,
-    source="textbook PD with a first-order derivative filter")
+    source="textbook PD with a first-order derivative filter", params=PARAMS)

@@ -27,24 +27,31 @@ from steerlab.config_base import FrozenConfig
 from steerlab.environment.channels import W_RUDDER
 from steerlab.ships.kinematics import earth_velocity
 from steerlab.ships.registry import ShipSpec
-from steerlab.ships.state import PLANAR_NAMES, PLANAR_UNITS
+from steerlab.records import Field as RecordField
+from steerlab.records import Layout
+from steerlab.ships.state import IPSI, IR, IU, IV, PLANAR_NAMES, PLANAR_UNITS
 
-# the parameter record: declared once, used by pack() and the kernel
-P_K, P_T, P_A = 0, 1, 2
-N_PARAMS = 3
+# the parameter record: declared once (name, unit, bounds, doc); the index constants, the
+# length and pack() come from the declaration; the plant state is read by name (ships/state.py)
+PARAMS = Layout("ship", "P_", [
+    RecordField("K", "K", "1/s", "rudder-to-yaw-rate gain", lo=0.0, lo_open=True),
+    RecordField("T", "T", "s", "time constant", lo=0.0, lo_open=True),
+    RecordField("A", "a", "s^2/rad^2", "cubic yaw damping", lo=0.0),
+], size_name="N_PARAMS")
+PARAMS.export(globals())          # P_K = 0, P_T = 1, P_A = 2, N_PARAMS = 3 (plain ints)
 
 
 @numba.njit
 def my_norrbin_rhs(t, x, delta, w, p, dx):
     """Derivatives of ``[x_n, y_e, psi, u, v, r]``: writes ``dx[:6]`` only, allocates nothing."""
-    psi = x[2]
-    u = x[3]
-    r = x[5]
+    psi = x[IPSI]
+    u = x[IU]
+    r = x[IR]
     earth_velocity(psi, u, 0.0, w, dx)
-    dx[2] = r
-    dx[3] = 0.0
-    dx[4] = 0.0
-    dx[5] = (p[P_K] * (delta + w[W_RUDDER]) - r - p[P_A] * r * r * r) / p[P_T]
+    dx[IPSI] = r
+    dx[IU] = 0.0
+    dx[IV] = 0.0
+    dx[IR] = (p[P_K] * (delta + w[W_RUDDER]) - r - p[P_A] * r * r * r) / p[P_T]
 
 
 class MyNorrbinOptions(FrozenConfig):
@@ -57,7 +64,7 @@ class MyNorrbinOptions(FrozenConfig):
 
 def pack(speed: float, rpm=None, options: MyNorrbinOptions | None = None) -> np.ndarray:
     o = options or MyNorrbinOptions()
-    return np.array([o.K, o.T, o.a], dtype=np.float64)
+    return PARAMS.pack(K=o.K, T=o.T, a=o.a)
 
 
 def b2_exact(speed, options=None):

@@ -24,6 +24,7 @@ import my_controller  # noqa: E402
 import my_ship  # noqa: E402
 
 import steerlab as sl  # noqa: E402
+from steerlab.ships.state import IPSI  # noqa: E402
 from steerlab.sim.setup import build  # noqa: E402
 
 
@@ -52,7 +53,7 @@ def main(duration: float = 600.0, runs: int = 8, generations: int = 3) -> dict:
     setups = [build(scenario.replace(seed=seed, controller={**scenario.controller.model_dump(), "Kp": kp}))
               for kp in (1.0, 1.5, 2.0) for seed in (1, 2, 3)]
     batch = sl.simulate_batch(setups)
-    out["batch_final_heading_deg"] = np.degrees(batch.final_states[:, 2]).round(3).tolist()
+    out["batch_final_heading_deg"] = np.degrees(batch.final_states[:, IPSI]).round(3).tolist()
 
     # 3. Monte-Carlo over sea realisations
     from steerlab.sweeps.montecarlo import run_montecarlo

@@ -47,6 +47,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from steerlab.errors import InputError
+from steerlab.guidance.reference_vector import REF_PSI
+from steerlab.ships.state import IPSI
 from steerlab.metrics import integral_metrics, step_metrics
 from steerlab.metrics_online import M_D2_DEG, M_E2_DEG
 
@@ -186,7 +188,7 @@ def metric_arrays(acc: np.ndarray, lam: float, names, time=None, states=None, re
         st = np.empty(n)
         mr = np.empty(n)
         for i in range(n):
-            sm = step_metrics(time, states[i, :, 2], ref[i, :, 0])
+            sm = step_metrics(time, states[i, :, IPSI], ref[i, :, REF_PSI])
             if sm["overshoot_pct"] is None and names & {"overshoot", "settling"}:
                 raise InputError("--cost", "'overshoot' and 'settling' are measured from a set-point change; "
                                  "the scenario's [guidance] has none (add changes = [...])")

@@ -16,12 +16,24 @@
   compiled loops and the batch lanes;
 * ``compiles``: numba compiles the kernel for the engine's argument types;
 * ``parity``: the readable and the compiled engine give the same run (rtol = atol = 1e-12)
-  on the short scenario.
+  on the short scenario;
+* ``vectorises`` (a **warning**, :class:`VectorisationWarning`; an error with
+  ``strict=True``): the batch engine's compiled group of the combination is read (LLVM IR,
+  :func:`steerlab.sim.lanes.vectorisation_report`): all four RK4 stages of the ship kernel
+  must become vector arithmetic across runs, with no C-library call made once per run.
+  A kernel that calls the C library (``math.sin``, ``math.atan2``, ``math.exp`` ...: use
+  :func:`steerlab.sincos.sincos` and :mod:`steerlab.vecmath`), loops a data-dependent number
+  of times or branches around a call keeps its numbers but runs one run at a time in a batch
+  (several times slower), as MMG and de Keizer's ships do: hence a warning, not a failure.
+  A controller is called one run at a time in the batch loop, so its own branches and calls
+  are allowed; the rule then confirms that the partner ship's stages stay vectorised with it.
 
 A violation raises :class:`~steerlab.errors.InputError` with one line naming the component
 and the rule, e.g. ``controller 'my_pid': rule 'no allocation': the compiled kernel
-allocates memory (np.empty/np.zeros/array expressions) ...``. On success the functions
-return a dict of what was checked.
+allocates memory (np.empty/np.zeros/array expressions) ...``; the ``vectorises`` rule warns
+with one such line (``ship 'my_ship': rule 'vectorises': ...``). On success the functions
+return a dict of what was checked (``vectorised_stages``: 4 when the batch vectorises,
+``warnings``: the lines warned).
 """
 
 from __future__ import annotations
@@ -36,6 +48,11 @@ from steerlab.guidance.reference_vector import N_REF, REF_PSI
 
 _ALLOCATORS = ("NRT_MemInfo_alloc", "NRT_MemInfo_new", "NRT_Allocate")
 PARITY_TOL = 1e-12
+RK4_STAGES = 4
+
+
+class VectorisationWarning(UserWarning):
+    """The batch engine cannot vectorise a kernel across runs: same numbers, one run at a time."""
 
 
 def _fail(kind: str, name: str, rule: str, msg: str):
@@ -110,6 +127,37 @@ def _parity(kind, name, setup) -> float:
     return worst
 
 
+def _vectorisation(kind, name, setup, strict: bool) -> tuple[int | None, list]:
+    """The ``vectorises`` rule (module docstring): ``(vectorised stages, warning lines)``."""
+    import warnings
+
+    import numba
+
+    from steerlab.sim.batch import simulate_batch
+    from steerlab.sim.lanes import vectorisation_report
+
+    if not numba.config.LOOP_VECTORIZE:       # NUMBA_LOOP_VECTORIZE=0: nothing to inspect
+        return None, []
+    simulate_batch([setup, setup])            # compiles (or loads) the batch group of the combination
+    rep = vectorisation_report(setup.ship.rhs, setup.controller.update, setup.x0.size, setup.guide)
+    stages, calls = rep["vectorised_stages"], rep["per_run_library_calls"]
+    if stages >= RK4_STAGES and not calls:
+        return stages, []
+    who = f"the ship kernel {setup.ship.name!r}" + ("" if kind == "ship" else f" with this controller")
+    if calls:
+        how = (f"it calls the C library once per run ({', '.join(calls)}; use steerlab.sincos.sincos, "
+               "steerlab.vecmath), so its RK4 stages are vector code in name only")
+    else:
+        how = (f"{stages} of {RK4_STAGES} RK4 stages vectorised (a C-library call such as math.sin or math.atan2, "
+               "a data-dependent loop or a branch around a call)")
+    msg = f"the batch engine cannot vectorise {who} across runs: {how}; same numbers, one run at a time (slower)"
+    if strict:
+        _fail(kind, name, "vectorises", msg)
+    line = f"{kind} {name!r}: rule 'vectorises': {msg}"
+    warnings.warn(line, VectorisationWarning, stacklevel=4)
+    return stages, [line]
+
+
 def _scenario(ship: str, controller: dict, duration: float, speed_kn=None, ship_options=None):
     from steerlab.sim.scenario import scenario_from_dict
 
@@ -122,18 +170,21 @@ def _scenario(ship: str, controller: dict, duration: float, speed_kn=None, ship_
     return scenario_from_dict(d)
 
 
-def check_controller(spec, ship: str = "esso", config: dict | None = None, duration: float = 30.0) -> dict:
+def check_controller(spec, ship: str = "esso", config: dict | None = None, duration: float = 30.0,
+                     vectorisation: bool = True, strict: bool = False) -> dict:
     """Check a :class:`~steerlab.control.registry.ControllerSpec` (module docstring).
 
     ``spec`` need not be registered: it is checked under its own name on ``ship``, with the
     scenario's ``[controller]`` table ``config`` (default: ``{"type": spec.name}``).
+    ``vectorisation=False`` skips the ``vectorises`` rule (it compiles the batch group);
+    ``strict=True`` makes it an error instead of a warning.
     """
     from steerlab.control import registry
 
     kind, name = "controller", getattr(spec, "name", repr(spec))
     cfg = dict(config or {"type": name})
     with _registered(registry.CONTROLLERS, kind, spec):
-        return _check_controller(spec, kind, name, ship, cfg, duration)
+        return _check_controller(spec, kind, name, ship, cfg, duration, vectorisation, strict)
 
 
 @contextlib.contextmanager
@@ -152,7 +203,7 @@ def _registered(reg, kind, spec):
             reg.unregister(name)
 
 
-def _check_controller(spec, kind, name, ship, cfg, duration):
+def _check_controller(spec, kind, name, ship, cfg, duration, vectorisation=True, strict=False):
     from steerlab.sim.setup import build, check_state_size, design
 
     try:
@@ -176,15 +227,18 @@ def _check_controller(spec, kind, name, ship, cfg, duration):
         _fail(kind, name, "no allocation", "the compiled kernel allocates memory (np.empty/np.zeros/array "
                                            "expressions): keep scratch space in the state z or the record p")
     diff = _parity(kind, name, setup)
+    rules = ["declared sizes", "record size", "compiles", "no allocation", "parity"]
+    stages, warned = _vectorisation(kind, name, setup, strict) if vectorisation else (None, [])
     return {"controller": name, "ship": ship, "n_state": int(z.shape[0]), "n_params": int(p.shape[0]),
-            "rules": ["declared sizes", "record size", "compiles", "no allocation", "parity"],
-            "parity_max_abs_diff": diff}
+            "rules": rules + (["vectorises"] if vectorisation else []), "parity_max_abs_diff": diff,
+            "vectorised_stages": stages, "warnings": warned}
 
 
 def check_ship(spec, controller: dict | None = None, speed_kn: float | None = None, options: dict | None = None,
-               duration: float = 30.0) -> dict:
+               duration: float = 30.0, vectorisation: bool = True, strict: bool = False) -> dict:
     """Check a :class:`~steerlab.ships.registry.ShipSpec` (module docstring), run with
-    ``controller`` (a ``[controller]`` table, default PID) at ``speed_kn`` with ``options``."""
+    ``controller`` (a ``[controller]`` table, default PID) at ``speed_kn`` with ``options``.
+    ``vectorisation=False`` skips the ``vectorises`` rule; ``strict=True`` makes it an error."""
     from steerlab.ships import registry
 
     kind, name = "ship", getattr(spec, "name", repr(spec))
@@ -192,10 +246,10 @@ def check_ship(spec, controller: dict | None = None, speed_kn: float | None = No
         _fail(kind, name, "declared sizes", f"n_states = {spec.n_states} but {len(spec.state_names)} state names "
                                             f"and {len(spec.state_units)} units")
     with _registered(registry.SHIPS, kind, spec):
-        return _check_ship(spec, kind, name, controller, speed_kn, options, duration)
+        return _check_ship(spec, kind, name, controller, speed_kn, options, duration, vectorisation, strict)
 
 
-def _check_ship(spec, kind, name, controller, speed_kn, options, duration):
+def _check_ship(spec, kind, name, controller, speed_kn, options, duration, vectorisation=True, strict=False):
     from steerlab.sim.setup import build
     from steerlab.units import KNOT
 
@@ -219,9 +273,11 @@ def _check_ship(spec, kind, name, controller, speed_kn, options, duration):
         _fail(kind, name, "no allocation", "the compiled rhs allocates memory (np.empty/np.zeros/array "
                                            "expressions): write into dx and use scalars")
     diff = _parity(kind, name, setup)
+    rules = ["declared sizes", "record size", "writes only its own", "compiles", "no allocation", "parity"]
+    stages, warned = _vectorisation(kind, name, setup, strict) if vectorisation else (None, [])
     return {"ship": name, "n_states": spec.n_states, "n_params": int(ps.shape[0]),
-            "rules": ["declared sizes", "record size", "writes only its own", "compiles", "no allocation", "parity"],
-            "parity_max_abs_diff": diff}
+            "rules": rules + (["vectorises"] if vectorisation else []), "parity_max_abs_diff": diff,
+            "vectorised_stages": stages, "warnings": warned}
 
 
-__all__ = ["check_controller", "check_ship"]
+__all__ = ["VectorisationWarning", "check_controller", "check_ship"]

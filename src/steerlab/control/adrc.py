@@ -178,4 +178,5 @@ def build(cfg: ADRCConfig, ctx):
 CONTROLLER = ControllerSpec(
     name="adrc", description="linear ADRC: ESO + disturbance-cancelling PD (Zwierzewicz et al. 2021)",
     update=adrc_update, n_state=N_STATE, config=ADRCConfig, build=build,
-    source="Zwierzewicz, Dorobczynski, Artyszuk (2021) Energies 14:7937, Secs 2 and 5, eqs (7), (38)")
+    source="Zwierzewicz, Dorobczynski, Artyszuk (2021) Energies 14:7937, Secs 2 and 5, eqs (7), (38)",
+    params=PARAMS)

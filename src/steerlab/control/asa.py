@@ -332,4 +332,5 @@ CONTROLLER = ControllerSpec(
     name="asa",
     description="adaptive autopilot ASA: MRAS course changing + identification, noise-adaptive filter",
     update=asa_update, n_state=N_STATE, config=ASAConfig, build=build,
-    source="van Amerongen (1982) Adaptive steering of ships, ch. 4 (Sec. 4.6), eqs 4.43-4.45, 4.66-4.105")
+    source="van Amerongen (1982) Adaptive steering of ships, ch. 4 (Sec. 4.6), eqs 4.43-4.45, 4.66-4.105",
+    params=PARAMS)

@@ -182,4 +182,5 @@ CONTROLLER = ControllerSpec(
     name="backstepping_a",
     description="backstepping on the Van Leeuwen model, steering gear neglected (Witkowska, version A)",
     update=backstepping_a_update, n_state=N_STATE, config=BacksteppingAConfig, build=build,
-    source="Witkowska & Smierzchalski, Table 2 eqs (18)-(20), (25), (27)-(28)")
+    source="Witkowska & Smierzchalski, Table 2 eqs (18)-(20), (25), (27)-(28)",
+    params=PARAMS)

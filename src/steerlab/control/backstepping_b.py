@@ -42,6 +42,7 @@ from steerlab.control.backstepping_a import (B_IRDOT, B_K1, B_K2, B_K3, B_K4, B_
                                              B_TU, B_UMAX, N_STATE, Z_R_PREV, backstepping_errors,
                                              config_fields, make)
 from steerlab.control.registry import ControllerSpec
+from steerlab.control.backstepping_a import PARAMS as A_PARAMS
 from steerlab.control.van_leeuwen_design import yaw_accel
 from steerlab.ships.van_leeuwen import vl_drift, vl_drift_partials, vl_gain
 from steerlab.ships.state import IR
@@ -93,4 +94,5 @@ CONTROLLER = ControllerSpec(
     name="backstepping_b",
     description="backstepping on the Van Leeuwen model with the steering gear (Witkowska, version B)",
     update=backstepping_b_update, n_state=N_STATE, config=BacksteppingBConfig, build=build,
-    source="Witkowska & Smierzchalski, Table 2 eqs (21)-(24), (26), (29)")
+    source="Witkowska & Smierzchalski, Table 2 eqs (21)-(24), (26), (29)",
+    params=A_PARAMS)

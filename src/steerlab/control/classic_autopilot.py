@@ -175,4 +175,5 @@ CONTROLLER = ControllerSpec(
     name="classic_autopilot",
     description="classic autopilot: PID, rudder limiter, weather dead band, low-pass, integral off in turns",
     update=classic_autopilot_update, n_state=N_STATE, config=ClassicAutopilotConfig, build=build,
-    source="van Amerongen (1982) Sec. 3.1, Fig. 3.3")
+    source="van Amerongen (1982) Sec. 3.1, Fig. 3.3",
+    params=PARAMS)

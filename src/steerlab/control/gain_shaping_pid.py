@@ -38,6 +38,7 @@ from steerlab.config_base import FrozenConfig
 from steerlab.control.design_model import nomoto_design_model
 from steerlab.control.pid import N_STATE, PID, pid_update
 from steerlab.control.registry import ControllerSpec
+from steerlab.control.pid import PARAMS as PID_PARAMS
 from steerlab.errors import require_finite_range
 
 
@@ -76,4 +77,5 @@ def build(cfg: GainShapingPIDConfig, ctx):
 CONTROLLER = ControllerSpec(
     name="gain_shaping_pid", description="PID by first-order closed-loop gain shaping (berthing paper eq 17-19)",
     update=pid_update, n_state=N_STATE, config=GainShapingPIDConfig, build=build,
-    source="LOS/ADRC automatic berthing paper (2019), Sec. 3.1, eqs (17)-(19)")
+    source="LOS/ADRC automatic berthing paper (2019), Sec. 3.1, eqs (17)-(19)",
+    params=PID_PARAMS)

@@ -239,4 +239,5 @@ CONTROLLER = ControllerSpec(
     name="itae_pid",
     description="ITAE-robust PID with set-point pre-filter and speed scheduling (Morawski & Pomirski)",
     update=itae_pid_update, n_state=N_STATE, config=ItaePIDConfig, build=build,
-    source="Morawski & Pomirski, robust PID course-keeping, eqs (2), (6)-(11), Fig. 9")
+    source="Morawski & Pomirski, robust PID course-keeping, eqs (2), (6)-(11), Fig. 9",
+    params=PARAMS)

@@ -43,6 +43,7 @@ from steerlab.config_base import FrozenConfig
 from steerlab.control.design_model import nomoto_design_model
 from steerlab.control.pid import N_STATE, PID, pid_update
 from steerlab.control.registry import ControllerSpec
+from steerlab.control.pid import PARAMS as PID_PARAMS
 from steerlab.errors import require_finite_range
 
 
@@ -77,4 +78,5 @@ def build(cfg: LQPDConfig, ctx):
 CONTROLLER = ControllerSpec(
     name="lq_pd", description="LQ-optimal PD for the speed-loss criterion (van Amerongen 1982, 3.5-3.6)",
     update=pid_update, n_state=N_STATE, config=LQPDConfig, build=build,
-    source="van Amerongen (1982) Sec. 3.2.2, eqs (3.1), (3.5), (3.6)")
+    source="van Amerongen (1982) Sec. 3.2.2, eqs (3.1), (3.5), (3.6)",
+    params=PID_PARAMS)

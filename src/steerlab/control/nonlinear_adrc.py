@@ -224,4 +224,5 @@ CONTROLLER = ControllerSpec(
     name="nonlinear_adrc",
     description="nonlinear ADRC: tracking differentiator, ESO with fal, NLSEF (berthing paper eq 20-27)",
     update=nonlinear_adrc_update, n_state=N_STATE, config=NonlinearADRCConfig, build=build,
-    source="LOS + ADRC automatic berthing (2019) eqs (20)-(31); Han (2009)")
+    source="LOS + ADRC automatic berthing (2019) eqs (20)-(31); Han (2009)",
+    params=PARAMS)

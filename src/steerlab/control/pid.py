@@ -82,4 +82,5 @@ def build(cfg: PIDConfig, ctx):
 CONTROLLER = ControllerSpec(
     name="pid", description="PID, derivative on measured yaw rate, clamping anti-windup",
     update=pid_update, n_state=N_STATE, config=PIDConfig, build=build,
-    source="Zwierzewicz et al. (2021) Sec. 7 (gains); classic heading PID")
+    source="Zwierzewicz et al. (2021) Sec. 7 (gains); classic heading PID",
+    params=PARAMS)

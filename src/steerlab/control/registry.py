@@ -11,13 +11,16 @@ schema, the CLI and the engines pick it up from here. Controllers outside the pa
 ``build(cfg, ctx) -> (controller, params)`` turns a validated config and a
 :class:`~steerlab.control.design_context.DesignContext` into an object with
 ``init_state(x0, ref0) -> z0`` and the packed float64 parameter record of the kernel
-``update(z, p, t, x, ref, h) -> delta_cmd``.
+``update(z, p, t, x, ref, h) -> delta_cmd``. ``params`` (optional) is the
+:class:`~steerlab.records.Layout` of that record: with it, the tuner and variation find a
+field's slot by name (``Kp``, through wrappers ``inner.Kp``); without it a tuned field is
+designed per candidate (``build``).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-from typing import Callable
+from dataclasses import dataclass, field
+from typing import Callable, Optional
 
 from steerlab.plugins import Registry
 
@@ -31,6 +34,7 @@ class ControllerSpec:
     config: type
     build: Callable
     source: str = ""
+    params: Optional[object] = field(default=None, compare=False)   #: records.Layout of the record
 
 
 def _collect(module) -> list:

@@ -182,4 +182,5 @@ CONTROLLER = ControllerSpec(
     name="sliding_mode",
     description="sliding mode with boundary layer on the 4th-order ship + gear model (Witkowska eq 12-17)",
     update=sliding_mode_update, n_state=N_STATE, config=SlidingModeConfig, build=build,
-    source="Witkowska & Smierzchalski eqs (12)-(17); surface by Healey & Lienard (1993)")
+    source="Witkowska & Smierzchalski eqs (12)-(17); surface by Healey & Lienard (1993)",
+    params=PARAMS)

@@ -57,8 +57,10 @@ import numpy as np
 
 from steerlab.control.itae_pid import I_WN, itae_gains
 from steerlab.errors import InputError
+from steerlab.guidance.reference_vector import REF_PSI
 from steerlab.metrics import integral_metrics
 from steerlab.ships.registry import SHIPS
+from steerlab.ships.state import IPSI
 from steerlab.sim.batch import simulate_batch
 from steerlab.sim.scenario import scenario_from_dict
 from steerlab.sim.setup import SimSetup, build
@@ -251,10 +253,10 @@ def _figs7_8(out_dir: Path) -> list[dict]:
             "<= 3.5 deg/s the unlimited turn is lost (see the rudder-rate sensitivity rows): the paper's "
             "picture lies between, at a rate it does not state",
             "Fig. 8 (image only): the limiter protects against the big overshoot"))):
-        psi = np.degrees(b.states[j, :, 2])
+        psi = np.degrees(b.states[j, :, IPSI])
         delta = np.degrees(b.states[j, :, -1])
         cmd = np.degrees(b.delta_cmd[j])
-        e = np.degrees(b.ref[j, :, 0]) - psi
+        e = np.degrees(b.ref[j, :, REF_PSI]) - psi
         m = _turn_metrics(t, psi, 30.0)
         sat = float(np.sum(np.abs(cmd) >= 35.0 - 1e-9) * (t[1] - t[0]))
         ax[0, j].plot(t, cmd, label="delta_d (order)")
@@ -287,7 +289,7 @@ def _turn_rate_sweep(out_dir: Path, rates) -> list[dict]:
                 for rate in rates]
         b = simulate_batch(runs, record_every=1)
         for j, rate in enumerate(rates):
-            m = _turn_metrics(b.time, np.degrees(b.states[j, :, 2]), 30.0)
+            m = _turn_metrics(b.time, np.degrees(b.states[j, :, IPSI]), 30.0)
             res[lim].append(m["overshoot_deg"])
             tag = f"limiter {lim:g} deg/s" if lim else "no limiter"
             rows.append(_row(f"sensitivity: 30 deg turn overshoot, {tag}, rudder rate {rate:.3g} deg/s", None,

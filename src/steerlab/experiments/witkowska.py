@@ -36,6 +36,7 @@ from typing import Callable, Optional
 import numpy as np
 
 from steerlab.sim.engine import simulate
+from steerlab.ships.state import IPSI
 from steerlab.sim.scenario import scenario_from_dict
 from steerlab.units import ms_to_knots
 
@@ -110,7 +111,7 @@ def step_indices(time, psi_deg, delta_deg, step_deg: float, t0: float, T: float)
 
 def _run_step(ctrl, speed, loading):
     res = simulate(scenario(ctrl, speed, {"loading": loading}, [(0.0, STEP_DEG)], WINDOW))
-    return res, step_indices(res.time, np.degrees(res.states[:, 2]), np.degrees(res.states[:, -1]),
+    return res, step_indices(res.time, np.degrees(res.states[:, IPSI]), np.degrees(res.states[:, -1]),
                              STEP_DEG, 0.0, WINDOW)
 
 
@@ -126,7 +127,7 @@ def _figure(path, curves, title):
     FigureCanvasAgg(fig)
     ax1, ax2 = fig.subplots(2, 1, sharex=True)
     for label, res in curves:
-        ax1.plot(res.time, np.degrees(res.states[:, 2]), label=label)
+        ax1.plot(res.time, np.degrees(res.states[:, IPSI]), label=label)
         ax2.plot(res.time, np.degrees(res.states[:, -1]), label=label)
     ax1.plot(curves[0][1].time, np.degrees(curves[0][1].psi_ref), "k:", lw=0.8, label="set")
     ax1.set_ylabel("heading [deg]")

@@ -156,11 +156,12 @@ def replay(label: str, loading: str, settings: dict):
     ``(time, heading [deg], rudder [deg], J)`` from the compiled batch engine (the loop the GA
     compiled; a one-run batch)."""
     from steerlab.metrics import speed_loss_J
+    from steerlab.ships.state import IPSI
     from steerlab.sim.setup import build
-    from steerlab.sweeps.packed import PackedBatch
+    from steerlab.sim.batch import simulate_batch
 
-    res = PackedBatch.from_setups([build(base_scenario(label, loading, settings))]).run(record_every=10)
-    return (res.time, np.degrees(res.states[0, :, 2]), np.degrees(res.states[0, :, -1]),
+    res = simulate_batch([build(base_scenario(label, loading, settings))], record_every=10)
+    return (res.time, np.degrees(res.states[0, :, IPSI]), np.degrees(res.states[0, :, -1]),
             speed_loss_J(res.acc[0], LAMBDA))
 
 

@@ -59,7 +59,9 @@ from typing import Callable, Optional
 import numpy as np
 
 from steerlab.control.estimators import PAPER_L, eso_poles
+from steerlab.environment.channels import W_RUDDER
 from steerlab.environment.waves import held_noise_std_eq39
+from steerlab.guidance.reference_vector import REF_PSI
 from steerlab.metrics import compute_metrics, settling_time, step_metrics
 from steerlab.ships import esso_3dof
 from steerlab.ships.b2_estimate import b2_estimate_paper
@@ -232,7 +234,7 @@ def _fig2(base: Scenario, lengths: _Lengths, out_dir: Path) -> tuple[list[dict],
     ipsi = b.state_names.index("psi")
     psi = b.states[:, :, ipsi]
     delta = b.states[:, :, -1]
-    ref = b.ref[:, :, 0]
+    ref = b.ref[:, :, REF_PSI]
     mets = [step_metrics(t, psi[i], ref[i]) for i in range(len(variants))]
 
     # figure 2: the stable (Herbst) reading for every T_settle
@@ -359,7 +361,7 @@ def _fig3_fig6(base: Scenario, lengths: _Lengths, out_dir: Path,
                   fontsize=10)
     ax1.legend(fontsize=8)
     ax2.plot(t, r_adrc.delta * R2D, lw=1.0, label="rudder delta")
-    ax2.plot(t, r_adrc.disturbance[:, 0] * R2D, "k--", lw=0.8, label="disturbance (equiv. rudder)")
+    ax2.plot(t, r_adrc.disturbance[:, W_RUDDER] * R2D, "k--", lw=0.8, label="disturbance (equiv. rudder)")
     ax2.set_ylabel("angle [deg]")
     ax2.set_xlabel("time [s]")
     ax2.set_xlim(0, t[-1])
@@ -440,7 +442,7 @@ def _fig4_fig5(base: Scenario, lengths: _Lengths, out_dir: Path,
     ipsi = b.state_names.index("psi")
     psi = b.states[:, :, ipsi] * R2D
     delta = b.states[:, :, -1] * R2D
-    d = np.stack([s.w[:, 0] for s in setups]) * R2D
+    d = np.stack([s.w[:, W_RUDDER] for s in setups]) * R2D
     # the PID in the same sea (seed NOISE_SEED), for context on rudder activity
     r_pid = simulate(scen[0].replace(controller=pid_config()))
     psi_pid = r_pid.psi * R2D

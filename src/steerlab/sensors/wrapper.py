@@ -123,7 +123,8 @@ def sensed_spec(spec: ControllerSpec) -> ControllerSpec:
     kernel = bound_kernel(_sensed_update_template, name.replace("+", "_") + "_update", _inner=spec.update)
     return ControllerSpec(name=name, description=f"{spec.description}, measured through sensor models",
                           update=kernel, n_state=spec.n_state, config=spec.config, build=spec.build,
-                          source=spec.source)
+                          source=spec.source,
+                          params=None if spec.params is None else sensed_layout(spec.params))
 
 
 class SensorParams(NamedTuple):

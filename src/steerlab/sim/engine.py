@@ -11,7 +11,7 @@ import numpy as np
 
 from steerlab.angles import wrap_to_pi_array
 from steerlab.guidance.reference_models import course_guide
-from steerlab.guidance.reference_vector import N_REF, REF_NAMES, REF_RPM, initial_reference
+from steerlab.guidance.reference_vector import N_REF, REF_NAMES, REF_PSI, REF_R, REF_RPM, initial_reference
 from steerlab.metrics_online import accumulate, new_accumulator
 from steerlab.sim.kernels import closed_loop, plant_step
 from steerlab.sim.result import Result
@@ -34,7 +34,7 @@ def _ref_columns(s: SimSetup) -> int:
 def _result(s: SimSetup, X, cmd, ref, engine: str) -> Result:
     time = np.arange(s.n_steps + 1) * s.dt
     res = Result(time=time, states=X, state_names=s.state_names, state_units=s.state_units,
-                 delta_cmd=cmd, psi_ref=ref[:, 0], r_ref=ref[:, 1], disturbance=s.w,
+                 delta_cmd=cmd, psi_ref=ref[:, REF_PSI], r_ref=ref[:, REF_R], disturbance=s.w,
                  meta={"name": s.name, "seed": s.seed, "ship": s.ship.name,
                        "controller": s.controller.name, "engine": engine, "dt": s.dt,
                        "controller_sample_time": s.nc * s.dt, "n_steps": s.n_steps})

@@ -6,7 +6,7 @@ Nobody tunes an autopilot for one sea realisation. A condition set is the produc
 
 of variations of one base scenario; each is validated and built once
 (:func:`steerlab.sim.setup.build`), then packed for the batch engine
-(:class:`~steerlab.sweeps.packed.PackedBatch`). Loading states come from a TOML file of
+(:class:`~steerlab.sim.batch.PackedBatch`). Loading states come from a TOML file of
 partial scenarios merged onto the base (e.g. two ship-option sets)::
 
     [[condition]]

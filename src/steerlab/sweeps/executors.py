@@ -2,7 +2,7 @@
 
 ``LocalExecutor`` runs the whole batch in one call of the compiled batch engine (vectorised
 groups of runs over a pool of threads on the local cores). ``DaskExecutor`` cuts the batch into chunks of ``chunk_size`` runs
-(:meth:`~steerlab.sweeps.packed.PackedBatch.take`: each chunk carries only the disturbance
+(:meth:`~steerlab.sim.batch.PackedBatch.take`: each chunk carries only the disturbance
 sequences it uses), sends them to the workers of a dask.distributed cluster, and
 concatenates the outputs in the original order. Runs are independent and deterministic, so
 the numbers are bit-identical to the local run for the same seeds (tested with a
@@ -18,7 +18,7 @@ from __future__ import annotations
 import numpy as np
 
 from steerlab.errors import InputError
-from steerlab.sweeps.packed import BatchOutput, PackedBatch
+from steerlab.sim.batch import BatchResult, PackedBatch
 
 
 def _run_chunk(chunk: PackedBatch, record_every):
@@ -30,7 +30,7 @@ class LocalExecutor:
 
     name = "local"
 
-    def run(self, batch: PackedBatch, record_every: int | None = None, progress=None) -> BatchOutput:
+    def run(self, batch: PackedBatch, record_every: int | None = None, progress=None) -> BatchResult:
         """``progress(done, n)``: runs done so far (see :meth:`PackedBatch.run`)."""
         return batch.run(record_every, progress)
 
@@ -49,7 +49,7 @@ class DaskExecutor:
         self._cluster = cluster
         self.name = f"dask ({client.scheduler.address})"
 
-    def run(self, batch: PackedBatch, record_every: int | None = None, progress=None) -> BatchOutput:
+    def run(self, batch: PackedBatch, record_every: int | None = None, progress=None) -> BatchResult:
         """``progress(done, n)``: runs done so far, after each chunk that comes back."""
         from distributed import as_completed
 
@@ -63,7 +63,7 @@ class DaskExecutor:
             for f in as_completed(futures):
                 done += size[f.key]
                 progress(done, n)
-        return BatchOutput.concatenate(self.client.gather(futures))
+        return BatchResult.concatenate(self.client.gather(futures))
 
     def close(self) -> None:
         self.client.close()

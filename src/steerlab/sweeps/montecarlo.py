@@ -2,7 +2,7 @@ r"""Monte-Carlo over sea realisations: distributions and confidence intervals of
 
 The scenario is run ``n_runs`` times with seeds ``scenario.seed + i`` (each seed a different
 realisation of the sampled disturbances, e.g. the eq-39 coloured noise), in compiled batches
-of up to :data:`CHUNK_RUNS` runs (:class:`~steerlab.sweeps.packed.PackedBatch`). For every metric of
+of up to :data:`CHUNK_RUNS` runs (:class:`~steerlab.sim.batch.PackedBatch`). For every metric of
 :func:`steerlab.metrics.integral_metrics` (exact, from the on-line accumulator) and of
 :func:`steerlab.metrics.step_metrics` plus the final error and the largest rudder angle
 (from the recorded log, every ``record_every`` steps) it reports
@@ -24,11 +24,13 @@ import numpy as np
 
 from steerlab.angles import wrap_to_pi_array
 from steerlab.errors import InputError
+from steerlab.guidance.reference_vector import REF_PSI
 from steerlab.metrics import METRIC_UNITS, R2D, integral_metrics, step_metrics
 from steerlab.progress import runs_progress
+from steerlab.ships.state import IPSI
 from steerlab.sweeps.conditions import condition_set
 from steerlab.sweeps.executors import LocalExecutor
-from steerlab.sweeps.packed import PackedBatch
+from steerlab.sim.batch import PackedBatch
 
 MAX_RUNS = 100_000
 CHUNK_RUNS = 256
@@ -136,12 +138,12 @@ def run_montecarlo(scenario, n_runs: int, lam: float = 0.1, record_every: int | 
             time = out.time
             err = np.empty((n_runs, len(time)))
             rud = np.empty((n_runs, len(time)))
-        err[start:start + m] = wrap_to_pi_array(out.ref[:, :, 0] - out.states[:, :, 2]) * R2D
+        err[start:start + m] = wrap_to_pi_array(out.ref[:, :, REF_PSI] - out.states[:, :, IPSI]) * R2D
         rud[start:start + m] = out.states[:, :, nd] * R2D
         for i in range(m):
             mt = integral_metrics(out.acc[i], lam)
             mt.pop("lambda")
-            mt.update(step_metrics(out.time, out.states[i, :, 2], out.ref[i, :, 0]))
+            mt.update(step_metrics(out.time, out.states[i, :, IPSI], out.ref[i, :, REF_PSI]))
             mt["final_error_deg"] = float(err[start + i, -1])
             mt["max_abs_rudder_deg"] = float(np.max(np.abs(rud[start + i])))
             for k, v in mt.items():

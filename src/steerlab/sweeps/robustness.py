@@ -30,7 +30,7 @@ from steerlab.progress import runs_progress
 from steerlab.sim.scenario import scenario_from_dict
 from steerlab.sweeps.conditions import deep_merge, make_condition
 from steerlab.sweeps.executors import LocalExecutor
-from steerlab.sweeps.packed import PackedBatch
+from steerlab.sim.batch import PackedBatch
 from steerlab.costs import ONLINE, metric_arrays, parse_cost
 
 MAX_POINTS = 100_000

@@ -2,7 +2,7 @@
 
 For P candidates and C conditions the batch has P*C runs (candidate-major). Conditions that
 share the ship model, dt, controller sample time and duration go into one
-:class:`~steerlab.sweeps.packed.PackedBatch` (one compiled call per group, normally one);
+:class:`~steerlab.sim.batch.PackedBatch` (one compiled call per group, normally one);
 the candidates only change the packed controller records (:class:`~steerlab.tuning.params.ParamMap`).
 Each run's cost is the cost expression over its metrics; a candidate's cost is the mean
 (``aggregate="mean"``) or the worst (``"max"``) over the conditions.
@@ -16,7 +16,7 @@ import numpy as np
 
 from steerlab.errors import InputError
 from steerlab.sweeps.executors import LocalExecutor
-from steerlab.sweeps.packed import PackedBatch
+from steerlab.sim.batch import PackedBatch
 from steerlab.costs import PENALTY, metric_arrays
 
 AGGREGATES = ("mean", "max")

@@ -6,17 +6,26 @@ written per controller and controllers that land later are tunable without edits
 * a *parameter* is a numeric field of the controller's config (``[controller]`` in a
   scenario: ``Kp, Ki, Kd`` of ``pid``, ``T_settle`` or a numeric ``c0`` of ``adrc`` ...),
   named case-insensitively (``kp`` = ``Kp``);
-* the mapping to the packed record ``pc`` of the kernel is found by **probing the
-  controller's** ``build(cfg, ctx)`` at the two bounds and the midpoint, for every condition:
-  if exactly one entry of ``pc`` moves, affinely (``pc[i] = a value + b``), and the initial
-  controller state does not move, the parameter is *direct*: a population is packed by
-  writing ``a x + b`` into column ``i`` (no validation or design per candidate);
-* otherwise (e.g. ``T_settle`` sets ``Kp = 36/T^2`` and ``Kd = 12/T``) the parameter is
-  *designed*: each candidate is validated once and ``build`` runs per distinct design
-  context, exactly as for a scenario.
+* the slot of the packed record ``pc`` it moves is found **by name** in the record's declared
+  layout (:class:`~steerlab.records.Layout`, ``ControllerSpec.params``), through the wrappers
+  the runs use (:func:`record_field`): ``Kp`` of ``pid`` is ``Kp``, of ``pid+wf`` and of a
+  scenario with ``[sensors]`` ``inner.Kp``, of both ``inner.inner.Kp``. A config field in
+  degrees at the edge (``u_max_deg``, ``eta_deg_s``) is the record field without the suffix
+  (``u_max``, ``eta``, unit ``rad`` / ``rad/s``) through :func:`steerlab.units.rad`. Such a
+  parameter is *direct* when every condition's designed record holds exactly the config's
+  value there (checked on the records the conditions already built) and one design at the
+  upper bound moves that slot only (:func:`_passed_through`: a design rule may also derive
+  other numbers from the same field); a population is then packed by writing ``a x + b``
+  into that column, ``a, b`` the affine map through the transformed bounds;
+* otherwise (no declared layout, a field the design rule turns into other numbers, e.g.
+  ``T_settle`` sets ``Kp = 36/T^2`` and ``Kd = 12/T``) the parameter is *designed*: each
+  candidate is validated once and ``build`` runs per distinct design context, exactly as for
+  a scenario.
 
 Both bounds are validated by the config (a bound outside a field's allowed range is an
-:class:`~steerlab.errors.InputError`), so every value between them is valid too.
+:class:`~steerlab.errors.InputError`), so every value between them is valid too. The
+controller's initial state must not depend on a direct field (``init_state(x0, ref0)`` reads
+the plant and the reference only, as every steerlab controller does).
 """
 
 from __future__ import annotations
@@ -147,8 +156,77 @@ class ParamMap:
         return {n: float(v) for n, v in zip(self.names, x)}
 
 
+DEGREE_SUFFIXES = (("_deg_s", "rad/s"), ("_deg", "rad"))
+"""Config fields in degrees at the edge: ``<name>_deg`` -> record field ``<name>`` [rad]."""
+
+
+def record_field(layout, field: str, depth: int = 0):
+    """``(name, slot, transform)`` of the record field a config ``field`` sets, by name in
+    ``layout``, or None. ``depth`` wrappers whose fields are not the config's (the
+    ``[sensors]`` block) come first: the search starts at ``"inner." * depth``, then goes
+    one wrapper in at a time (``"inner.Kp"`` of ``pid+wf``). ``transform`` maps the config
+    value to the record's (identity, or degrees -> radians)."""
+    from steerlab.units import rad
+
+    if layout is None:
+        return None
+    wanted = [(field, None)]
+    for suffix, unit in DEGREE_SUFFIXES:
+        if field.endswith(suffix):
+            wanted.append((field[:-len(suffix)], unit))
+            break
+    names = set(layout.names)
+    prefix = "inner." * depth
+    while any(n.startswith(prefix) for n in names):
+        for name, unit in wanted:
+            full = prefix + name
+            if full in names:
+                f = layout.fields[layout.index(full)]
+                if unit is None:
+                    return full, layout.index(full), (lambda v: v)
+                if f.unit == unit:
+                    return full, layout.index(full), rad
+        prefix += "inner."
+    return None
+
+
+def _passed_through(pm: ParamMap, f: str, name: str, idx: int, value: float, v: float) -> bool:
+    """Whether the design rule writes config field ``f = v`` into slot ``idx`` as ``value``
+    and changes nothing else (no other slot, no initial state), for every condition. The slot
+    itself comes from the name (:func:`record_field`); this one design per distinct condition
+    only confirms it (a design rule may also derive other numbers from the same field, e.g.
+    ``nonlinear_adrc``'s ``b`` feeds its default gains)."""
+    cache: dict = {}
+    cfgs: dict = {}
+    for c, cfg in enumerate(pm.base_cfgs):
+        if id(cfg) not in cfgs:
+            cfgs[id(cfg)] = _validated(cfg, {f: v}, f"--bounds {name}")
+        pc, z0 = pm.record(c, cfgs[id(cfg)], cache)
+        want = pm.base_pc[c].copy()
+        want[idx] = value
+        if not (np.array_equal(pc, want) and np.array_equal(z0, pm.base_z[c])):
+            return False
+    return True
+
+
+def _number(v) -> bool:
+    """A config value that is a number (not None, a flag or a named rule such as ``"estimate"``)."""
+    return isinstance(v, (int, float)) and not isinstance(v, bool)
+
+
+def _sensor_depth(spec_name: str) -> int:
+    from steerlab.sensors.wrapper import SUFFIX
+
+    depth = 0
+    while spec_name.endswith(SUFFIX):
+        spec_name = spec_name[:-len(SUFFIX)]
+        depth += 1
+    return depth
+
+
 def build_param_map(conditions, names, bounds: np.ndarray) -> ParamMap:
-    """Resolve ``names`` against the conditions' controller and probe the mapping (module docstring)."""
+    """Resolve ``names`` against the conditions' controller and find their record slots by
+    name (module docstring)."""
     spec = get_controller(conditions[0].scenario.controller.type)
     cfg_cls = spec.config
     fields = resolve_names(cfg_cls, names)
@@ -160,41 +238,35 @@ def build_param_map(conditions, names, bounds: np.ndarray) -> ParamMap:
     base_z = np.stack([c.setup.z0 for c in conditions])
     pm = ParamMap(list(names), fields, bounds, [], base_cfgs, [c.design for c in conditions],
                   [c.scenario.seed for c in conditions], base_pc, base_z)
+    run_specs = {c.setup.controller.name: c.setup.controller for c in conditions}
     for j, f in enumerate(fields):
         lo, hi = bounds[j]
-        probes = (lo, hi, 0.5 * (lo + hi))
         for v in (lo, hi):
             _validated(base_cfgs[0], {f: float(v)}, f"--bounds {names[j]}")
-        idx = None
-        a = np.empty(len(conditions))
-        b = np.empty(len(conditions))
-        ok = True
-        moved_any = False
-        caches = [{} for _ in probes]
-        cfgs = {}
-        for c, cfg in enumerate(base_cfgs):
-            if id(cfg) not in cfgs:
-                cfgs[id(cfg)] = [_validated(cfg, {f: float(v)}, f"--bounds {names[j]}") for v in probes]
-            outs = [pm.record(c, pv, cache) for pv, cache in zip(cfgs[id(cfg)], caches)]
-            (p_lo, z_lo), (p_hi, z_hi), (p_mid, z_mid) = outs
-            moved = np.nonzero((p_lo != p_hi) | (p_lo != p_mid))[0]
-            if len(moved):
-                moved_any = True
-            if len(moved) != 1 or not (np.array_equal(z_lo, z_hi) and np.array_equal(z_lo, z_mid)):
-                ok = False
-                continue
-            i = int(moved[0])
-            if idx is None:
-                idx = i
-            elif idx != i:
-                ok = False
-                continue
-            a[c] = (p_hi[i] - p_lo[i]) / (hi - lo)
-            b[c] = p_lo[i] - a[c] * lo
-            if not math.isclose(a[c] * probes[2] + b[c], p_mid[i], rel_tol=1e-12, abs_tol=1e-300):
-                ok = False
-        if not moved_any:
-            raise InputError("--params", f"{names[j]!r} ({f}) does not change the controller's "
-                                         "parameters in this scenario; it cannot be tuned here")
-        pm.direct.append((idx, a, b) if ok and idx is not None else None)
+        found = {n: record_field(s.params, f, _sensor_depth(n)) for n, s in run_specs.items()}
+        slots = {(r[0], r[1]) for r in found.values() if r is not None}
+        direct = None
+        if len(slots) == 1 and None not in found.values():
+            (_, idx), = slots
+            transform = next(iter(found.values()))[2]
+            # the designed records hold the config's value there (else the design rule moves it)
+            ok = all(not _number(getattr(cfg, f)) or base_pc[c, idx] == transform(float(getattr(cfg, f)))
+                     for c, cfg in enumerate(base_cfgs))
+            if ok:
+                ok = _passed_through(pm, f, names[j], idx, transform(float(hi)), float(hi))
+            if ok:
+                p_lo, p_hi = transform(float(lo)), transform(float(hi))
+                a = (p_hi - p_lo) / (hi - lo)
+                b = p_lo - a * lo
+                C = len(conditions)
+                direct = (idx, np.full(C, a), np.full(C, b))
+        if direct is None:
+            # designed per candidate: a field the design ignores here cannot be tuned
+            los, his = ({}, {})
+            rec = [pm.record(0, _validated(base_cfgs[0], {f: float(v)}, f"--bounds {names[j]}"), cache)
+                   for v, cache in ((lo, los), (hi, his))]
+            if np.array_equal(rec[0][0], rec[1][0]) and np.array_equal(rec[0][1], rec[1][1]):
+                raise InputError("--params", f"{names[j]!r} ({f}) does not change the controller's "
+                                             "parameters in this scenario; it cannot be tuned here")
+        pm.direct.append(direct)
     return pm
