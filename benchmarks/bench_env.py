@@ -3,17 +3,22 @@
 
 Usage::
 
-    python benchmarks/bench_gym.py                       # N = 1, 64, 1024
-    python benchmarks/bench_gym.py --n 1,64 --steps 150 --json
+    python benchmarks/bench_env.py                       # N = 1, 64, 1024
+    python benchmarks/bench_env.py --n 1,64 --steps 150 --repeats 5 --json
 
-Workload: ``steerlab/CourseKeeping-v0`` (Esso tanker at 16 kn, gear 35 deg / 2.33 deg/s, eq-39
-waves, dt 0.1 s, control_dt 1 s = 10 RK4 steps per env step, 120 s episodes so resets are
-included), random actions drawn up front. For each N: env-steps/s (N ships x steps / wall) of
-``gymnasium.make_vec(..., vectorization_mode="vector_entry_point")`` (one compiled call for N
-ships) and of ``gymnasium.vector.SyncVectorEnv`` over N single environments, and their ratio.
-Each figure is the median of ``--repeats`` after one untimed warm-up; ``reset_ms`` is the
-median wall time of one reset of all N native ships without a seed (what an autoreset round
-costs: the N seas drawn in one call). Not a test: numbers depend on the machine and its load.
+Workload: ``steerlab/CourseKeeping-v0`` with its defaults (Esso tanker at 16 kn, gear 35 deg /
+2.33 deg/s, eq-39 waves, dt 0.1 s, control_dt 1 s = 10 RK4 steps per env step) but 120 s
+episodes, so that the 150 timed steps include one autoreset of every ship; random actions
+drawn up front. For each N, in one process: env-steps/s (N ships x steps / time) of
+``gymnasium.make_vec(..., vectorization_mode="vector_entry_point")`` (the whole step of N ships,
+autoresets included, in one compiled call) and of ``gymnasium.vector.SyncVectorEnv`` over N
+single environments made by ``gymnasium.make`` (its wrappers included), and their ratio.
+The two are timed alternately, ``--repeats`` times each after one untimed warm-up (the first
+call compiles), each timing starting from ``reset(seed=0)``; the figures are the medians, by
+wall clock and by the process's CPU time (``time.process_time``: what the code costs when other
+programs share the cores). ``reset_ms`` is the median wall time of one reset of all N native
+ships without a seed (what an autoreset round costs). Not a test: the numbers depend on the
+machine and its load.
 """
 
 from __future__ import annotations
@@ -26,59 +31,74 @@ import time
 import numpy as np
 
 
-def _rate(env, n, steps, repeats, seed=0):
-    rng = np.random.default_rng(seed)
-    acts = rng.uniform(-1, 1, size=(steps, n, 1)).astype(np.float32)
+def _time(env, acts, seed=0):
+    """``(wall, cpu)`` seconds of ``len(acts)`` steps from ``reset(seed=seed)``."""
     env.reset(seed=seed)
-    for k in range(min(steps, 5)):                       # warm-up (compiles)
-        env.step(acts[k])
-    times = []
-    for _ in range(repeats):
-        env.reset(seed=seed)
-        t0 = time.perf_counter()
-        for k in range(steps):
-            env.step(acts[k])
-        times.append(time.perf_counter() - t0)
-    return n * steps / float(np.median(times))
+    w0, c0 = time.perf_counter(), time.process_time()
+    for a in acts:
+        env.step(a)
+    return time.perf_counter() - w0, time.process_time() - c0
 
 
 def _reset_ms(env, n, repeats):
     core = env.unwrapped.core
+    lanes = np.arange(n)
     times = []
     for _ in range(max(repeats, 3)):
         t0 = time.perf_counter()
-        core.reset_lanes(range(n))
+        core.reset_lanes(lanes)
         times.append(time.perf_counter() - t0)
     return 1e3 * float(np.median(times))
 
 
-def main(argv=None) -> int:
+def measure(n, steps=150, repeats=5, episode_s=120.0):
+    """One row of the table for ``n`` ships (see the module docstring)."""
     import gymnasium as gym
 
     import steerlab.gym  # noqa: F401  (registers the ids)
 
+    kw = {"episode_s": episode_s}
+    native = gym.make_vec("steerlab/CourseKeeping-v0", num_envs=n, vectorization_mode="vector_entry_point", **kw)
+    sync = gym.vector.SyncVectorEnv([lambda: gym.make("steerlab/CourseKeeping-v0", **kw) for _ in range(n)])
+    acts = np.random.default_rng(0).uniform(-1, 1, size=(steps, n, 1)).astype(np.float32)
+    for env in (native, sync):                           # warm-up: compiles, touches the memory
+        _time(env, acts[:5])
+    t = {"native": [], "sync": []}
+    for _ in range(repeats):
+        t["native"].append(_time(native, acts))
+        t["sync"].append(_time(sync, acts))
+    row = {"n": n, "steps": steps, "repeats": repeats}
+    for name, times in t.items():
+        wall, cpu = np.median(np.array(times), axis=0)
+        row[f"{name}_env_steps_per_s"] = n * steps / wall
+        row[f"{name}_env_steps_per_cpu_s"] = n * steps / cpu
+    row["ratio"] = row["native_env_steps_per_s"] / row["sync_env_steps_per_s"]
+    row["ratio_cpu"] = row["native_env_steps_per_cpu_s"] / row["sync_env_steps_per_cpu_s"]
+    row["native_reset_all_ms"] = _reset_ms(native, n, repeats)
+    native.close()
+    sync.close()
+    return row
+
+
+def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--n", default="1,64,1024", help="comma-separated numbers of ships")
     ap.add_argument("--steps", type=int, default=150, help="env steps per timing (> 120: one autoreset inside)")
-    ap.add_argument("--repeats", type=int, default=3)
+    ap.add_argument("--repeats", type=int, default=5)
     ap.add_argument("--json", action="store_true")
     a = ap.parse_args(argv)
-    kw = {"episode_s": 120.0}
     rows = []
     for n in (int(v) for v in a.n.split(",")):
-        native = gym.make_vec("steerlab/CourseKeeping-v0", num_envs=n, vectorization_mode="vector_entry_point", **kw)
-        sync = gym.vector.SyncVectorEnv([lambda: gym.make("steerlab/CourseKeeping-v0", **kw) for _ in range(n)])
-        r_native = _rate(native, n, a.steps, a.repeats)
-        r_sync = _rate(sync, n, a.steps, a.repeats)
-        reset_ms = _reset_ms(native, n, a.repeats)
-        rows.append({"n": n, "native_env_steps_per_s": r_native, "sync_env_steps_per_s": r_sync,
-                     "ratio": r_native / r_sync, "native_reset_all_ms": reset_ms})
+        r = measure(n, a.steps, a.repeats)
+        rows.append(r)
         if not a.json:
-            print(f"N={n:5d}  native {r_native:12.4g} env-steps/s   SyncVectorEnv {r_sync:12.4g}   "
-                  f"ratio {r_native / r_sync:8.1f}x   native reset of all N {reset_ms:8.2f} ms")
+            print(f"N={n:5d}  native {r['native_env_steps_per_s']:10.3g} env-steps/s   SyncVectorEnv "
+                  f"{r['sync_env_steps_per_s']:10.3g}   ratio {r['ratio']:6.1f}x   (CPU time: "
+                  f"{r['native_env_steps_per_cpu_s']:9.3g} / {r['sync_env_steps_per_cpu_s']:9.3g} = "
+                  f"{r['ratio_cpu']:6.1f}x)   native reset of all N {r['native_reset_all_ms']:7.2f} ms", flush=True)
     if a.json:
-        print(json.dumps({"workload": "steerlab/CourseKeeping-v0, esso 16 kn, waves, 10 RK4 steps per env step",
-                          "rows": rows}, indent=2))
+        print(json.dumps({"workload": "steerlab/CourseKeeping-v0, esso 16 kn, waves, 10 RK4 steps per env step, "
+                                      "120 s episodes", "rows": rows}, indent=2))
     return 0
 
 

@@ -9,7 +9,7 @@ All its random numbers come from Philox4x64-10 blocks of key ``KEY[i]`` and coun
   ``-m + 2 m u`` [rad] (``m``: the task's ``initial_offset_deg``; 0 but for course keeping)
   and ``(x1 >> 33) mod (2^31 - 1)`` an integer sea seed, used only for seas with optional
   blocks, realised by the scenario machinery (:func:`steerlab.sim.setup.realise`);
-* white noise (``stream`` 1): the standard normals ``z_j`` (Box-Muller), scaled by
+* white noise (``stream`` 1): the standard normals ``z_j`` (ziggurat), scaled by
   ``sqrt(P / Ts)`` as :func:`steerlab.environment.waves.held_white_noise` scales numpy's
   (``P`` the wave power, ``Ts`` its sample time).
 

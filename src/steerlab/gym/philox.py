@@ -17,8 +17,14 @@ counters (:func:`episode_counter`), so an episode's draws depend only on (seed, 
 number), never on N or on the other lanes, and all lanes' draws are made in one compiled call.
 
 Derived variates: uniform ``u = (x >> 11) 2^-53`` in [0, 1) (53 random bits); standard
-normals by the Box-Muller transform (Box & Muller 1958), ``z0 = rho cos(2 pi u2)``,
-``z1 = rho sin(2 pi u2)``, ``rho = sqrt(-2 ln u1)``, ``u1 = ((x >> 11) + 1) 2^-53`` in (0, 1].
+normals by the ziggurat method (Marsaglia & Tsang, "The ziggurat method for generating random
+variables", J. Stat. Softw. 5(8), 2000) with 256 layers in numpy's 64-bit form: from a word
+``x``, layer ``i = x & 255``, sign bit 8, ``a = (x >> 9) & (2^52 - 1)``, candidate
+``z = +-a w_i``, accepted at once if ``a < k_i`` (about 99 % of draws); else for ``i = 0`` a
+draw from the tail beyond ``r`` (``xx = -ln(1 - u1) / r``, ``yy = -ln(1 - u2)`` until
+``2 yy > xx^2``, ``z = +-(r + xx)``), else the wedge test
+``f_i + u (f_(i-1) - f_i) < exp(-z^2 / 2)``, a new word on rejection; tables by the
+paper's recurrence (:func:`_ziggurat_tables`).
 """
 
 from __future__ import annotations
@@ -39,6 +45,14 @@ _LO32 = np.uint64(0xFFFFFFFF)
 _S32 = np.uint64(32)
 _S11 = np.uint64(11)
 _TWO_M53 = 2.0 ** -53
+
+ZIG_R = 3.6541528853610088      #: the ziggurat's base-layer edge (256 layers; Marsaglia & Tsang 2000)
+ZIG_V = 4.92867323399e-3        #: area of each of its layers
+_B8 = np.uint64(0xFF)
+_B52 = np.uint64(0xFFFFFFFFFFFFF)
+_S8 = np.uint64(8)
+_ONE = np.uint64(1)
+_ZERO = np.uint64(0)
 
 #: counter word 2 of an episode's draws: its header (initial offset, sea seed) and its white noise
 STREAM_HEADER, STREAM_NORMAL = 0, 1
@@ -87,29 +101,79 @@ def uniform(x):
     return float(x >> _S11) * _TWO_M53
 
 
+def _ziggurat_tables(r=ZIG_R, v=ZIG_V, layers=256):
+    """Marsaglia & Tsang's (2000) tables for ``layers`` layers of area ``v`` under
+    ``f(x) = exp(-x^2 / 2)``, the base one ending at ``r``, scaled for 52-bit integers (as
+    numpy's ``ki_double``, ``wi_double``, ``fi_double``): ``(KI, WI, FI)``."""
+    m = 2.0 ** 52
+    ki = np.zeros(layers, dtype=np.uint64)
+    wi = np.zeros(layers)
+    fi = np.zeros(layers)
+    dn = tn = r
+    q = v / math.exp(-0.5 * dn * dn)
+    ki[0] = int((dn / q) * m)
+    wi[0] = q / m
+    wi[layers - 1] = dn / m
+    fi[0] = 1.0
+    fi[layers - 1] = math.exp(-0.5 * dn * dn)
+    for i in range(layers - 2, 0, -1):
+        dn = math.sqrt(-2.0 * math.log(v / dn + math.exp(-0.5 * dn * dn)))
+        ki[i + 1] = int((dn / tn) * m)
+        tn = dn
+        fi[i] = math.exp(-0.5 * dn * dn)
+        wi[i] = dn / m
+    return ki, wi, fi
+
+
 @numba.njit(inline="always")
-def _box_muller(x1, x2):
-    """Two standard normals from two uint64."""
-    u1 = float((x1 >> _S11) + np.uint64(1)) * _TWO_M53
-    rho = math.sqrt(-2.0 * math.log(u1))
-    th = 2.0 * math.pi * uniform(x2)
-    return rho * math.cos(th), rho * math.sin(th)
+def _word(buf, pos, b, episode, st, k0, k1):
+    """The next uint64 of the stream: ``(word, pos, b)`` (``buf`` holds block ``b - 1``)."""
+    if pos == 4:
+        buf[0], buf[1], buf[2], buf[3] = philox_block(np.uint64(b), episode, st, np.uint64(0), k0, k1)
+        b += 1
+        pos = 0
+    return buf[pos], pos + 1, b
 
 
 @numba.njit
 def normals(k0, k1, episode, stream, out, scale):
-    """``out[j] = z_j * scale``, ``z_j`` the j-th standard normal of (key, episode, stream):
-    block ``b`` (counter ``(b, episode, stream, 0)``) gives ``z_4b .. z_4b+3`` by two
-    Box-Muller pairs, ``(x0, x1)`` and ``(x2, x3)``."""
-    n = out.shape[0]
+    """``out[j] = z_j * scale``, ``z_j`` the standard normals of (key, episode, stream) by
+    the ziggurat method (see the module docstring) from the words of blocks ``b = 0, 1, ...``
+    (counter ``(b, episode, stream, 0)``), taken in order."""
     st = np.uint64(stream)
-    for b in range((n + 3) // 4):
-        x0, x1, x2, x3 = philox_block(np.uint64(b), episode, st, np.uint64(0), k0, k1)
-        z = _box_muller(x0, x1) + _box_muller(x2, x3)
-        for p in range(4):
-            j = 4 * b + p
-            if j < n:
-                out[j] = z[p] * scale
+    buf = np.empty(4, dtype=np.uint64)
+    pos, b = 4, 0
+    for j in range(out.shape[0]):
+        while True:
+            w, pos, b = _word(buf, pos, b, episode, st, k0, k1)
+            i = w & _B8
+            w = w >> _S8
+            neg = (w & _ONE) != _ZERO
+            rabs = (w >> _ONE) & _B52
+            x = float(rabs) * _WI[i]
+            if neg:
+                x = -x
+            if rabs < _KI[i]:
+                z = x
+                break
+            if i == _ZERO:                               # the base layer's tail beyond r
+                while True:
+                    w, pos, b = _word(buf, pos, b, episode, st, k0, k1)
+                    xx = -math.log1p(-uniform(w)) / ZIG_R
+                    w, pos, b = _word(buf, pos, b, episode, st, k0, k1)
+                    yy = -math.log1p(-uniform(w))
+                    if yy + yy > xx * xx:
+                        break
+                z = -(ZIG_R + xx) if neg else ZIG_R + xx
+                break
+            w, pos, b = _word(buf, pos, b, episode, st, k0, k1)
+            if (_FI[i - 1] - _FI[i]) * uniform(w) + _FI[i] < math.exp(-0.5 * x * x):
+                z = x
+                break
+        out[j] = z * scale
+
+
+_KI, _WI, _FI = _ziggurat_tables()
 
 
 def seed_key(seed) -> tuple[int, int]:
