@@ -5,11 +5,13 @@ Usage::
 
     python benchmarks/bench_env.py                       # N = 1, 64, 1024
     python benchmarks/bench_env.py --n 1,64 --steps 150 --repeats 5 --json
+    python benchmarks/bench_env.py --control-dt 0.1     # one RK4 step per env step
 
 Workload: ``steerlab/CourseKeeping-v0`` with its defaults (Esso tanker at 16 kn, gear 35 deg /
-2.33 deg/s, eq-39 waves, dt 0.1 s, control_dt 1 s = 10 RK4 steps per env step) but 120 s
-episodes, so that the 150 timed steps include one autoreset of every ship; random actions
-drawn up front. For each N, in one process: env-steps/s (N ships x steps / time) of
+2.33 deg/s, eq-39 waves, dt 0.1 s, control_dt 1 s = 10 RK4 steps per env step) but episodes of
+120 env steps, so that the 150 timed steps include one autoreset of every ship; random actions
+drawn up front. ``--control-dt 0.1`` makes an env step one RK4 step (less physics per step, so
+more of a step is the per-call overhead a vector env saves). For each N, in one process: env-steps/s (N ships x steps / time) of
 ``gymnasium.make_vec(..., vectorization_mode="vector_entry_point")`` (the whole step of N ships,
 autoresets included, in one compiled call) and of ``gymnasium.vector.SyncVectorEnv`` over N
 single environments made by ``gymnasium.make`` (its wrappers included), and their ratio.
@@ -51,13 +53,13 @@ def _reset_ms(env, n, repeats):
     return 1e3 * float(np.median(times))
 
 
-def measure(n, steps=150, repeats=5, episode_s=120.0):
+def measure(n, steps=150, repeats=5, control_dt=1.0):
     """One row of the table for ``n`` ships (see the module docstring)."""
     import gymnasium as gym
 
     import steerlab.gym  # noqa: F401  (registers the ids)
 
-    kw = {"episode_s": episode_s}
+    kw = {"episode_s": 120 * control_dt, "control_dt": control_dt}
     native = gym.make_vec("steerlab/CourseKeeping-v0", num_envs=n, vectorization_mode="vector_entry_point", **kw)
     sync = gym.vector.SyncVectorEnv([lambda: gym.make("steerlab/CourseKeeping-v0", **kw) for _ in range(n)])
     acts = np.random.default_rng(0).uniform(-1, 1, size=(steps, n, 1)).astype(np.float32)
@@ -67,7 +69,7 @@ def measure(n, steps=150, repeats=5, episode_s=120.0):
     for _ in range(repeats):
         t["native"].append(_time(native, acts))
         t["sync"].append(_time(sync, acts))
-    row = {"n": n, "steps": steps, "repeats": repeats}
+    row = {"n": n, "control_dt": control_dt, "steps": steps, "repeats": repeats}
     for name, times in t.items():
         wall, cpu = np.median(np.array(times), axis=0)
         row[f"{name}_env_steps_per_s"] = n * steps / wall
@@ -85,11 +87,13 @@ def main(argv=None) -> int:
     ap.add_argument("--n", default="1,64,1024", help="comma-separated numbers of ships")
     ap.add_argument("--steps", type=int, default=150, help="env steps per timing (> 120: one autoreset inside)")
     ap.add_argument("--repeats", type=int, default=5)
+    ap.add_argument("--control-dt", type=float, default=1.0,
+                    help="env step [s] (the env's default 1 s = 10 RK4 steps of 0.1 s; 0.1: one); episodes of 120 steps")
     ap.add_argument("--json", action="store_true")
     a = ap.parse_args(argv)
     rows = []
     for n in (int(v) for v in a.n.split(",")):
-        r = measure(n, a.steps, a.repeats)
+        r = measure(n, a.steps, a.repeats, a.control_dt)
         rows.append(r)
         if not a.json:
             print(f"N={n:5d}  native {r['native_env_steps_per_s']:10.3g} env-steps/s   SyncVectorEnv "
@@ -97,8 +101,8 @@ def main(argv=None) -> int:
                   f"{r['native_env_steps_per_cpu_s']:9.3g} / {r['sync_env_steps_per_cpu_s']:9.3g} = "
                   f"{r['ratio_cpu']:6.1f}x)   native reset of all N {r['native_reset_all_ms']:7.2f} ms", flush=True)
     if a.json:
-        print(json.dumps({"workload": "steerlab/CourseKeeping-v0, esso 16 kn, waves, 10 RK4 steps per env step, "
-                                      "120 s episodes", "rows": rows}, indent=2))
+        print(json.dumps({"workload": f"steerlab/CourseKeeping-v0, esso 16 kn, waves, dt 0.1 s, control_dt "
+                                      f"{a.control_dt} s, episodes of 120 env steps", "rows": rows}, indent=2))
     return 0
 
 

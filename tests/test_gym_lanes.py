@@ -1,7 +1,7 @@
 """The native vector environment on the batch engine's vectorised lanes (issue 13).
 
 Ship i of ``SteeringVectorEnv`` (driver ``step_lanes``: groups of LANES ships, structure of
-arrays, vectorised RK4 stages; seas of all resetting ships drawn in one call) must be
+arrays, vectorised RK4 stages; every draw of every ship from its own Philox key, in compiled code) must be
 bit-identical to a single ``SteeringEnv`` (scalar plant step, one ship) seeded alike, for a
 number of ships that is not a multiple of LANES, through an autoreset; the compiled
 ``step_lanes`` of the Esso must hold its four RK4 stages as vector arithmetic.
@@ -233,3 +233,23 @@ def test_a_diverged_ship_in_the_vector_env_ends_only_its_episode():
     assert np.all(np.isfinite(o)) and np.all(np.isfinite(r))
     o, r, te, tr, _ = venv.step(np.zeros((18, 1), dtype=np.float32))      # autoreset: fresh ships
     assert not te.any() and np.all(r == 0.0) and np.all(np.abs(o[:, 1]) < 1e-9)
+
+
+def test_an_action_outside_the_space_is_refused_by_the_vector_env_and_changes_nothing():
+    from steerlab.errors import InputError
+
+    venv = _vec("steerlab/CourseKeeping-v0", n=18)
+    core = venv.unwrapped.core
+    venv.reset(seed=3)
+    venv.step(np.zeros((18, 1), dtype=np.float32))
+    before = [a.copy() for a in (core.X, core.K, core.J, core.W, core.obs, core.rew)]
+    for bad in (1.5, -1.01, np.nan, np.inf):
+        acts = np.zeros((18, 1), dtype=np.float32)
+        acts[17, 0] = bad                                     # in the partial group of 2
+        with pytest.raises(InputError) as ei:
+            venv.step(acts)
+        assert ei.value.field == "action" and "[-1, 1]" in str(ei.value)
+        assert all(np.array_equal(a, b, equal_nan=True) for a, b in
+                   zip(before, (core.X, core.K, core.J, core.W, core.obs, core.rew)))
+    o, *_ = venv.step(np.ones((18, 1), dtype=np.float32))     # the boundary itself is allowed
+    assert np.all(np.isfinite(o))

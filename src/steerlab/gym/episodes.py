@@ -1,23 +1,29 @@
 r"""N course-keeping / course-change episodes on one ship: the core of the Gymnasium environments.
 
 A lane is one episode: a ship (``steerlab ships``) with a steering gear in a sea built by the
-scenario machinery (``[environment]`` keys; :func:`steerlab.sim.setup.build_seeds`, so the
-seas are exactly those of ``steerlab run``), a reference heading from the scenario's guidance
-kernel (the time-only course schedule, or ``guidance=`` any ``[guidance]`` table, e.g. LOS
-route following for ``track_following``: :data:`TRACK_GUIDANCE` by default),
-and an agent that orders the rudder every ``control_dt`` seconds (``nc = control_dt / dt``
-plant steps, order held). Each lane owns a random generator (gymnasium's
-``seeding.np_random``); at reset it draws the sea's seed and, for course keeping, the initial
-heading offset. Lanes are independent: lane i of N behaves as a single environment seeded
-alike.
+scenario machinery (``[environment]`` keys, :func:`steerlab.sim.setup.design`), a reference
+heading from the scenario's guidance kernel (the time-only course schedule, or ``guidance=``
+any ``[guidance]`` table, e.g. LOS route following for ``track_following``:
+:data:`TRACK_GUIDANCE` by default), and an agent that orders the rudder every ``control_dt``
+seconds (``nc = control_dt / dt`` plant steps, order held).
+
+Randomness (:mod:`steerlab.gym.lane_seas`): a reset with a seed keys the lane with it; each
+episode of the lane (0 after the seeded reset, then 1, 2, ... at the resets without a seed)
+draws its initial heading offset (course keeping) and its sea's white noise from
+Philox4x64-10 blocks of (key, episode) in compiled code - no generator object per lane or per
+reset. Lanes are independent: lane i of N behaves as a single environment seeded alike, and
+the same seed gives the same episodes. A plain sea (waves, constant wind, current, rudder
+offset: the default) is the scenario's eq-39 wave disturbance driven by those normals, its
+rows filtered env step by env step just before the plants read them; a sea with optional
+blocks (``uses_sea``: spectra, gusts, current variation, wind rudder) is realised lane by lane
+by :func:`~steerlab.sim.setup.realise` with a sea seed drawn from the episode's header, so it
+is the sea ``steerlab run`` gives that seed.
 
 ``vectorised=True`` (the native vector environment) advances the ships with the batch
-engine's vectorised groups (:func:`steerlab.gym.plant_batch.vector_stepper`) instead of one
-after the other; the numbers are the same. Resets of many lanes draw their seas in one call
-(:func:`steerlab.environment.disturbance.build_disturbances`, the seas
-:func:`~steerlab.sim.setup.realise` gives, without re-designing anything per reset); a sea
-with optional blocks (``uses_sea``: spectra, gusts, current variation, wind rudder) is
-realised lane by lane.
+engine's vectorised groups and does the whole step - actions checked, autoresets, plants,
+guidance, observations, rewards - in one compiled call
+(:func:`steerlab.gym.plant_batch.vector_stepper`, :meth:`Episodes.step_autoreset`); the
+single environment steps its ship with the scalar kernel; the numbers are the same.
 """
 
 from __future__ import annotations

@@ -9,7 +9,11 @@ scalar code. Two schedules of the same operations:
   engines' scalar step (:func:`steerlab.sim.kernels.plant_step`);
 * :func:`vector_stepper` (the native vector environment): the ship driver's ``step_lanes``
   (:mod:`steerlab.sim.driver_template`), the batch engine's structure-of-arrays groups of
-  ``LANES`` ships with every RK4 stage vectorised across the group.
+  ``LANES`` ships with every RK4 stage vectorised across the group, inside one compiled call
+  that also checks the actions and does the autoresets (:func:`lane_resetter`).
+
+Both write a plain sea's disturbance rows of the step first
+(:func:`steerlab.gym.lane_seas.fill_rows`).
 
 Per ship both perform the same IEEE operations in the same order, so a lane's numbers do not
 depend on N, on the schedule or on the other lanes: ship i of the vector environment equals

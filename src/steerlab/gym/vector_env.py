@@ -4,11 +4,15 @@ r"""The native vector environment: N ships stepped in one compiled call.
 gives a :class:`SteeringVectorEnv`: spaces, reward and episodes as the single
 :class:`~steerlab.gym.env.SteeringEnv` (observations (N, 3), actions (N, 1)), all N ships
 advanced by the batch engine's vectorised groups of ``LANES`` ships in one compiled call
-(:func:`steerlab.gym.plant_batch.vector_stepper`; the single environment steps its ship with
-the scalar kernel, with the same numbers). ``reset(seed=s)`` seeds ship i
-with ``s + i`` (as gymnasium's ``SyncVectorEnv``), so ship i's episode equals a single
-environment's reset with seed ``s + i``. Autoreset: gymnasium's ``NEXT_STEP`` mode (the step
-after an episode ends resets that ship and ignores its action; reward 0).
+(:func:`steerlab.gym.plant_batch.vector_stepper`: actions checked, autoresets, plants,
+guidance, observations and rewards; the single environment steps its ship with the scalar
+kernel, with the same numbers). ``reset(seed=s)`` seeds ship i with ``s + i`` (as gymnasium's
+``SyncVectorEnv``; or ``seed=[s0, s1, ...]``, one per ship), so ship i's episodes equal a
+single environment's after ``reset(seed=s + i)``. Autoreset: gymnasium's ``NEXT_STEP`` mode
+(the step after an episode ends resets that ship to its next episode and ignores its action;
+reward 0). An action outside [-1, 1] (or NaN) raises :class:`~steerlab.errors.InputError`
+before anything moves; a diverged ship ends its episode (``terminated``,
+``infos["reason"] == "diverged"``, zeros observed).
 """
 
 from __future__ import annotations
