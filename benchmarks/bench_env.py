@@ -16,7 +16,8 @@ more of a step is the per-call overhead a vector env saves). For each N, in one 
 autoresets included, in one compiled call) and of ``gymnasium.vector.SyncVectorEnv`` over N
 single environments made by ``gymnasium.make`` (its wrappers included), and their ratio.
 The two are timed alternately, ``--repeats`` times each after one untimed warm-up (the first
-call compiles), each timing starting from ``reset(seed=0)``; the figures are the medians, by
+call compiles), each timing the ``--steps`` steps after ``reset(seed=0)`` (repeated until
+``--min-time`` seconds, for small N, and averaged); the figures are the medians, by
 wall clock and by the process's CPU time (``time.process_time``: what the code costs when other
 programs share the cores). ``reset_ms`` is the median wall time of one reset of all N native
 ships without a seed (what an autoreset round costs). Not a test: the numbers depend on the
@@ -33,13 +34,20 @@ import time
 import numpy as np
 
 
-def _time(env, acts, seed=0):
-    """``(wall, cpu)`` seconds of ``len(acts)`` steps from ``reset(seed=seed)``."""
-    env.reset(seed=seed)
-    w0, c0 = time.perf_counter(), time.process_time()
-    for a in acts:
-        env.step(a)
-    return time.perf_counter() - w0, time.process_time() - c0
+def _time(env, acts, seed=0, min_s=0.0):
+    """``(wall, cpu)`` seconds per ``len(acts)`` steps from ``reset(seed=seed)`` (the reset not
+    timed), averaged over as many such blocks as take ``min_s`` seconds of wall time."""
+    wall = cpu = 0.0
+    blocks = 0
+    while blocks == 0 or wall < min_s:
+        env.reset(seed=seed)
+        w0, c0 = time.perf_counter(), time.process_time()
+        for a in acts:
+            env.step(a)
+        wall += time.perf_counter() - w0
+        cpu += time.process_time() - c0
+        blocks += 1
+    return wall / blocks, cpu / blocks
 
 
 def _reset_ms(env, n, repeats):
@@ -53,7 +61,7 @@ def _reset_ms(env, n, repeats):
     return 1e3 * float(np.median(times))
 
 
-def measure(n, steps=150, repeats=5, control_dt=1.0):
+def measure(n, steps=150, repeats=5, control_dt=1.0, min_s=0.2):
     """One row of the table for ``n`` ships (see the module docstring)."""
     import gymnasium as gym
 
@@ -67,8 +75,8 @@ def measure(n, steps=150, repeats=5, control_dt=1.0):
         _time(env, acts[:5])
     t = {"native": [], "sync": []}
     for _ in range(repeats):
-        t["native"].append(_time(native, acts))
-        t["sync"].append(_time(sync, acts))
+        t["native"].append(_time(native, acts, min_s=min_s))
+        t["sync"].append(_time(sync, acts, min_s=min_s))
     row = {"n": n, "control_dt": control_dt, "steps": steps, "repeats": repeats}
     for name, times in t.items():
         wall, cpu = np.median(np.array(times), axis=0)
@@ -89,11 +97,13 @@ def main(argv=None) -> int:
     ap.add_argument("--repeats", type=int, default=5)
     ap.add_argument("--control-dt", type=float, default=1.0,
                     help="env step [s] (the env's default 1 s = 10 RK4 steps of 0.1 s; 0.1: one); episodes of 120 steps")
+    ap.add_argument("--min-time", type=float, default=0.2,
+                    help="each timing repeats its block of steps until this many seconds (small N)")
     ap.add_argument("--json", action="store_true")
     a = ap.parse_args(argv)
     rows = []
     for n in (int(v) for v in a.n.split(",")):
-        r = measure(n, a.steps, a.repeats, a.control_dt)
+        r = measure(n, a.steps, a.repeats, a.control_dt, a.min_time)
         rows.append(r)
         if not a.json:
             print(f"N={n:5d}  native {r['native_env_steps_per_s']:10.3g} env-steps/s   SyncVectorEnv "
