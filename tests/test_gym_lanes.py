@@ -198,10 +198,13 @@ def test_seeds_are_checked_and_unseeded_resets_differ():
     from steerlab.errors import InputError
 
     venv = _vec("steerlab/CourseKeeping-v0", n=2)
-    for bad in (-1, 2 ** 128, 1.5, [1]):
+    with pytest.raises(RuntimeError, match="reset"):
+        venv.step(np.zeros((2, 1), dtype=np.float32))
+    for bad in (-1, 2 ** 128, 1.5, [1], [3, -3]):
         with pytest.raises(InputError) as ei:
             venv.reset(seed=bad)
         assert ei.value.field == "seed"
+    assert not venv.unwrapped.core.keyed.any()             # a refused seed list changed no ship
     a, _ = venv.reset()                                    # keyed from the OS's entropy
     b, _ = _vec("steerlab/CourseKeeping-v0", n=2).reset()
     assert not np.array_equal(a, b)

@@ -177,12 +177,15 @@ class Episodes:
 
         lanes = np.asarray(lanes, dtype=np.int64).reshape(-1)
         if seeds is not None or not self.keyed[lanes].all():
+            new = {}                                       # all checked before any lane changes
             for q, i in enumerate(lanes.tolist()):
                 s = None if seeds is None else seeds[q]
                 if s is not None or not self.keyed[i]:
-                    self.KEY[i] = seed_key(s)
-                    self.EP[i] = 0
-                    self.keyed[i] = True
+                    new[i] = seed_key(s)
+            for i, key in new.items():
+                self.KEY[i] = key
+                self.EP[i] = 0
+                self.keyed[i] = True
         sea_seeds = self._sea_seeds[: lanes.shape[0]]
         self._reset(lanes, self.KEY, self.EP, self.S, self.Z, self._scale, self.offset_max, self.X, self.K, self.J,
                     self.cmd, self.PS, self.GZ, self.REF, self._x0, self._ps0, self.gz0, self._ref0, self.gd,

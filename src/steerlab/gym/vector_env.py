@@ -40,6 +40,7 @@ class SteeringVectorEnv(VectorEnv):
         self._autoreset = np.zeros(self.num_envs, dtype=np.bool_)   # ended at the last step: reset at the next
         self._term = np.zeros(self.num_envs, dtype=np.bool_)
         self._trunc = np.zeros(self.num_envs, dtype=np.bool_)
+        self._reset_done = False
 
     def reset(self, *, seed=None, options=None):
         n = self.num_envs
@@ -57,10 +58,13 @@ class SteeringVectorEnv(VectorEnv):
                                          f"got {seed!r}")
         self.core.reset_lanes(np.arange(n), seeds)
         self._autoreset[:] = False
+        self._reset_done = True
         return self.core.obs.copy(), {}
 
     def step(self, actions):
         c = self.core
+        if not self._reset_done:
+            raise RuntimeError("call reset() before step()")
         c.step_autoreset(actions, self._autoreset, self._term, self._trunc)
         infos = {}
         if self._term.any():
