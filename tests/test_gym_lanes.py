@@ -256,3 +256,21 @@ def test_an_action_outside_the_space_is_refused_by_the_vector_env_and_changes_no
                    zip(before, (core.X, core.K, core.J, core.W, core.obs, core.rew)))
     o, *_ = venv.step(np.ones((18, 1), dtype=np.float32))     # the boundary itself is allowed
     assert np.all(np.isfinite(o))
+
+
+def test_bench_env_script_reports_both_envs(capsys):
+    """benchmarks/bench_env.py, run as its own main on a tiny workload (its numbers: README)."""
+    import importlib.util
+    import json
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parents[1] / "benchmarks" / "bench_env.py"
+    spec = importlib.util.spec_from_file_location("bench_env", path)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    assert mod.main(["--n", "3", "--steps", "4", "--repeats", "1", "--min-time", "0", "--json"]) == 0
+    (row,) = json.loads(capsys.readouterr().out)["rows"]
+    assert row["n"] == 3 and row["steps"] == 4 and row["control_dt"] == 1.0
+    for k in ("native_env_steps_per_s", "sync_env_steps_per_s", "native_env_steps_per_cpu_s", "ratio", "ratio_cpu"):
+        assert row[k] > 0
+    assert row["ratio"] == pytest.approx(row["native_env_steps_per_s"] / row["sync_env_steps_per_s"])
