@@ -11,7 +11,8 @@ Workload: ``steerlab/CourseKeeping-v0`` with its defaults (Esso tanker at 16 kn,
 2.33 deg/s, eq-39 waves, dt 0.1 s, control_dt 1 s = 10 RK4 steps per env step) but episodes of
 120 env steps, so that the 150 timed steps include one autoreset of every ship; random actions
 drawn up front. ``--control-dt 0.1`` makes an env step one RK4 step (less physics per step, so
-more of a step is the per-call overhead a vector env saves). For each N, in one process: env-steps/s (N ships x steps / time) of
+more of a step is the per-call overhead a vector env saves). For each N, in one process:
+env-steps/s (N ships x steps / time) of
 ``gymnasium.make_vec(..., vectorization_mode="vector_entry_point")`` (the whole step of N ships,
 autoresets included, in one compiled call) and of ``gymnasium.vector.SyncVectorEnv`` over N
 single environments made by ``gymnasium.make`` (its wrappers included), and their ratio.
@@ -96,7 +97,8 @@ def main(argv=None) -> int:
     ap.add_argument("--steps", type=int, default=150, help="env steps per timing (> 120: one autoreset inside)")
     ap.add_argument("--repeats", type=int, default=5)
     ap.add_argument("--control-dt", type=float, default=1.0,
-                    help="env step [s] (the env's default 1 s = 10 RK4 steps of 0.1 s; 0.1: one); episodes of 120 steps")
+                    help="env step [s] (the env's default 1 s = 10 RK4 steps of 0.1 s; 0.1: one); "
+                         "episodes of 120 steps")
     ap.add_argument("--min-time", type=float, default=0.2,
                     help="each timing repeats its block of steps until this many seconds (small N)")
     ap.add_argument("--json", action="store_true")
