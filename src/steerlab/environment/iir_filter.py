@@ -17,21 +17,29 @@ import numba
 import numpy as np
 
 
+@numba.njit(inline="always")
+def df2_step(b, a, z, xk):
+    """One sample of the transposed direct form II: returns ``y[k]`` for input ``xk`` and
+    advances the state ``z`` (``max(len(b) - 1, 1)`` floats, zeros at rest) in place. Filtering
+    a sequence sample by sample with it gives the bits of :func:`lfilter` (the same loop)."""
+    n = b.shape[0]
+    if n > 1:
+        yk = z[0] + b[0] * xk
+        for i in range(n - 2):
+            z[i] = z[i + 1] + xk * b[i + 1] - yk * a[i + 1]
+        z[n - 2] = xk * b[n - 1] - yk * a[n - 1]
+    else:
+        yk = xk * b[0]
+    return yk
+
+
 @numba.njit(cache=True)
 def _transposed_df2(b, a, x, y):
     """``y`` = ``x`` filtered by ``b``/``a`` (equal lengths >= 1, ``a[0] == 1``), from rest."""
     n = b.shape[0]
     z = np.zeros(max(n - 1, 1))
     for k in range(x.shape[0]):
-        xk = x[k]
-        if n > 1:
-            yk = z[0] + b[0] * xk
-            for i in range(n - 2):
-                z[i] = z[i + 1] + xk * b[i + 1] - yk * a[i + 1]
-            z[n - 2] = xk * b[n - 1] - yk * a[n - 1]
-        else:
-            yk = xk * b[0]
-        y[k] = yk
+        y[k] = df2_step(b, a, z, x[k])
 
 
 @numba.njit(cache=True)

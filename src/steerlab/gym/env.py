@@ -12,6 +12,11 @@ the step - the speed-loss criterion (Koyama; van Amerongen 1982 eq 3.1), ``lam``
 Episode: ``episode_s`` seconds (``truncated``); a diverged ship (non-finite state, or a yaw
 rate beyond the observation bound) ends it
 (``terminated``, ``info["reason"] == "diverged"``, observation zeros).
+Seeding: ``reset(seed=s)`` keys the ship's random numbers with ``s`` (an int in [0, 2^128));
+each later ``reset()`` starts the next episode of that key (:mod:`steerlab.gym.lane_seas`);
+``info`` of a reset: ``episode`` (its number since the seed), ``initial_heading`` [rad]
+(and ``sea_seed`` when the sea, having optional blocks, was realised by the scenario
+machinery).
 Tasks: ``course_keeping`` (``steerlab/CourseKeeping-v0``: hold 0 deg from a seeded initial
 offset of up to ``initial_offset_deg``), ``course_change`` (``steerlab/CourseChange-v0``: a
 ``change_deg`` step of the reference at ``change_t``), ``track_following``

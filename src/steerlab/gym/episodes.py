@@ -1,30 +1,41 @@
 r"""N course-keeping / course-change episodes on one ship: the core of the Gymnasium environments.
 
 A lane is one episode: a ship (``steerlab ships``) with a steering gear in a sea built by the
-scenario machinery (``[environment]`` keys; :func:`steerlab.sim.setup.build_seeds`, so the
-seas are exactly those of ``steerlab run``), a reference heading from the scenario's guidance
-kernel (the time-only course schedule, or ``guidance=`` any ``[guidance]`` table, e.g. LOS
-route following for ``track_following``: :data:`TRACK_GUIDANCE` by default),
-and an agent that orders the rudder every ``control_dt`` seconds (``nc = control_dt / dt``
-plant steps, order held). Each lane owns a random generator (gymnasium's
-``seeding.np_random``); at reset it draws the sea's seed and, for course keeping, the initial
-heading offset. Lanes are independent: lane i of N behaves as a single environment seeded
-alike.
+scenario machinery (``[environment]`` keys, :func:`steerlab.sim.setup.design`), a reference
+heading from the scenario's guidance kernel (the time-only course schedule, or ``guidance=``
+any ``[guidance]`` table, e.g. LOS route following for ``track_following``:
+:data:`TRACK_GUIDANCE` by default), and an agent that orders the rudder every ``control_dt``
+seconds (``nc = control_dt / dt`` plant steps, order held).
+
+Randomness (:mod:`steerlab.gym.lane_seas`): a reset with a seed keys the lane with it; each
+episode of the lane (0 after the seeded reset, then 1, 2, ... at the resets without a seed)
+draws its initial heading offset (course keeping) and its sea's white noise from
+Philox4x64-10 blocks of (key, episode) in compiled code - no generator object per lane or per
+reset. Lanes are independent: lane i of N behaves as a single environment seeded alike, and
+the same seed gives the same episodes. A plain sea (waves, constant wind, current, rudder
+offset: the default) is the scenario's eq-39 wave disturbance driven by those normals, its
+rows filtered env step by env step just before the plants read them; a sea with optional
+blocks (``uses_sea``: spectra, gusts, current variation, wind rudder) is realised lane by lane
+by :func:`~steerlab.sim.setup.realise` with a sea seed drawn from the episode's header, so it
+is the sea ``steerlab run`` gives that seed.
 
 ``vectorised=True`` (the native vector environment) advances the ships with the batch
-engine's vectorised groups (:func:`steerlab.gym.plant_batch.vector_stepper`) instead of one
-after the other; the numbers are the same. Resets of many lanes draw their seas in one call
-(:func:`steerlab.environment.disturbance.build_disturbances`, the seas
-:func:`~steerlab.sim.setup.realise` gives, without re-designing anything per reset); a sea
-with optional blocks (``uses_sea``: spectra, gusts, current variation, wind rudder) is
-realised lane by lane.
+engine's vectorised groups and does the whole step - actions checked, autoresets, plants,
+guidance, observations, rewards - in one compiled call
+(:func:`steerlab.gym.plant_batch.vector_stepper`, :meth:`Episodes.step_autoreset`); the
+single environment steps its ship with the scalar kernel; the numbers are the same.
 """
 
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
+
+from steerlab.environment.disturbance import N_CHANNELS, W_RUDDER, build_disturbance
+from steerlab.environment.iir_filter import _padded
+from steerlab.environment.waves import _hold, band_pass_eq39
 
 from steerlab.errors import InputError, require_finite_range
 from steerlab.units import rad
@@ -119,7 +130,6 @@ class Episodes:
         self.rew = np.zeros(n)
         self.bad = np.zeros(n, dtype=np.bool_)
         self.active = np.ones(n, dtype=np.bool_)
-        self.W[:] = s0.w
         self.w_index = np.arange(n, dtype=np.int64)
         self._work = np.empty((5, nx))
         self.vectorised = bool(vectorised)
@@ -129,63 +139,103 @@ class Episodes:
             self._step = lane_stepper(s0.ship.rhs, self.guide)
         self._reset = resetter(self.guide)
         self._x0, self._ps0, self._ref0 = s0.x0, s0.ps, initial_reference()
-        self.rngs = [None] * n
+        # per lane: its key (the reset seed), its next episode number (steerlab.gym.lane_seas)
+        self.KEY = np.zeros((n, 2), dtype=np.uint64)
+        self.EP = np.zeros(n, dtype=np.uint64)
+        self.keyed = np.zeros(n, dtype=np.bool_)
+        self._sea_seeds = np.zeros(n, dtype=np.int64)
+        dist, sc = self.design.dist, self.scenario
+        # a plain sea's wave channel is filtered lazily from the lane's draws; its other channels
+        # are seed-free and written once
+        self.lazy = self._fast_seas and bool(dist.waves)
+        if self._fast_seas:
+            self._base = build_disturbance(replace(dist, waves=False), sc.n_steps, sc.dt, 0)
+            self.W[:] = self._base
+        else:
+            self._base = np.zeros((1, N_CHANNELS))
+            self.W[:] = s0.w
+        if self.lazy:
+            hold, n_samples = _hold(sc.n_steps, sc.dt, dist.wave_sample_time, dist.wave_power)
+            self._scale = math.sqrt(dist.wave_power / dist.wave_sample_time)
+            self._fb, self._fa = _padded(*band_pass_eq39(sc.dt))
+        else:
+            hold, n_samples, self._scale = 1, 0, 0.0
+            self._fb, self._fa = np.zeros(1), np.ones(1)
+        self._hold = hold
+        self.S = np.zeros((n, n_samples))
+        self.Z = np.zeros((n, max(self._fb.shape[0] - 1, 1)))
+
+    def _sea_args(self):
+        return (self.lazy, self.S, self.Z, self._base, self._hold, self._fb, self._fa, W_RUDDER)
 
     # ----------------------------------------------------------------- reset
     def reset_lanes(self, lanes, seeds=None):
-        """Reset ``lanes`` (indices); ``seeds[i]`` (int or None) reseeds lane's generator first."""
-        from gymnasium.utils import seeding
+        """Reset ``lanes`` (indices) to their next episode; ``seeds[i]`` (int or None) first
+        keys lane ``lanes[i]`` with that seed (episode 0). A lane never keyed is keyed from
+        the operating system's entropy. Returns one info dict per lane."""
+        from steerlab.gym.philox import seed_key
 
-        from steerlab.environment.disturbance import build_disturbances
-
-        lanes = np.asarray(list(lanes), dtype=np.int64)
-        m = lanes.shape[0]
-        sea_seeds, offsets = [], np.zeros(m)
-        for q, i in enumerate(lanes.tolist()):
-            s = None if seeds is None else seeds[q]
-            if s is not None or self.rngs[i] is None:
-                self.rngs[i], _ = seeding.np_random(s)
-            rng = self.rngs[i]
-            sea_seeds.append(int(rng.integers(0, 2**31 - 1)))
-            if self.offset_max > 0:
-                offsets[q] = float(rng.uniform(-self.offset_max, self.offset_max))
-        if self._fast_seas:
-            sc = self.scenario
-            build_disturbances(self.design.dist, sc.n_steps, sc.dt, sea_seeds, out=self.W, rows=lanes)
-        else:
+        lanes = np.asarray(lanes, dtype=np.int64).reshape(-1)
+        if seeds is not None or not self.keyed[lanes].all():
+            new = {}                                       # all checked before any lane changes
             for q, i in enumerate(lanes.tolist()):
-                self.W[i] = self._realise(self.design, sea_seeds[q]).w
-        self.K[lanes] = 0
-        self.J[lanes] = 0
-        self.cmd[lanes] = 0.0
-        self.bad[lanes] = False
-        self.rew[lanes] = 0.0
-        self._reset(lanes, self.X, self.PS, self.GZ, self.REF, self._x0, self._ps0, self.gz0, self._ref0, offsets,
-                    self.gd, self.control_dt, self.rpm_slot, self.obs)
-        return [{"sea_seed": sea_seeds[q], "initial_heading": float(self.X[i, IPSI])}
-                for q, i in enumerate(lanes.tolist())]
+                s = None if seeds is None else seeds[q]
+                if s is not None or not self.keyed[i]:
+                    new[i] = seed_key(s)
+            for i, key in new.items():
+                self.KEY[i] = key
+                self.EP[i] = 0
+                self.keyed[i] = True
+        sea_seeds = self._sea_seeds[: lanes.shape[0]]
+        self._reset(lanes, self.KEY, self.EP, self.S, self.Z, self._scale, self.offset_max, self.X, self.K, self.J,
+                    self.cmd, self.PS, self.GZ, self.REF, self._x0, self._ps0, self.gz0, self._ref0, self.gd,
+                    self.control_dt, self.rpm_slot, self.obs, self.rew, self.bad, sea_seeds)
+        infos = [{"episode": int(self.EP[i]) - 1, "initial_heading": float(self.X[i, IPSI])} for i in lanes.tolist()]
+        if not self._fast_seas:
+            for q, i in enumerate(lanes.tolist()):
+                self.W[i] = self._realise(self.design, int(sea_seeds[q])).w
+                infos[q]["sea_seed"] = int(sea_seeds[q])
+        return infos
 
     # ----------------------------------------------------------------- step
     def orders(self, actions) -> np.ndarray:
         """Rudder orders [rad] from actions in [-1, 1] (fraction of the gear limit); refuses others."""
         a = np.asarray(actions, dtype=np.float64).reshape(self.n)
         if not (np.abs(a) <= 1.0).all():                 # NaN fails the comparison too
-            i = int(np.argmax(~(np.abs(a) <= 1.0)))
-            raise InputError("action", f"must be finite and in [-1, 1] (rudder order / gear limit "
-                                       f"{math.degrees(self.delta_max):g} deg), got {a[i]!r}")
+            raise self._refused(a[int(np.argmax(~(np.abs(a) <= 1.0)))])
         return a * self.delta_max
 
+    def _refused(self, value):
+        return InputError("action", f"must be finite and in [-1, 1] (rudder order / gear limit "
+                                    f"{math.degrees(self.delta_max):g} deg), got {value!r}")
+
     def step(self, actions, active=None):
-        """Advance the ``active`` lanes (default all) by one env step; fills ``obs``, ``rew``, ``bad``."""
+        """Advance the ``active`` lanes (default all) by one env step with the scalar kernel (the
+        single environment); fills ``obs``, ``rew``, ``bad``; returns ``(obs, rew, terminated,
+        truncated)``."""
+        if self.vectorised:
+            raise RuntimeError("a vectorised Episodes steps with step_autoreset()")
         self.cmd[:] = self.orders(actions)
         act = self.active if active is None else active
-        if self.vectorised:
-            self._vstep(self.X, self.K, self.J, self.cmd, self.W, self.w_index, self.PS, self.PG, self.dt, self.nc,
-                        self.gd, self.GZ, self.REF, self.rpm_slot, self.lam, self.reward, act, self.obs, self.rew,
-                        self.bad)
-        else:
-            self._step(self.X, self.K, self.J, self.cmd, self.W, self.PS, self.PG, self.dt, self.nc, self.gd,
-                       self.GZ, self.REF, self.rpm_slot, self.lam, self.reward, act, self.obs, self.rew, self.bad,
-                       self._work)
+        self._step(self.X, self.K, self.J, self.cmd, self.W, self.PS, self.PG, self.dt, self.nc, self.gd,
+                   self.GZ, self.REF, self.rpm_slot, self.lam, self.reward, act, self.obs, self.rew, self.bad,
+                   self._work, *self._sea_args())
         truncated = self.J >= self.n_env_steps
         return self.obs, self.rew, self.bad.copy(), truncated & ~self.bad
+
+    def step_autoreset(self, actions, redo, term, trunc):
+        """The vector environment's step (:func:`steerlab.gym.plant_batch.vector_stepper`, one
+        compiled call): the lanes not in ``redo`` (N,) bool advance with ``actions`` (N,) in
+        [-1, 1], the ``redo`` lanes reset to their next episode (action ignored, reward 0);
+        fills ``obs``, ``rew``, ``term``, ``trunc`` and sets ``redo = term | trunc``."""
+        a = np.asarray(actions, dtype=np.float64).reshape(self.n)
+        again = None if self.lazy else redo.copy()
+        i = self._vstep(a, redo, self.X, self.K, self.J, self.cmd, self.W, self.w_index, self.PS, self.PG, self.dt,
+                        self.nc, self.gd, self.GZ, self.REF, self.rpm_slot, self.lam, self.reward, self.obs,
+                        self.rew, self.bad, term, trunc, self.n_env_steps, self.delta_max, *self._sea_args(),
+                        self.KEY, self.EP, self._scale, self.offset_max, self._x0, self._ps0, self.gz0, self._ref0,
+                        self._fast_seas)
+        if i >= 0:
+            raise self._refused(a[i])
+        if again is not None and again.any():              # seas realised lane by lane: reset here
+            self.reset_lanes(np.flatnonzero(again))

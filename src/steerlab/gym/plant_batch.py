@@ -9,7 +9,11 @@ scalar code. Two schedules of the same operations:
   engines' scalar step (:func:`steerlab.sim.kernels.plant_step`);
 * :func:`vector_stepper` (the native vector environment): the ship driver's ``step_lanes``
   (:mod:`steerlab.sim.driver_template`), the batch engine's structure-of-arrays groups of
-  ``LANES`` ships with every RK4 stage vectorised across the group.
+  ``LANES`` ships with every RK4 stage vectorised across the group, inside one compiled call
+  that also checks the actions and does the autoresets (:func:`lane_resetter`).
+
+Both write a plain sea's disturbance rows of the step first
+(:func:`steerlab.gym.lane_seas.fill_rows`).
 
 Per ship both perform the same IEEE operations in the same order, so a lane's numbers do not
 depend on N, on the schedule or on the other lanes: ship i of the vector environment equals
@@ -35,6 +39,7 @@ import numpy as np
 
 from steerlab.angles import wrap_to_pi
 from steerlab.guidance.reference_vector import REF_PSI, REF_RPM
+from steerlab.gym.lane_seas import draw_episode, fill_rows
 from steerlab.sim.kernels import plant_step
 from steerlab.ships.state import IPSI, IR
 
@@ -103,25 +108,29 @@ def finisher(guide):
 
 @lru_cache(maxsize=None)
 def lane_stepper(ship_rhs, guide):
-    """``step_lanes(X, K, J, cmd, W, PS, PG, dt, nc, gd, GZ, REF, rpm_slot, lam, reward, active, obs, rew, bad, work)``,
-    one plant after the other (the single environment).
+    """``step_lanes(X, K, J, cmd, W, PS, PG, dt, nc, gd, GZ, REF, rpm_slot, lam, reward, active, obs, rew, bad,
+    work, lazy, S, Z, base, hold, fb, fa, ch)``, one plant after the other (the single environment).
 
     ``X`` (N, nx) plant states, ``K`` (N,) plant-step counters, ``J`` (N,) env-step counters,
     ``cmd`` (N,) rudder orders [rad], ``W`` (N, n_steps + 1, channels) disturbances, ``PS``,
     ``PG`` packed ship and gear records, ``gd`` the guidance record, ``GZ`` (N, n_gz) guidance
     states and ``REF`` (N, N_REF) reference vectors (advanced in place); ``active`` (N,) lanes
     to step; writes ``obs`` (N, 3), ``rew`` (N,), ``bad`` (N,) (:func:`finisher`). ``work`` is
-    a (5, nx) scratch array.
+    a (5, nx) scratch array. With ``lazy`` the env step's disturbance rows of channel ``ch``
+    are written first (:func:`steerlab.gym.lane_seas.fill_rows`: samples ``S``, filter
+    ``fb/fa`` state ``Z``, seed-free rows ``base``, ``hold`` rows per sample).
     """
     rk4_step = plant_step(ship_rhs)
     finish = finisher(guide)
 
     @numba.njit
     def step_lanes(X, K, J, cmd, W, PS, PG, dt, nc, gd, GZ, REF, rpm_slot, lam, reward, active, obs, rew, bad,
-                   work):
+                   work, lazy, S, Z, base, hold, fb, fa, ch):
         for i in range(X.shape[0]):
             if not active[i]:
                 continue
+            if lazy:
+                fill_rows(i, K[i], nc, W, S, Z, base, hold, fb, fa, ch)
             x = X[i]
             for _ in range(nc):
                 k = K[i]
@@ -134,47 +143,116 @@ def lane_stepper(ship_rhs, guide):
 
 @lru_cache(maxsize=None)
 def vector_stepper(ship_rhs, guide, nx: int):
-    """The same step as :func:`lane_stepper` (same arguments but ``work``, plus ``w_index``
-    (N,) int64 = ``arange(N)``), the plants advanced by the ship driver's ``step_lanes``
-    (groups of ``LANES`` ships, structure of arrays, vectorised RK4 stages) - one compiled
-    call per env step."""
+    """The native vector environment's whole step, one compiled call:
+    ``step(A, redo, X, K, J, cmd, W, w_index, PS, PG, dt, nc, gd, GZ, REF, rpm_slot, lam, reward, obs, rew, bad,
+    term, trunc, n_env_steps, dmax, lazy, S, Z, base, hold, fb, fa, ch, KEY, EP, scale, offset_max, x0, ps0, gz0,
+    ref0, auto) -> int``.
+
+    ``A`` (N,) actions, ``redo`` (N,) the lanes whose episode ended at the previous step
+    (gymnasium's ``NEXT_STEP`` autoreset: their action is ignored). First every other lane's
+    action is checked to be in [-1, 1]: the index of the first one that is not is returned
+    (nothing changed; -1 if all are). Those lanes get the order ``A[i] dmax`` [rad], their
+    disturbance rows (with ``lazy``, as :func:`lane_stepper`) and ``nc`` plant steps through
+    the ship driver's ``step_lanes`` (groups of ``LANES`` ships, structure of arrays,
+    vectorised RK4 stages), then :func:`finisher`; ``term`` = diverged, ``trunc`` = the
+    episode's ``n_env_steps`` done. With ``auto`` (seas that need no per-lane scenario
+    machinery) the ``redo`` lanes are reset here (:func:`lane_resetter`: ``KEY``, ``EP``, ``scale``, ``offset_max``,
+    the design's ``x0``, ``ps0``, ``gz0``, ``ref0``; reward 0, not ended); else the caller
+    resets them. Finally ``redo = term | trunc``. Per ship the operations are those of
+    :func:`lane_stepper` and :func:`resetter`, so ship i's numbers equal a single
+    environment's, bit for bit.
+    """
     from steerlab.sim.drivers import driver, entry
     from steerlab.sim.lanes import LANES
 
     plants = entry(driver(ship_rhs, None, None, int(nx), LANES), "step_lanes")   # disk-cached
     finish = finisher(guide)
+    reset_one = lane_resetter(guide)
 
     @numba.njit(nogil=True)
-    def step(X, K, J, cmd, W, w_index, PS, PG, dt, nc, gd, GZ, REF, rpm_slot, lam, reward, active, obs, rew, bad):
-        idx = np.flatnonzero(active)
+    def step(A, redo, X, K, J, cmd, W, w_index, PS, PG, dt, nc, gd, GZ, REF, rpm_slot, lam, reward, obs, rew, bad,
+             term, trunc, n_env_steps, dmax, lazy, S, Z, base, hold, fb, fa, ch, KEY, EP, scale, offset_max, x0,
+             ps0, gz0, ref0, auto):
+        n = X.shape[0]
+        for i in range(n):
+            if not redo[i] and not abs(A[i]) <= 1.0:      # NaN fails the comparison too
+                return i
+        idx = np.empty(n, dtype=np.int64)
+        m = 0
+        for i in range(n):
+            if not redo[i]:
+                idx[m] = i
+                m += 1
+                cmd[i] = A[i] * dmax
+                if lazy:
+                    fill_rows(i, K[i], nc, W, S, Z, base, hold, fb, fa, ch)
+        idx = idx[:m]
         plants(X, K, cmd, W, w_index, PS, PG, idx, dt, nc)
-        for q in range(idx.shape[0]):
-            finish(idx[q], X, K, J, dt, nc, gd, GZ, REF, PS, rpm_slot, lam, reward, obs, rew, bad)
+        for q in range(m):
+            i = idx[q]
+            finish(i, X, K, J, dt, nc, gd, GZ, REF, PS, rpm_slot, lam, reward, obs, rew, bad)
+            term[i] = bad[i]
+            trunc[i] = J[i] >= n_env_steps and not bad[i]
+        for i in range(n):
+            if redo[i]:
+                if auto:
+                    reset_one(i, KEY, EP, S, Z, scale, offset_max, X, K, J, cmd, PS, GZ, REF, x0, ps0, gz0, ref0,
+                              gd, nc * dt, rpm_slot, obs, rew, bad)
+                rew[i] = 0.0
+                term[i] = False
+                trunc[i] = False
+            redo[i] = term[i] or trunc[i]
+        return -1
 
     return step
 
 
 @lru_cache(maxsize=None)
+def lane_resetter(guide):
+    """``reset_one(i, KEY, EP, S, Z, scale, offset_max, X, K, J, cmd, PS, GZ, REF, x0, ps, gz0, ref0, gd, h_env,
+    rpm_slot, obs, rew, bad) -> sea_seed``: lane ``i``'s next episode
+    (:func:`steerlab.gym.lane_seas.draw_episode`: its samples, filter state, heading offset
+    and sea seed), its plant back to the design's start (``x0`` with the offset [rad] added
+    to the heading, ``ps``, ``gz0``, ``ref0``; counters, order, reward and flag zeroed), its
+    first reference from the guidance kernel at ``t = 0`` (a propeller order to
+    ``PS[i, rpm_slot]`` as in :func:`finisher`) and its observation (:func:`observe`)."""
+
+    @numba.njit(inline="always")
+    def reset_one(i, KEY, EP, S, Z, scale, offset_max, X, K, J, cmd, PS, GZ, REF, x0, ps, gz0, ref0, gd, h_env,
+                  rpm_slot, obs, rew, bad):
+        offset, sea_seed = draw_episode(i, KEY, EP, S, Z, scale, offset_max)
+        X[i, :] = x0
+        X[i, IPSI] += offset
+        K[i] = 0
+        J[i] = 0
+        cmd[i] = 0.0
+        rew[i] = 0.0
+        bad[i] = False
+        PS[i, :] = ps
+        GZ[i, :] = gz0
+        REF[i, :] = ref0
+        guide(0.0, X[i], gd, GZ[i], REF[i], h_env)
+        if rpm_slot >= 0 and REF[i, REF_RPM] >= 0.0:
+            PS[i, rpm_slot] = REF[i, REF_RPM]
+        observe(X[i], REF[i, REF_PSI], obs[i])
+        return sea_seed
+
+    return reset_one
+
+
+@lru_cache(maxsize=None)
 def resetter(guide):
-    """``reset(idx, X, PS, GZ, REF, x0, ps, gz0, ref0, offsets, gd, h_env, rpm_slot, obs)``: the
-    lanes ``idx`` back to the design's start (``x0`` with the heading offset ``offsets[q]``
-    [rad] added, ``ps``, ``gz0``, ``ref0``), their first reference from the guidance kernel
-    at ``t = 0`` (a propeller order to ``PS[i, rpm_slot]`` as in :func:`finisher`) and their
-    observation (:func:`observe`); one compiled call for all of them."""
+    """``reset(idx, KEY, EP, S, Z, scale, offset_max, X, K, J, cmd, PS, GZ, REF, x0, ps, gz0, ref0, gd, h_env,
+    rpm_slot, obs, rew, bad, sea_seeds)``: :func:`lane_resetter` for the lanes ``idx``, their
+    sea seeds into ``sea_seeds``; one compiled call for all of them."""
+    reset_one = lane_resetter(guide)
 
     @numba.njit
-    def reset(idx, X, PS, GZ, REF, x0, ps, gz0, ref0, offsets, gd, h_env, rpm_slot, obs):
+    def reset(idx, KEY, EP, S, Z, scale, offset_max, X, K, J, cmd, PS, GZ, REF, x0, ps, gz0, ref0, gd, h_env,
+              rpm_slot, obs, rew, bad, sea_seeds):
         for q in range(idx.shape[0]):
-            i = idx[q]
-            X[i, :] = x0
-            X[i, IPSI] += offsets[q]
-            PS[i, :] = ps
-            GZ[i, :] = gz0
-            REF[i, :] = ref0
-            guide(0.0, X[i], gd, GZ[i], REF[i], h_env)
-            if rpm_slot >= 0 and REF[i, REF_RPM] >= 0.0:
-                PS[i, rpm_slot] = REF[i, REF_RPM]
-            observe(X[i], REF[i, 0], obs[i])
+            sea_seeds[q] = reset_one(idx[q], KEY, EP, S, Z, scale, offset_max, X, K, J, cmd, PS, GZ, REF, x0, ps,
+                                     gz0, ref0, gd, h_env, rpm_slot, obs, rew, bad)
 
     return reset
 

@@ -4,11 +4,15 @@ r"""The native vector environment: N ships stepped in one compiled call.
 gives a :class:`SteeringVectorEnv`: spaces, reward and episodes as the single
 :class:`~steerlab.gym.env.SteeringEnv` (observations (N, 3), actions (N, 1)), all N ships
 advanced by the batch engine's vectorised groups of ``LANES`` ships in one compiled call
-(:func:`steerlab.gym.plant_batch.vector_stepper`; the single environment steps its ship with
-the scalar kernel, with the same numbers). ``reset(seed=s)`` seeds ship i
-with ``s + i`` (as gymnasium's ``SyncVectorEnv``), so ship i's episode equals a single
-environment's reset with seed ``s + i``. Autoreset: gymnasium's ``NEXT_STEP`` mode (the step
-after an episode ends resets that ship and ignores its action; reward 0).
+(:func:`steerlab.gym.plant_batch.vector_stepper`: actions checked, autoresets, plants,
+guidance, observations and rewards; the single environment steps its ship with the scalar
+kernel, with the same numbers). ``reset(seed=s)`` seeds ship i with ``s + i`` (as gymnasium's
+``SyncVectorEnv``; or ``seed=[s0, s1, ...]``, one per ship), so ship i's episodes equal a
+single environment's after ``reset(seed=s + i)``. Autoreset: gymnasium's ``NEXT_STEP`` mode
+(the step after an episode ends resets that ship to its next episode and ignores its action;
+reward 0). An action outside [-1, 1] (or NaN) raises :class:`~steerlab.errors.InputError`
+before anything moves; a diverged ship ends its episode (``terminated``,
+``infos["reason"] == "diverged"``, zeros observed).
 """
 
 from __future__ import annotations
@@ -18,6 +22,7 @@ import numpy as np
 from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
+from steerlab.errors import InputError
 from steerlab.gym.env import spaces
 from steerlab.gym.episodes import Episodes
 
@@ -32,37 +37,37 @@ class SteeringVectorEnv(VectorEnv):
         self.observation_space = batch_space(self.single_observation_space, self.num_envs)
         self.action_space = batch_space(self.single_action_space, self.num_envs)
         self.render_mode = render_mode
-        self._autoreset = np.zeros(self.num_envs, dtype=np.bool_)
+        self._autoreset = np.zeros(self.num_envs, dtype=np.bool_)   # ended at the last step: reset at the next
+        self._term = np.zeros(self.num_envs, dtype=np.bool_)
+        self._trunc = np.zeros(self.num_envs, dtype=np.bool_)
+        self._reset_done = False
 
     def reset(self, *, seed=None, options=None):
         n = self.num_envs
         if seed is None:
-            seeds = [None] * n
-        elif isinstance(seed, int):
-            seeds = [seed + i for i in range(n)]
+            seeds = None
+        elif isinstance(seed, (int, np.integer)) and not isinstance(seed, (bool, np.bool_)):
+            seeds = [int(seed) + i for i in range(n)]
         else:
-            seeds = list(seed)
-        self.core.reset_lanes(range(n), seeds)
+            try:
+                seeds = list(seed)
+            except TypeError:
+                seeds = None
+            if seeds is None or len(seeds) != n:
+                raise InputError("seed", f"must be None, an int or a sequence of {n} ints (one per ship), "
+                                         f"got {seed!r}")
+        self.core.reset_lanes(np.arange(n), seeds)
         self._autoreset[:] = False
+        self._reset_done = True
         return self.core.obs.copy(), {}
 
     def step(self, actions):
         c = self.core
-        a = np.asarray(actions, dtype=np.float64).reshape(self.num_envs)
-        redo = self._autoreset.copy()
-        if redo.any():
-            a = np.where(redo, 0.0, a)               # the action of a resetting ship is ignored
-        obs, rew, term, trunc = c.step(a, active=~redo)
-        rew = rew.copy()
-        term, trunc = term.copy(), trunc.copy()
-        if redo.any():
-            c.reset_lanes(np.flatnonzero(redo))
-            rew[redo] = 0.0
-            term[redo] = False
-            trunc[redo] = False
+        if not self._reset_done:
+            raise RuntimeError("call reset() before step()")
+        c.step_autoreset(actions, self._autoreset, self._term, self._trunc)
         infos = {}
-        if term.any():
-            infos["reason"] = np.where(term, "diverged", "")
-            infos["_reason"] = term.copy()
-        self._autoreset = term | trunc
-        return c.obs.copy(), rew, term, trunc, infos
+        if self._term.any():
+            infos["reason"] = np.where(self._term, "diverged", "")
+            infos["_reason"] = self._term.copy()
+        return c.obs.copy(), c.rew.copy(), self._term.copy(), self._trunc.copy(), infos

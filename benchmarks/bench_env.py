@@ -1,0 +1,122 @@
+#!/usr/bin/env python
+"""Environment steps per second: steerlab's native vector env against gymnasium's SyncVectorEnv.
+
+Usage::
+
+    python benchmarks/bench_env.py                       # N = 1, 64, 1024
+    python benchmarks/bench_env.py --n 1,64 --steps 150 --repeats 5 --json
+    python benchmarks/bench_env.py --control-dt 0.1     # one RK4 step per env step
+
+Workload: ``steerlab/CourseKeeping-v0`` with its defaults (Esso tanker at 16 kn, gear 35 deg /
+2.33 deg/s, eq-39 waves, dt 0.1 s, control_dt 1 s = 10 RK4 steps per env step) but episodes of
+120 env steps, so that the 150 timed steps include one autoreset of every ship; random actions
+drawn up front. ``--control-dt 0.1`` makes an env step one RK4 step (less physics per step, so
+more of a step is the per-call overhead a vector env saves). For each N, in one process:
+env-steps/s (N ships x steps / time) of
+``gymnasium.make_vec(..., vectorization_mode="vector_entry_point")`` (the whole step of N ships,
+autoresets included, in one compiled call) and of ``gymnasium.vector.SyncVectorEnv`` over N
+single environments made by ``gymnasium.make`` (its wrappers included), and their ratio.
+The two are timed alternately, ``--repeats`` times each after one untimed warm-up (the first
+call compiles), each timing the ``--steps`` steps after ``reset(seed=0)`` (repeated until
+``--min-time`` seconds, for small N, and averaged); the figures are the medians, by
+wall clock and by the process's CPU time (``time.process_time``: what the code costs when other
+programs share the cores). ``reset_ms`` is the median wall time of one reset of all N native
+ships without a seed (what an autoreset round costs). Not a test: the numbers depend on the
+machine and its load.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+
+import numpy as np
+
+
+def _time(env, acts, seed=0, min_s=0.0):
+    """``(wall, cpu)`` seconds per ``len(acts)`` steps from ``reset(seed=seed)`` (the reset not
+    timed), averaged over as many such blocks as take ``min_s`` seconds of wall time."""
+    wall = cpu = 0.0
+    blocks = 0
+    while blocks == 0 or wall < min_s:
+        env.reset(seed=seed)
+        w0, c0 = time.perf_counter(), time.process_time()
+        for a in acts:
+            env.step(a)
+        wall += time.perf_counter() - w0
+        cpu += time.process_time() - c0
+        blocks += 1
+    return wall / blocks, cpu / blocks
+
+
+def _reset_ms(env, n, repeats):
+    core = env.unwrapped.core
+    lanes = np.arange(n)
+    times = []
+    for _ in range(max(repeats, 3)):
+        t0 = time.perf_counter()
+        core.reset_lanes(lanes)
+        times.append(time.perf_counter() - t0)
+    return 1e3 * float(np.median(times))
+
+
+def measure(n, steps=150, repeats=5, control_dt=1.0, min_s=0.2):
+    """One row of the table for ``n`` ships (see the module docstring)."""
+    import gymnasium as gym
+
+    import steerlab.gym  # noqa: F401  (registers the ids)
+
+    kw = {"episode_s": 120 * control_dt, "control_dt": control_dt}
+    native = gym.make_vec("steerlab/CourseKeeping-v0", num_envs=n, vectorization_mode="vector_entry_point", **kw)
+    sync = gym.vector.SyncVectorEnv([lambda: gym.make("steerlab/CourseKeeping-v0", **kw) for _ in range(n)])
+    acts = np.random.default_rng(0).uniform(-1, 1, size=(steps, n, 1)).astype(np.float32)
+    for env in (native, sync):                           # warm-up: compiles, touches the memory
+        _time(env, acts[:5])
+    t = {"native": [], "sync": []}
+    for _ in range(repeats):
+        t["native"].append(_time(native, acts, min_s=min_s))
+        t["sync"].append(_time(sync, acts, min_s=min_s))
+    row = {"n": n, "control_dt": control_dt, "steps": steps, "repeats": repeats}
+    for name, times in t.items():
+        wall, cpu = np.median(np.array(times), axis=0)
+        row[f"{name}_env_steps_per_s"] = n * steps / wall
+        row[f"{name}_env_steps_per_cpu_s"] = n * steps / cpu
+    row["ratio"] = row["native_env_steps_per_s"] / row["sync_env_steps_per_s"]
+    row["ratio_cpu"] = row["native_env_steps_per_cpu_s"] / row["sync_env_steps_per_cpu_s"]
+    row["native_reset_all_ms"] = _reset_ms(native, n, repeats)
+    native.close()
+    sync.close()
+    return row
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--n", default="1,64,1024", help="comma-separated numbers of ships")
+    ap.add_argument("--steps", type=int, default=150, help="env steps per timing (> 120: one autoreset inside)")
+    ap.add_argument("--repeats", type=int, default=5)
+    ap.add_argument("--control-dt", type=float, default=1.0,
+                    help="env step [s] (the env's default 1 s = 10 RK4 steps of 0.1 s; 0.1: one); "
+                         "episodes of 120 steps")
+    ap.add_argument("--min-time", type=float, default=0.2,
+                    help="each timing repeats its block of steps until this many seconds (small N)")
+    ap.add_argument("--json", action="store_true")
+    a = ap.parse_args(argv)
+    rows = []
+    for n in (int(v) for v in a.n.split(",")):
+        r = measure(n, a.steps, a.repeats, a.control_dt, a.min_time)
+        rows.append(r)
+        if not a.json:
+            print(f"N={n:5d}  native {r['native_env_steps_per_s']:10.3g} env-steps/s   SyncVectorEnv "
+                  f"{r['sync_env_steps_per_s']:10.3g}   ratio {r['ratio']:6.1f}x   (CPU time: "
+                  f"{r['native_env_steps_per_cpu_s']:9.3g} / {r['sync_env_steps_per_cpu_s']:9.3g} = "
+                  f"{r['ratio_cpu']:6.1f}x)   native reset of all N {r['native_reset_all_ms']:7.2f} ms", flush=True)
+    if a.json:
+        print(json.dumps({"workload": f"steerlab/CourseKeeping-v0, esso 16 kn, waves, dt 0.1 s, control_dt "
+                                      f"{a.control_dt} s, episodes of 120 env steps", "rows": rows}, indent=2))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,63 @@
+r"""The seas and initial offsets of the Gymnasium environments' episodes, drawn per lane in compiled code.
+
+An episode of lane ``i`` is numbered ``e`` (0 after ``reset(seed=s)``, then 1, 2, ... at each
+reset without a seed) and its lane is keyed with its seed (:func:`steerlab.gym.philox.seed_key`).
+All its random numbers come from Philox4x64-10 blocks of key ``KEY[i]`` and counters
+``(b, e, stream, 0)`` (:mod:`steerlab.gym.philox`), so they depend on (seed, e) only:
+
+* header (``stream`` 0, block 0): ``u = uniform(x0)`` gives the initial heading offset
+  ``-m + 2 m u`` [rad] (``m``: the task's ``initial_offset_deg``; 0 but for course keeping)
+  and ``(x1 >> 33) mod (2^31 - 1)`` an integer sea seed, used only for seas with optional
+  blocks, realised by the scenario machinery (:func:`steerlab.sim.setup.realise`);
+* white noise (``stream`` 1): the standard normals ``z_j`` (ziggurat), scaled by
+  ``sqrt(P / Ts)`` as :func:`steerlab.environment.waves.held_white_noise` scales numpy's
+  (``P`` the wave power, ``Ts`` its sample time).
+
+The wave channel of a plain sea (waves, constant wind, current and rudder offset: the
+default ``{"waves": True}``) is the scenario's eq-39 wave disturbance
+(:func:`steerlab.environment.disturbance.build_disturbance`: the same held samples, the same
+ZOH filter and sum with the seed-free channels) driven by these normals instead of
+``numpy.random.default_rng(seed)``'s. It is written lazily (:func:`fill_rows`), the rows of
+an env step just before its plant steps read them, one filter sample at a time
+(:func:`steerlab.environment.iir_filter.df2_step`), so a reset costs no pass over the
+episode's disturbance rows and builds no generator object: bit-identical to filtering the
+whole sequence at once (``tests/test_gym_lanes.py``).
+"""
+
+from __future__ import annotations
+
+import numba
+import numpy as np
+
+from steerlab.environment.iir_filter import df2_step
+from steerlab.gym.philox import STREAM_HEADER, STREAM_NORMAL, normals, philox_block, uniform
+
+_S33 = np.uint64(33)
+SEA_SEED_MOD = np.uint64(2 ** 31 - 1)
+
+
+@numba.njit(inline="always")
+def draw_episode(i, KEY, EP, S, Z, scale, offset_max):
+    """Start lane ``i``'s episode ``EP[i]`` (then ``EP[i] += 1``): its white-noise samples
+    into ``S[i]`` (scaled by ``scale``), its filter state ``Z[i]`` to rest; returns
+    ``(offset [rad], sea_seed)``."""
+    e = EP[i]
+    EP[i] = e + np.uint64(1)
+    x0, x1, _, _ = philox_block(np.uint64(0), e, np.uint64(STREAM_HEADER), np.uint64(0), KEY[i, 0], KEY[i, 1])
+    offset = -offset_max + (2.0 * offset_max) * uniform(x0)
+    sea_seed = (x1 >> _S33) % SEA_SEED_MOD
+    if S.shape[1] > 0:
+        normals(KEY[i, 0], KEY[i, 1], e, STREAM_NORMAL, S[i], scale)
+    Z[i, :] = 0.0
+    return offset, np.int64(sea_seed)
+
+
+@numba.njit(inline="always")
+def fill_rows(i, k0, n, W, S, Z, base, hold, b, a, ch):
+    """Rows ``k0 .. k0 + n - 1`` of lane ``i``'s disturbance ``W[i]``, channel ``ch``:
+    ``base[k, ch] + y[k]``, ``y`` the filter ``b/a`` of the held samples ``S[i, k // hold]``
+    (state ``Z[i]``, advanced; rows must come in order from 0)."""
+    z = Z[i]
+    s = S[i]
+    for k in range(k0, k0 + n):
+        W[i, k, ch] = base[k, ch] + df2_step(b, a, z, s[k // hold])
