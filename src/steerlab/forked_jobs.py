@@ -5,7 +5,7 @@ the metrics and the CSV together; the machines steerlab runs on have two or more
 :class:`ForkedJobs` forks one child per group of jobs (after the run, so the children share the
 result's arrays without copying or pickling), the parent writes the CSV and the JSON meanwhile,
 and :meth:`ForkedJobs.wait` joins them: a job that fails in a child is raised in the parent as
-one :class:`RuntimeError` with the child's error line.
+one :class:`RuntimeError` with the child's error line (inline, the job's own exception).
 
 Fork is used only where it is safe and helps: Linux, more than one core, no other Python thread
 running, and ``STEERLAB_FORK_JOBS`` not ``0``. Otherwise the jobs run in the parent, in order,
