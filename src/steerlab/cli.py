@@ -156,7 +156,8 @@ def cmd_bench(args) -> int:
 
 EXAMPLES = {
     "run": """examples:
-  steerlab run --out out/default            # bundled default: Esso tanker + ADRC, 20 deg change, waves
+  steerlab run --out out/default            # bundled default: Esso tanker + ADRC, 20 deg change, sea state 6
+  steerlab run examples/scenarios/calm_default.toml --out out/calm   # the default up to 0.1.0 (eq 39 noise)
   steerlab run examples/scenarios/esso-pid.toml --out out/esso-pid --parquet
   steerlab run examples/scenarios/los-route.toml --out out/los        # route following: track figure with the route
   steerlab run --seed 7 --engine readable --out out/seed7""",

@@ -1,7 +1,7 @@
 """Scenario: a frozen, validated description of one closed-loop run, loaded from TOML.
 
 Degrees, knots and rpm appear only here (the edge); :func:`steerlab.sim.setup.build` turns a
-scenario into SI arrays for the engines. Example (the bundled default)::
+scenario into SI arrays for the engines. Example (``examples/scenarios/calm_default.toml``, the default up to 0.1.0)::
 
     name = "esso-adrc-course-change-waves"
     seed = 1
@@ -238,5 +238,6 @@ def default_scenario_path() -> Path:
 
 
 def default_scenario() -> Scenario:
-    """The bundled default: Esso tanker + ADRC, 20 deg course change, then course keeping in waves."""
+    """The bundled default: Esso tanker + ADRC, 20 deg course change, then course keeping in a
+    JONSWAP sea of sea state 6 from 45 deg off the bow (``src/steerlab/scenarios/default.toml``)."""
     return load_scenario(default_scenario_path())
