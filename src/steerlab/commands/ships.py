@@ -69,12 +69,10 @@ def show(ship_id: str) -> dict:
 
 
 def _print_list(rows):
-    w_id = max(len(r["id"]) for r in rows)
-    w_m = max(len(r["model"]) for r in rows)
-    w_r = max(len(r["range"]) for r in rows)
-    print(f"{'id':<{w_id}}  {'model':<{w_m}}  {'range':<{w_r}}  source")
-    for r in rows:
-        print(f"{r['id']:<{w_id}}  {r['model']:<{w_m}}  {r['range']:<{w_r}}  {r['source']}")
+    from steerlab.text_table import render_table
+
+    print(render_table(("id", "model", "range", "source"),
+                       ((r["id"], r["model"], r["range"], r["source"]) for r in rows), align="llll"))
 
 
 def _print_show(d):
