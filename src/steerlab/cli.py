@@ -235,7 +235,7 @@ def main(argv=None) -> int:
     if not getattr(args, "quiet", False):
         from steerlab.sim import drivers
 
-        drivers.on_compile = lambda msg: print(msg, file=sys.stderr, flush=True)
+        drivers.on_compile = _say_compiling
     try:
         return args.func(args)
     except InputError as err:
@@ -256,14 +256,22 @@ def main(argv=None) -> int:
         print("steerlab: interrupted", file=sys.stderr)
         return 130
     finally:
-        _close_progress()
+        _close_progress(forget=True)
 
 
-def _close_progress() -> None:
+def _say_compiling(msg: str) -> None:
+    """The compile notice on stderr, below an open progress bar, wrapped to 100 columns."""
+    import textwrap
+
+    _close_progress()
+    print(textwrap.fill(msg, 100, subsequent_indent="  "), file=sys.stderr, flush=True)
+
+
+def _close_progress(forget: bool = False) -> None:
     """End an open progress-bar line, so that what follows starts on a line of its own."""
     progress = sys.modules.get("steerlab.progress")
     if progress is not None:
-        progress.close_all()
+        progress.close_all(forget)
 
 
 if __name__ == "__main__":  # pragma: no cover

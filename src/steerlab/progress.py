@@ -188,7 +188,10 @@ def reporter(quiet: bool = False) -> Reporter:
     return r
 
 
-def close_all() -> None:
-    """End the open bar line of every reporter made by :func:`reporter` (end of a command)."""
-    while _REPORTERS:
-        _REPORTERS.pop().close()
+def close_all(forget: bool = False) -> None:
+    """End the open bar line of every reporter made by :func:`reporter`; ``forget``: also drop
+    them (end of a command)."""
+    for r in _REPORTERS:
+        r.close()
+    if forget:
+        _REPORTERS.clear()

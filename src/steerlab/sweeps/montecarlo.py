@@ -139,8 +139,7 @@ def run_montecarlo(scenario, n_runs: int, lam: float = 0.1, record_every: int | 
             if record_every < 1:
                 raise InputError("--record-every", f"must be >= 1, got {record_every}")
             say(f"{n_runs} runs of {batch.n_steps} steps ({batch.ship_name} + {batch.controller_name}), "
-                f"log every {record_every} step(s), in chunks of up to {CHUNK_RUNS}; first call "
-                "compiles the loop")
+                f"log every {record_every} step(s), chunks of <= {CHUNK_RUNS} runs")
         out = executor.run(batch, record_every, lambda done, _n, s0=start: report(s0 + done, n_runs))
         nd = batch.X.shape[1] - 1
         diverged[start:start + m] = out.diverged
