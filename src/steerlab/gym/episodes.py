@@ -23,8 +23,10 @@ realised lane by lane.
 from __future__ import annotations
 
 import math
+from typing import Any, Iterable, Mapping, Optional, Sequence, Union
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from steerlab.errors import InputError, require_finite_range
 from steerlab.units import rad
@@ -63,10 +65,12 @@ def _scenario(task, ship, speed_kn, gear, environment, ship_options, dt, episode
 class Episodes:
     """N lanes (see the module docstring); all arrays SI."""
 
-    def __init__(self, n, task="course_keeping", ship="esso", speed_kn=16.0, gear=None, environment=None,
-                 ship_options=None, dt=0.1, control_dt=1.0, episode_s=300.0, lam=0.1,
-                 initial_offset_deg=10.0, change_deg=20.0, change_t=10.0, guidance=None, reward="speed_loss",
-                 vectorised=False):
+    def __init__(self, n: int, task: str = "course_keeping", ship: str = "esso", speed_kn: float = 16.0,
+                 gear: Optional[Mapping[str, float]] = None, environment: Optional[Mapping[str, Any]] = None,
+                 ship_options: Optional[Mapping[str, Any]] = None, dt: float = 0.1, control_dt: float = 1.0,
+                 episode_s: float = 300.0, lam: float = 0.1, initial_offset_deg: float = 10.0,
+                 change_deg: float = 20.0, change_t: float = 10.0, guidance: Optional[Mapping[str, Any]] = None,
+                 reward: str = "speed_loss", vectorised: bool = False) -> None:
         from steerlab.environment.sea import uses_sea
         from steerlab.gym.plant_batch import REWARDS, lane_stepper, resetter, vector_stepper
         from steerlab.guidance.reference_models import course_guide
@@ -129,10 +133,11 @@ class Episodes:
             self._step = lane_stepper(s0.ship.rhs, self.guide)
         self._reset = resetter(self.guide)
         self._x0, self._ps0, self._ref0 = s0.x0, s0.ps, initial_reference()
-        self.rngs = [None] * n
+        self.rngs: list[np.random.Generator | None] = [None] * n
 
     # ----------------------------------------------------------------- reset
-    def reset_lanes(self, lanes, seeds=None):
+    def reset_lanes(self, lanes: Union[Iterable[int], np.ndarray],
+                    seeds: Optional[Sequence[Optional[int]]] = None) -> list[dict[str, Any]]:
         """Reset ``lanes`` (indices); ``seeds[i]`` (int or None) reseeds lane's generator first."""
         from gymnasium.utils import seeding
 
@@ -166,7 +171,7 @@ class Episodes:
                 for q, i in enumerate(lanes.tolist())]
 
     # ----------------------------------------------------------------- step
-    def orders(self, actions) -> np.ndarray:
+    def orders(self, actions: ArrayLike) -> np.ndarray:
         """Rudder orders [rad] from actions in [-1, 1] (fraction of the gear limit); refuses others."""
         a = np.asarray(actions, dtype=np.float64).reshape(self.n)
         if not (np.abs(a) <= 1.0).all():                 # NaN fails the comparison too
@@ -175,7 +180,8 @@ class Episodes:
                                        f"{math.degrees(self.delta_max):g} deg), got {a[i]!r}")
         return a * self.delta_max
 
-    def step(self, actions, active=None):
+    def step(self, actions: ArrayLike, active: Optional[np.ndarray] = None
+             ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """Advance the ``active`` lanes (default all) by one env step; fills ``obs``, ``rew``, ``bad``."""
         self.cmd[:] = self.orders(actions)
         act = self.active if active is None else active

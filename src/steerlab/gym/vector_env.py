@@ -13,8 +13,11 @@ after an episode ends resets that ship and ignores its action; reward 0).
 
 from __future__ import annotations
 
+from typing import Any, Optional, Sequence, Union
+
 import gymnasium as gym
 import numpy as np
+from numpy.typing import ArrayLike
 from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
@@ -25,7 +28,8 @@ from steerlab.gym.episodes import Episodes
 class SteeringVectorEnv(VectorEnv):
     metadata = {"render_modes": [], "autoreset_mode": AutoresetMode.NEXT_STEP}
 
-    def __init__(self, num_envs: int = 1, task="course_keeping", render_mode=None, **kw):
+    def __init__(self, num_envs: int = 1, task: str = "course_keeping", render_mode: Optional[str] = None,
+                 **kw: Any) -> None:
         self.num_envs = int(num_envs)
         self.core = Episodes(self.num_envs, task=task, vectorised=True, **kw)
         self.single_observation_space, self.single_action_space = spaces()
@@ -34,8 +38,10 @@ class SteeringVectorEnv(VectorEnv):
         self.render_mode = render_mode
         self._autoreset = np.zeros(self.num_envs, dtype=np.bool_)
 
-    def reset(self, *, seed=None, options=None):
+    def reset(self, *, seed: Union[int, Sequence[Optional[int]], None] = None,
+              options: Optional[dict[str, Any]] = None) -> tuple[np.ndarray, dict[str, Any]]:
         n = self.num_envs
+        seeds: list[int | None]
         if seed is None:
             seeds = [None] * n
         elif isinstance(seed, int):
@@ -46,7 +52,8 @@ class SteeringVectorEnv(VectorEnv):
         self._autoreset[:] = False
         return self.core.obs.copy(), {}
 
-    def step(self, actions):
+    def step(self, actions: ArrayLike
+             ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, dict[str, Any]]:
         c = self.core
         a = np.asarray(actions, dtype=np.float64).reshape(self.num_envs)
         redo = self._autoreset.copy()
@@ -60,7 +67,7 @@ class SteeringVectorEnv(VectorEnv):
             rew[redo] = 0.0
             term[redo] = False
             trunc[redo] = False
-        infos = {}
+        infos: dict[str, Any] = {}
         if term.any():
             infos["reason"] = np.where(term, "diverged", "")
             infos["_reason"] = term.copy()

@@ -12,14 +12,19 @@ the same accumulator the single-run metrics use, and ``record_every`` keeps a de
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
+from typing import TYPE_CHECKING, Callable, Optional
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from steerlab.errors import InputError
 from steerlab.guidance.reference_vector import N_REF
 from steerlab.metrics_online import N_ACC
 from steerlab.sim.lanes import LANES, batch_loop
 from steerlab.sim.setup import SimSetup
+
+if TYPE_CHECKING:
+    import pandas
 
 
 @dataclass
@@ -42,7 +47,7 @@ class BatchResult:
     ref: np.ndarray
     state_names: tuple
 
-    def to_pandas(self, lam: float = 0.1):
+    def to_pandas(self, lam: float = 0.1) -> pandas.DataFrame:
         """One row per run: integral metrics and final states (:func:`steerlab.sim.frames.batch_frame`)."""
         from steerlab.sim.frames import batch_frame
 
@@ -65,7 +70,7 @@ def _stack(arrays, field):
 
 
 def simulate_batch(setups: list[SimSetup], record_every: int | None = None, lanes: int = LANES,
-                   progress=None) -> BatchResult:
+                   progress: Optional[Callable[[int, int], None]] = None) -> BatchResult:
     """Run every setup with the compiled engine, in parallel over the available cores.
 
     ``lanes`` runs are advanced together by each thread (see :func:`steerlab.sim.lanes.lane_loop`);
@@ -86,7 +91,7 @@ def simulate_batch(setups: list[SimSetup], record_every: int | None = None, lane
     N = s0.n_steps
     # share identical disturbance sequences (same array object) instead of copying them n times
     w_ids: dict[int, int] = {}
-    w_list = []
+    w_list: list[np.ndarray] = []
     w_index = np.empty(n, dtype=np.int64)
     for i, s in enumerate(setups):
         key = id(s.w)
@@ -122,7 +127,7 @@ def simulate_batch(setups: list[SimSetup], record_every: int | None = None, lane
     return BatchResult(acc, X, time, out_x, out_cmd, out_ref, s0.state_names)
 
 
-def vary_controller(setup: SimSetup, pc_rows) -> list[SimSetup]:
+def vary_controller(setup: SimSetup, pc_rows: ArrayLike) -> list[SimSetup]:
     """Copies of ``setup`` with the controller parameters replaced by each row of ``pc_rows``."""
     rows = np.asarray(pc_rows, dtype=float)
     if rows.ndim != 2 or rows.shape[1] != setup.pc.shape[0]:
