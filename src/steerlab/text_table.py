@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import io
 import math
+import re
 import shutil
 import sys
 from typing import Any, Iterable, Optional, Sequence
@@ -48,12 +49,15 @@ def cell(value: Any, digits: int = 4) -> str:
     return str(value)
 
 
+_NUMBER_TEXT = re.compile(r"[-+]?[\d.]+(?:e[-+]?\d+)?(?:\s*%)?|\[[-+\d.e, ]*\]", re.IGNORECASE)
+
+
 def _numeric(value: Any) -> bool:
     """True for a number, None, or a short text that reads as one (``"1.5"``, ``"[1, 2]"``, ``"-"``)."""
     if value is None or isinstance(value, (int, float)):
         return True
-    text = str(value)
-    return len(text) <= 24 and all(c in "0123456789.+-eE[], %/n/a" for c in text)
+    text = str(value).strip()
+    return text in ("n/a", "-") or (len(text) <= 32 and _NUMBER_TEXT.fullmatch(text) is not None)
 
 
 def render_table(header: Sequence[str], rows: Iterable[Sequence[Any]], title: Optional[str] = None,
