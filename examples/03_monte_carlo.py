@@ -2,7 +2,8 @@
 
 Teaches: run a scenario over N seeds in one compiled batch, read the metric distributions
 (mean, 95 % CI, percentiles) and draw the percentile bands. A sea that moves the ship
-(sea state 5) gives bands you can see; the default scenario's eq (39) noise barely does.
+(sea state 5) gives bands you can see; the eq (39) noise of ``calm_default.toml`` (the
+default up to 0.1.0) barely does.
 Equivalent command: ``steerlab montecarlo examples/scenarios/sea-state-5.toml --runs 200 --out out/mc``.
 """
 

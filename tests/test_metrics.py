@@ -1,6 +1,7 @@
 """Performance indices on synthetic arrays with known answers."""
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -196,16 +197,18 @@ def test_step_metrics_without_setpoint_change():
                                                                                 abs=dt + 1e-9)
 
 
-def test_step_metrics_of_the_default_run_agree_with_python_control_step_info():
-    """The default scenario (Esso + ADRC, 20 deg change at t = 100 s): overshoot, 10-90 % rise
-    and 2 % settling as python-control's ``step_info`` computes them on the same response
-    (10.80 %, 85.7 s, 306.3 s), measured from the change."""
+def test_step_metrics_of_the_calm_default_run_agree_with_python_control_step_info():
+    """The default scenario up to 0.1.0 (``examples/scenarios/calm_default.toml``: Esso + ADRC,
+    20 deg change at t = 100 s, eq (39) noise): overshoot, 10-90 % rise and 2 % settling as
+    python-control's ``step_info`` computes them on the same response (10.80 %, 85.7 s,
+    306.3 s), measured from the change."""
     import control
 
     from steerlab.sim.engine import simulate
-    from steerlab.sim.scenario import default_scenario
+    from steerlab.sim.scenario import load_scenario
 
-    res = simulate(default_scenario())
+    res = simulate(load_scenario(Path(__file__).resolve().parent.parent / "examples" / "scenarios"
+                                 / "calm_default.toml"))
     m = compute_metrics(res)
     sel = res.time >= 100.0
     info = control.step_info(res.psi[sel], T=res.time[sel] - 100.0, yfinal=math.radians(20.0))

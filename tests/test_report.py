@@ -19,7 +19,7 @@ PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 
 @pytest.fixture(scope="module")
 def run():
-    """A short default run (course change at t = 100 s, waves): scenario, result, metrics."""
+    """A short default run (course change at t = 100 s, JONSWAP sea state 6): scenario, result, metrics."""
     scenario = default_scenario().replace(duration=300.0)
     result = simulate(scenario)
     return scenario, result, compute_metrics(result)

@@ -30,10 +30,14 @@ def test_default_scenario():
     assert isinstance(sc, Scenario)
     assert default_scenario_path().name == "default.toml"
     assert sc.controller.type == "adrc" and sc.ship.model == "esso"
-    assert sc.n_steps == 30000
-    assert sc.environment.waves is True
+    assert sc.n_steps == 15000
+    # a sea that moves the ship: JONSWAP, sea state 6, 45 deg off the bow (the eq (39) noise of
+    # the default up to 0.1.0 is examples/scenarios/calm_default.toml)
+    wave = sc.environment.wave
+    assert (wave.model, wave.spectrum, wave.sea_state, wave.wave_angle_deg) == ("spectrum", "jonswap", 6, 45.0)
+    assert sc.environment.waves is False
     s = build(sc)
-    assert s.w.shape == (30001, N_CHANNELS) and s.nc == 1
+    assert s.w.shape == (15001, N_CHANNELS) and s.nc == 1
     assert s.pc[A_C0] == pytest.approx(9.18e-4, rel=5e-3)      # c0 by eq (29), steerlab sign
 
 

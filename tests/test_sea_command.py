@@ -57,7 +57,7 @@ def test_sea_command_bad_input(tmp_path, capsys):
 
 
 def test_sea_without_wind_writes_no_wind_rose(tmp_path, capsys):
-    """The default scenario (eq 39 waves, no wind): no empty wind rose, and it says why."""
+    """The default scenario (JONSWAP waves, no wind): no empty wind rose, and it says why."""
     out = tmp_path / "out"
     assert main(["sea", "--out", str(out)]) == 0
     assert not (out / "wind_rose.png").exists() and (out / "sea_spectrum.png").exists()

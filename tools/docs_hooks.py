@@ -157,7 +157,7 @@ makes on every run of it.
 
 | what | reference | where |
 |---|---|---|
-| step metrics (overshoot, rise, settling) of the default run | python-control's `step_info` | `tests/test_metrics.py` |
+| step metrics (overshoot, rise, settling) of the calm default run (`examples/scenarios/calm_default.toml`) | python-control's `step_info` | `tests/test_metrics.py` |
 | the `lq_pd` gains | python-control's `lqr` | [PID-family controllers](controllers-pid.md) |
 | a controller object stepped along an engine run | the engine's own rudder orders, bit for bit | [Components](components.md) |
 | readable, compiled and batch engines | each other, bit for bit | [Architecture](architecture.md) |

@@ -15,6 +15,7 @@ numpy and numba only; ``sl.simulate`` and friends import their module on first u
 from __future__ import annotations
 
 import importlib
+from typing import TYPE_CHECKING, Any
 
 __version__ = "0.1.0"
 
@@ -45,7 +46,22 @@ _LAZY = {
 }
 
 
-def __getattr__(name: str):
+if TYPE_CHECKING:   # what type checkers see of the lazy names above (keep in step with _LAZY)
+    from steerlab.components.controller import controller as controller
+    from steerlab.components.controller_vector import controllers as controllers
+    from steerlab.components.linear import linearize as linearize
+    from steerlab.components.linear import transfer_function as transfer_function
+    from steerlab.components.ship import ship as ship
+    from steerlab.control.registry import register_controller as register_controller
+    from steerlab.ships.registry import register_ship as register_ship
+    from steerlab.sim.batch import simulate_batch as simulate_batch
+    from steerlab.sim.engine import simulate as simulate
+    from steerlab.sim.scenario import default_scenario as default_scenario
+    from steerlab.sim.scenario import load_scenario as load_scenario
+    from steerlab.sim.vary import vary as vary
+
+
+def __getattr__(name: str) -> Any:
     target = _LAZY.get(name)
     if target is None:
         raise AttributeError(f"module 'steerlab' has no attribute {name!r}")
@@ -55,7 +71,7 @@ def __getattr__(name: str):
     return value
 
 
-def __dir__():
+def __dir__() -> list[str]:
     return sorted(set(globals()) | set(_LAZY))
 
 

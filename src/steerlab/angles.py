@@ -1,12 +1,18 @@
 """Angle helpers. Radians inside; degrees only at the edges."""
 
+from __future__ import annotations
+
 import math
+from typing import TYPE_CHECKING, Any, overload
 
 import numba
 
+if TYPE_CHECKING:
+    import numpy as np
+
 
 @numba.njit(cache=True, inline="always")
-def wrap_to_pi(angle):
+def wrap_to_pi(angle: float) -> float:
     """Wrap an angle [rad] to the half-open interval [-pi, pi).
 
     A 359 deg -> 1 deg course change is therefore a +2 deg turn:
@@ -18,7 +24,11 @@ def wrap_to_pi(angle):
     return a % (2.0 * math.pi) - math.pi
 
 
-def wrap_to_2pi(angle):
+@overload
+def wrap_to_2pi(angle: float) -> float: ...
+@overload
+def wrap_to_2pi(angle: np.ndarray) -> np.ndarray: ...
+def wrap_to_2pi(angle: Any) -> Any:
     """Wrap an angle [rad] (a float or a numpy array) to [0, 2*pi) (a compass heading), strictly.
 
     ``a % (2 pi)`` alone rounds a tiny negative angle (``-1e-17``) to exactly ``2 pi``; that
@@ -31,7 +41,7 @@ def wrap_to_2pi(angle):
     return 0.0 if a >= 2.0 * math.pi else a
 
 
-def wrap_to_pi_array(angle):
+def wrap_to_pi_array(angle: object) -> np.ndarray:
     """:func:`wrap_to_pi` for numpy arrays (the kernel itself is scalar): same numbers."""
     import numpy as np
 

@@ -12,7 +12,6 @@ from __future__ import annotations
 import argparse
 import math
 import sys
-import time
 from pathlib import Path
 
 from steerlab.errors import EXIT_BAD_INPUT, EXIT_DIVERGED, DivergedError, InputError
@@ -29,13 +28,11 @@ def one_line(text: str, limit: int = MAX_MESSAGE) -> str:
 
 
 def _progress(quiet: bool):
-    start = time.perf_counter()
+    """The command's progress sink on stderr: status lines and one updating bar
+    (:class:`steerlab.progress.Reporter`; sparse plain lines when stderr is not a terminal)."""
+    from steerlab.progress import reporter
 
-    def say(msg: str) -> None:
-        if not quiet:
-            print(f"[{time.perf_counter() - start:6.1f} s] {msg}", file=sys.stderr, flush=True)
-
-    return say
+    return reporter(quiet)
 
 
 # ---------------------------------------------------------------- commands
@@ -90,18 +87,12 @@ def cmd_experiment(args) -> int:
     run = EXPERIMENTS[args.name].run
     with staged_output(Path(args.out)) as stage:
         rows = run(stage, progress=say, quick=args.quick)
-    width = max(len(str(r["quantity"])) for r in rows)
-    print(f"{'quantity':<{width}}  {'paper':>14}  {'steerlab':>14}  unit")
-    for r in rows:
-        print(f"{r['quantity']:<{width}}  {_fmt(r['paper']):>14}  {_fmt(r['steerlab']):>14}  {r['unit']}")
+    from steerlab.text_table import render_table
+
+    print(render_table(("quantity", "paper", "steerlab", "unit"),
+                       ((r["quantity"], r["paper"], r["steerlab"], r["unit"]) for r in rows), align="lrrl"))
     say(f"wrote {args.out}/comparison.json and the figures")
     return 0
-
-
-def _fmt(v) -> str:
-    if isinstance(v, float):
-        return f"{v:.4g}"
-    return str(v)
 
 
 def cmd_linearize(args) -> int:
@@ -149,8 +140,9 @@ def cmd_bench(args) -> int:
     if args.json:
         print(dump_json(out))
     else:
-        for k, v in out.items():
-            print(f"{k:<34} {_fmt(v)}")
+        from steerlab.text_table import render_pairs
+
+        print(render_pairs(out.items()))
     return 0
 
 
@@ -158,7 +150,8 @@ def cmd_bench(args) -> int:
 
 EXAMPLES = {
     "run": """examples:
-  steerlab run --out out/default            # bundled default: Esso tanker + ADRC, 20 deg change, waves
+  steerlab run --out out/default            # bundled default: Esso tanker + ADRC, 20 deg change, sea state 6
+  steerlab run examples/scenarios/calm_default.toml --out out/calm   # the default up to 0.1.0 (eq 39 noise)
   steerlab run examples/scenarios/esso-pid.toml --out out/esso-pid --parquet
   steerlab run examples/scenarios/los-route.toml --out out/los        # route following: track figure with the route
   steerlab run --seed 7 --engine readable --out out/seed7""",
@@ -244,18 +237,43 @@ def main(argv=None) -> int:
     if not getattr(args, "quiet", False):
         from steerlab.sim import drivers
 
-        drivers.on_compile = lambda msg: print(msg, file=sys.stderr, flush=True)
+        drivers.on_compile = _say_compiling
     try:
         return args.func(args)
     except InputError as err:
+        _close_progress()
         print(f"steerlab: error: {one_line(err)}", file=sys.stderr)
         return EXIT_BAD_INPUT
     except DivergedError as err:
+        _close_progress()
         print(f"steerlab: error: {one_line(err, 2 * MAX_MESSAGE)}", file=sys.stderr)
         return EXIT_DIVERGED
+    except BrokenPipeError:                   # "steerlab ships list | head": the reader left
+        import os
+
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 0
     except KeyboardInterrupt:
+        _close_progress()
         print("steerlab: interrupted", file=sys.stderr)
         return 130
+    finally:
+        _close_progress(forget=True)
+
+
+def _say_compiling(msg: str) -> None:
+    """The compile notice on stderr, below an open progress bar, wrapped to 100 columns."""
+    import textwrap
+
+    _close_progress()
+    print(textwrap.fill(msg, 100, subsequent_indent="  "), file=sys.stderr, flush=True)
+
+
+def _close_progress(forget: bool = False) -> None:
+    """End an open progress-bar line, so that what follows starts on a line of its own."""
+    progress = sys.modules.get("steerlab.progress")
+    if progress is not None:
+        progress.close_all(forget)
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -1,5 +1,7 @@
 """The one exception type for bad user input."""
 
+from typing import Any
+
 
 class InputError(ValueError):
     """Bad input: names the offending field and the allowed range.
@@ -14,7 +16,8 @@ class InputError(ValueError):
         super().__init__(f"{field}: {message}")
 
 
-def require_finite_range(field: str, value, lo=None, hi=None, lo_open=False, hi_open=False):
+def require_finite_range(field: str, value: Any, lo: float | None = None, hi: float | None = None,
+                         lo_open: bool = False, hi_open: bool = False) -> float:
     """Raise :class:`InputError` unless ``value`` is a finite number within the range."""
     import math
 

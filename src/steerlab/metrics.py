@@ -10,7 +10,7 @@ psi), delta the actual rudder angle; rectangle rule on the simulation grid):
 * rudder travel ``sum |d delta|``, rudder reversals (direction changes), mean |delta|
 * step metrics about the last set-point change: overshoot, 10-90 % rise time, settling time
   into +-2 % of the change and into +-1 deg, all measured from the change (the conventions of
-  python-control's ``step_info``, tested on the default run). A run without a set-point change
+  python-control's ``step_info``, tested on ``examples/scenarios/calm_default.toml``). A run without a set-point change
   has no step metrics (``None``, printed "n/a"); to time the rejection of a disturbance use
   :func:`settling_time` with ``t0`` = its onset.
 """

@@ -5,12 +5,18 @@ batches); :mod:`steerlab.metrics` calls the very same kernel over recorded array
 use the rectangle rule on the simulation grid: step ``k`` contributes ``f(t_k) * dt``.
 """
 
+from typing import TYPE_CHECKING
+
 import math
 
 import numba
 import numpy as np
 
 from steerlab.records import Field, Layout
+
+if TYPE_CHECKING:   # Layout.export below writes this module's index constants: ints, for type checkers
+    def __getattr__(name: str) -> int: ...
+
 
 ACCUMULATOR = Layout("online_metrics", "M_", [
     Field("IAE", "iae", "rad s", "integral of |e| dt"),

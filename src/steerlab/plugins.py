@@ -37,14 +37,23 @@ import pkgutil
 import sys
 from collections.abc import Mapping
 from pathlib import Path
-from typing import Callable
+from types import ModuleType
+from typing import Callable, Iterable, Iterator, Protocol, TypeVar
+
+
+class _Named(Protocol):
+    @property
+    def name(self) -> str: ...
+
+
+S = TypeVar("S", bound=_Named)     #: the spec type of a registry (ShipSpec, ControllerSpec)
 
 from steerlab.errors import InputError
 
 PLUGINS_ENV = "STEERLAB_PLUGINS"
 
 
-def load_module(ref: str):
+def load_module(ref: str) -> ModuleType:
     """Import a module by dotted name, or a ``.py`` file by path (registered in ``sys.modules``
     under its stem, so that pickling the specs it defines works in the same process)."""
     ref = str(ref).strip()
@@ -57,6 +66,8 @@ def load_module(ref: str):
         if existing is not None and Path(getattr(existing, "__file__", "") or "").resolve() == path:
             return existing
         spec = importlib.util.spec_from_file_location(name, path)
+        if spec is None or spec.loader is None:
+            raise InputError(PLUGINS_ENV, f"cannot load {str(path)!r} as a Python module")
         module = importlib.util.module_from_spec(spec)
         sys.modules[name] = module
         try:
@@ -71,7 +82,7 @@ def load_module(ref: str):
         raise InputError(PLUGINS_ENV, f"cannot import plug-in module {ref!r}: {err}") from None
 
 
-def package_modules(package: str, skip=(), recursive: bool = False):
+def package_modules(package: str, skip: Iterable[str] = (), recursive: bool = False) -> Iterator[ModuleType]:
     """Import and yield the modules of ``package`` in name order (sub-packages too when
     ``recursive``), except names starting with ``_`` and the base names in ``skip``. The one
     scanner behind the registries, the experiments and the CLI commands."""
@@ -91,7 +102,7 @@ def env_plugins() -> list[str]:
     return [p for p in os.environ.get(PLUGINS_ENV, "").split(os.pathsep) if p.strip()]
 
 
-class Registry(Mapping):
+class Registry(Mapping[str, S]):
     """Lazy read-only mapping ``name -> spec`` of one kind of component (module docstring).
 
     Parameters
@@ -117,8 +128,9 @@ class Registry(Mapping):
         controllers' ``"<name>+wf"`` wave-filter variants).
     """
 
-    def __init__(self, kind: str, package: str, collect: Callable, spec_type: type, field: str, group: str,
-                 skip=(), recursive: bool = False, derive: Callable | None = None):
+    def __init__(self, kind: str, package: str, collect: Callable[[ModuleType], Iterable[S]], spec_type: type[S],
+                 field: str, group: str, skip: Iterable[str] = (), recursive: bool = False,
+                 derive: Callable[[S], Iterable[S]] | None = None) -> None:
         self.kind = kind
         self.package = package
         self.collect = collect
@@ -145,7 +157,7 @@ class Registry(Mapping):
             except Exception as err:  # noqa: BLE001 - a broken plug-in names itself
                 raise InputError(self.group, f"entry point {ep.name!r} ({ep.value}) failed to load: {err}") from None
 
-    def specs_of(self, obj) -> list:
+    def specs_of(self, obj: object) -> list[S]:
         """The specs an object declares: a spec, a list of specs, a function returning them, or a module."""
         if isinstance(obj, self.spec_type):
             return [obj]
@@ -189,7 +201,7 @@ class Registry(Mapping):
         return self._found
 
     # ------------------------------------------------------------ registration
-    def register(self, spec, replace: bool = False):
+    def register(self, spec: S, replace: bool = False) -> S:
         """Add ``spec`` under ``spec.name`` (``replace=True`` to override a known name); returns it."""
         found = self._discover()
         self._add(found, spec, "register", replace)
@@ -213,7 +225,7 @@ class Registry(Mapping):
         self._origin.pop(name, None)
         if spec is not None and self.derive is not None:
             for d in self.derive(spec):
-                if found.get(d.name) is d:
+                if d.name in found and found[d.name] is d:
                     found.pop(d.name)
                     self._origin.pop(d.name, None)
         for fn in self._listeners:
@@ -243,7 +255,7 @@ class Registry(Mapping):
     def __len__(self):
         return len(self._discover())
 
-    def get_spec(self, name: str):
+    def get_spec(self, name: str) -> S:
         """The spec called ``name``; an unknown name is an :class:`InputError` on :attr:`field`."""
         found = self._discover()
         try:
@@ -259,9 +271,8 @@ def register_module(ref: str, replace: bool = False) -> list:
     from steerlab.ships.registry import SHIPS
 
     module = load_module(ref)
-    out = []
-    for reg in (SHIPS, CONTROLLERS):
-        out += [reg.register(s, replace) for s in reg.collect(module)]
+    out: list = [SHIPS.register(s, replace) for s in SHIPS.collect(module)]
+    out += [CONTROLLERS.register(s, replace) for s in CONTROLLERS.collect(module)]
     if not out:
         raise InputError(PLUGINS_ENV, f"module {ref!r} declares no ship (SHIP_SPECS) and no controller "
                                       "(CONTROLLER, CONTROLLERS)")

@@ -23,9 +23,10 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Iterable, Mapping, Optional
+from typing import Any, Iterable, Mapping, Optional
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from steerlab.errors import InputError, require_finite_range
 
@@ -121,7 +122,7 @@ class Layout:
                              f"unknown field; known fields: {list(self.names)}") from None
 
     # ---------------------------------------------------------------- records
-    def pack(self, values: Optional[Mapping[str, float]] = None, **kw) -> np.ndarray:
+    def pack(self, values: Optional[Mapping[str, float]] = None, **kw: float) -> np.ndarray:
         """The record of ``values`` (every field, by name), each checked against its bounds."""
         vals = {**(values or {}), **kw}
         unknown = sorted(set(vals) - set(self._index))
@@ -136,14 +137,14 @@ class Layout:
                                           f.lo_open, f.hi_open)
         return out
 
-    def unpack(self, record) -> dict:
+    def unpack(self, record: ArrayLike) -> dict[str, float]:
         """``{name: value}`` of a record (its length checked)."""
         record = np.asarray(record, dtype=np.float64)
         if record.shape != (self.size,):
             raise InputError(self.component, f"record of {record.shape} floats; this layout has {self.size}")
         return {f.name: float(record[i]) for i, f in enumerate(self.fields)}
 
-    def check_size(self, record, what: str = "") -> None:
+    def check_size(self, record: ArrayLike, what: str = "") -> None:
         """One clear line if ``record`` is not this layout's length."""
         n = np.asarray(record).shape
         if n != (self.size,):
@@ -169,14 +170,14 @@ class Layout:
         return Layout(component or self.component, self.prefix, fields)
 
     # ---------------------------------------------------------------- generated types
-    def record_type(self, name: str, methods: Optional[dict] = None):
+    def record_type(self, name: str, methods: Optional[dict] = None) -> Any:
         """A ``NamedTuple`` class with one attribute per field (defaults from the layout) and
         ``pack()`` -> the checked record; ``methods`` adds more (e.g. ``init_state``)."""
         from typing import NamedTuple
 
         missing = [f.name for f in self.fields if f.default is None]
         order = sorted(self.fields, key=lambda f: f.default is not None)   # required ones first
-        base = NamedTuple(name + "Fields", [(f.name, float) for f in order])
+        base = NamedTuple(name + "Fields", [(f.name, float) for f in order])  # type: ignore[misc]  # generated
         base.__new__.__defaults__ = tuple(f.default for f in order if f.default is not None) or None
         layout = self
 
@@ -185,7 +186,7 @@ class Layout:
 
         ns = {"pack": pack, "__doc__": f"{self.component} record: " + ", ".join(
             f"{f.name} [{f.unit}]" for f in self.fields), "LAYOUT": self, **(methods or {})}
-        cls = type(name, (base,), ns)
+        cls: Any = type(name, (base,), ns)
         cls.__required__ = tuple(missing)
         return cls
 
@@ -201,7 +202,7 @@ class Layout:
         out = {}
         for n in names:
             f = self.fields[self.index(n)]
-            kw = {"description": f"[{f.unit}] {f.doc}"}
+            kw: dict[str, Any] = {"description": f"[{f.unit}] {f.doc}"}
             if f.lo is not None:
                 kw["gt" if f.lo_open else "ge"] = f.lo
             hi = (upper or {}).get(n, f.hi)

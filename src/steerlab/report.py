@@ -169,17 +169,27 @@ def draw_rudder(ax, result, title: str = ""):
     """
     ax.grid(True, alpha=0.4)
     dist = np.asarray(result.disturbance)
+    handles = []
     if dist.ndim == 2 and dist.shape[1] > W_RUDDER and np.any(dist[:, W_RUDDER] != 0.0):
+        d_deg = dist[:, W_RUDDER] * R2D
+        rudder_span = max(float(np.max(np.abs(result.delta_cmd))), float(np.max(np.abs(result.delta))), 1e-9) * R2D
+        # a first-order wave moment as an equivalent rudder can be many times the rudder limit:
+        # then it gets its own (right) axis, so the rudder's work stays readable on the left
+        dax = ax.twinx() if np.max(np.abs(d_deg)) > 2.0 * rudder_span else ax
         # drawn first and light: wave noise would otherwise hide the rudder curves
-        ax.plot(result.time, dist[:, W_RUDDER] * R2D, color="C2", lw=0.7, alpha=0.45, zorder=1,
-                label="disturbance (equiv. rudder)")
-    ax.plot(result.time, result.delta_cmd * R2D, color="C1", lw=1.0, alpha=0.9, zorder=2,
-            label="delta_cmd (order)")
-    ax.plot(result.time, result.delta * R2D, color="C0", lw=1.3, zorder=3, label="delta (actual)")
+        handles += dax.plot(result.time, d_deg, color="C2", lw=0.7, alpha=0.45, zorder=1,
+                            label="disturbance (equiv. rudder)" + (", right axis" if dax is not ax else ""))
+        if dax is not ax:
+            dax.set_ylabel("disturbance, equivalent rudder [deg]", color="C2")
+            ax.set_zorder(dax.get_zorder() + 1)   # rudder curves above the disturbance
+            ax.patch.set_visible(False)
+    handles += ax.plot(result.time, result.delta_cmd * R2D, color="C1", lw=1.0, alpha=0.9, zorder=2,
+                       label="delta_cmd (order)")
+    handles += ax.plot(result.time, result.delta * R2D, color="C0", lw=1.3, zorder=3, label="delta (actual)")
     ax.axhline(0.0, color="0.5", lw=0.6)
     ax.set_xlabel("time [s]")
     ax.set_ylabel("rudder angle [deg]")
-    ax.legend(loc="best")
+    ax.legend(handles=handles, loc="best")
     _title(ax, title, "rudder")
     return ax
 
@@ -188,6 +198,8 @@ def plot_rudder(path: Path, result, title: str = "") -> Path:
     """Write :func:`draw_rudder` as a PNG at ``path``; returns ``path``."""
     fig, ax = _new_figure()
     draw_rudder(ax, result, title)
+    if len(fig.axes) > 1:                      # the disturbance's own axis: room for its labels
+        fig.subplots_adjust(right=1.0 - 0.8 / TIME_SERIES_SIZE[0])
     return _save(fig, path)
 
 

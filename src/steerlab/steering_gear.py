@@ -17,7 +17,7 @@ rate limit holds exactly per step.
 
 from __future__ import annotations
 
-from typing import NamedTuple
+from typing import TYPE_CHECKING, NamedTuple
 
 import numba
 import numpy as np
@@ -25,6 +25,10 @@ import numpy as np
 from steerlab.errors import require_finite_range
 from steerlab.records import Field, Layout
 from steerlab.units import rad
+
+if TYPE_CHECKING:   # Layout.export below writes this module's index constants: ints, for type checkers
+    def __getattr__(name: str) -> int: ...
+
 
 GEAR = Layout("gear", "G_", [
     Field("DMAX", "delta_max", "rad", "rudder limit (eq 15: 35 deg)", 0.0, rad(90.0), lo_open=True),

@@ -40,11 +40,16 @@ from __future__ import annotations
 
 import math
 import contextlib
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from steerlab.errors import InputError
 from steerlab.guidance.reference_vector import N_REF, REF_PSI
+
+if TYPE_CHECKING:
+    from steerlab.control.registry import ControllerSpec
+    from steerlab.ships.registry import ShipSpec
 
 _ALLOCATORS = ("NRT_MemInfo_alloc", "NRT_MemInfo_new", "NRT_Allocate")
 PARITY_TOL = 1e-12
@@ -161,7 +166,7 @@ def _vectorisation(kind, name, setup, strict: bool) -> tuple[int | None, list]:
 def _scenario(ship: str, controller: dict, duration: float, speed_kn=None, ship_options=None):
     from steerlab.sim.scenario import scenario_from_dict
 
-    d = {"name": "check", "seed": 1, "dt": 0.1, "duration": float(duration),
+    d: dict[str, Any] = {"name": "check", "seed": 1, "dt": 0.1, "duration": float(duration),
          "ship": {"model": ship, "options": dict(ship_options or {})},
          "controller": dict(controller), "guidance": {"psi0_deg": 0.0, "changes": [{"t": 1.0, "psi_deg": 10.0}]},
          "environment": {}}
@@ -170,7 +175,7 @@ def _scenario(ship: str, controller: dict, duration: float, speed_kn=None, ship_
     return scenario_from_dict(d)
 
 
-def check_controller(spec, ship: str = "esso", config: dict | None = None, duration: float = 30.0,
+def check_controller(spec: ControllerSpec, ship: str = "esso", config: dict | None = None, duration: float = 30.0,
                      vectorisation: bool = True, strict: bool = False) -> dict:
     """Check a :class:`~steerlab.control.registry.ControllerSpec` (module docstring).
 
@@ -234,7 +239,7 @@ def _check_controller(spec, kind, name, ship, cfg, duration, vectorisation=True,
             "vectorised_stages": stages, "warnings": warned}
 
 
-def check_ship(spec, controller: dict | None = None, speed_kn: float | None = None, options: dict | None = None,
+def check_ship(spec: ShipSpec, controller: dict | None = None, speed_kn: float | None = None, options: dict | None = None,
                duration: float = 30.0, vectorisation: bool = True, strict: bool = False) -> dict:
     """Check a :class:`~steerlab.ships.registry.ShipSpec` (module docstring), run with
     ``controller`` (a ``[controller]`` table, default PID) at ``speed_kn`` with ``options``.

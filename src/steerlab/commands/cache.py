@@ -53,12 +53,15 @@ def run(args) -> int:
 
             print(dump_json(info))
         else:
-            print(f"cache root       {info['root']}")
-            print(f"this steerlab    {info['current']}")
-            print(f"drivers          {info['drivers']} ({info['compiled_files']} compiled entry points, "
-                  f"{_mb(info['bytes'])})")
-            print(f"other versions   {len(info['stale_versions'])} ({_mb(info['stale_bytes'])}; "
-                  "'steerlab cache clear --stale' removes them)")
+            from steerlab.text_table import render_pairs
+
+            print(render_pairs([
+                ("cache root", info["root"]),
+                ("this steerlab", info["current"]),
+                ("drivers", f"{info['drivers']} ({info['compiled_files']} compiled entry points, "
+                            f"{_mb(info['bytes'])})"),
+                ("other versions", f"{len(info['stale_versions'])} ({_mb(info['stale_bytes'])}; "
+                                   "'steerlab cache clear --stale' removes them)")]))
         return 0
     if args.action == "clear":
         freed = drivers.cache_clear(stale_only=args.stale)

@@ -62,10 +62,11 @@ def cmd_montecarlo(args) -> int:
               "statistics and the bands, flagged in runs.csv (column diverged)"])
     with staged_output(Path(args.out)) as stage:
         write_montecarlo_outputs(stage, res, scenario.name)
-    print(f"{len(res.seeds)} runs, seeds {res.seeds[0]}..{res.seeds[-1]}")
-    print(f"{'metric':<24} {'mean':>12} {'95% CI of mean':>27} {'p5':>11} {'p95':>11}  unit")
-    for k, s in res.stats.items():
-        ci = f"[{s['ci95_low']:.4g}, {s['ci95_high']:.4g}]"
-        print(f"{k:<24} {s['mean']:>12.5g} {ci:>27} {s['p5']:>11.4g} {s['p95']:>11.4g}  {s['unit']}")
+    from steerlab.text_table import render_table
+
+    print(render_table(("metric", "mean", "95% CI of mean", "p5", "p95", "unit"),
+                       ((k, f"{s['mean']:.5g}", f"[{s['ci95_low']:.4g}, {s['ci95_high']:.4g}]", s["p5"], s["p95"],
+                         s["unit"]) for k, s in res.stats.items()),
+                       title=f"{len(res.seeds)} runs, seeds {res.seeds[0]}..{res.seeds[-1]}", align="lrrrrl"))
     say(f"wrote {args.out}/montecarlo.json and percentile_bands.png")
     return 0

@@ -65,10 +65,12 @@ def cmd_robustness(args) -> int:
               "state): metric inf, flagged in table.csv (column diverged)"])
     with staged_output(Path(args.out)) as stage:
         write_robustness_outputs(stage, res, scenario.name)
+    from steerlab.text_table import render_table
+
     names = [v.name for v in res.variations]
-    print("  ".join(f"{n:>10}" for n in names) + f"  {res.metric:>14}")
-    for pt, val in zip(res.points, res.metric_values):
-        print("  ".join(f"{x:>10.4g}" for x in pt) + f"  {val:>14.6g}")
+    print(render_table((*names, res.metric), ((*(f"{x:.4g}" for x in pt), f"{val:.6g}")
+                                              for pt, val in zip(res.points, res.metric_values)),
+                       align="r" * (len(names) + 1)))
     print(f"nominal: {res.nominal['metric']:.6g}")
     say(f"wrote {args.out}/robustness.json and the map")
     return 0

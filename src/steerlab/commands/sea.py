@@ -4,7 +4,7 @@ from __future__ import annotations
 
 EXAMPLES = """examples:
   steerlab sea examples/scenarios/sea-state-5.toml --out out/sea   # JONSWAP, sea state 5
-  steerlab sea --out out/sea-default                               # the bundled default scenario (eq 39 waves)
+  steerlab sea --out out/sea-default                               # the bundled default scenario (JONSWAP, sea state 6)
 
 Writes sea_spectrum.png, sea_timeseries.png, wind_rose.png (when there is wind), sea.csv and
 sea.json (variance and peak frequency: target vs generated).

@@ -69,35 +69,43 @@ def show(ship_id: str) -> dict:
 
 
 def _print_list(rows):
-    w_id = max(len(r["id"]) for r in rows)
-    w_m = max(len(r["model"]) for r in rows)
-    w_r = max(len(r["range"]) for r in rows)
-    print(f"{'id':<{w_id}}  {'model':<{w_m}}  {'range':<{w_r}}  source")
-    for r in rows:
-        print(f"{r['id']:<{w_id}}  {r['model']:<{w_m}}  {r['range']:<{w_r}}  {r['source']}")
+    from steerlab.text_table import render_table
+
+    print(render_table(("id", "model", "range", "source"),
+                       ((r["id"], r["model"], r["range"], r["source"]) for r in rows), align="llll"))
 
 
 def _print_show(d):
-    print(f"{d['id']}: {d['description']}")
-    print(f"  model:  {d['model']}")
-    print(f"  range:  {d['range']}")
-    print(f"  source: {d['source']}")
-    print("  states: " + ", ".join(f"{s['name']} [{s['unit']}]" for s in d["states"]))
+    import textwrap
+
+    from steerlab.text_table import render_table, table_width
+
+    width = table_width()
+
+    def say(label: str, text: str) -> None:
+        """``label: text`` wrapped to the table width, continuation lines indented."""
+        print(textwrap.fill(str(text), width, initial_indent=f"  {label}: ", subsequent_indent="      ",
+                            break_long_words=False, break_on_hyphens=False))
+
+    print(textwrap.fill(f"{d['id']}: {d['description']}", width, subsequent_indent="  "))
+    say("model", d["model"])
+    say("range", d["range"])
+    say("source", d["source"])
+    say("states", ", ".join(f"{s['name']} [{s['unit']}]" for s in d["states"]))
     cat = d.get("catalogue")
     if cat:
-        print(f"  vessel: {cat['vessel']}, L = {cat['length_m']:g} m ({cat['file']})")
-        cols = [f"{c['name']} [{c['unit']}]" for c in cat["columns"]]
-        widths = [max(len(h), 9) for h in cols]
-        print("  " + "  ".join(f"{h:>{w}}" for h, w in zip(cols, widths)))
-        for row in cat["rows"]:
-            print("  " + "  ".join(f"{v:>{w}.6g}" for v, w in zip(row, widths)))
+        say("vessel", f"{cat['vessel']}, L = {cat['length_m']:g} m ({cat['file']})")
+        table = render_table([f"{c['name']} [{c['unit']}]" for c in cat["columns"]],
+                             ([f"{v:.6g}" for v in row] for row in cat["rows"]),
+                             align="r" * len(cat["columns"]), width=width - 2)
+        print("\n".join("  " + line for line in table.splitlines()))
         if cat["constants"]:
-            print("  constants: " + ", ".join(f"{k} = {v:g}" for k, v in cat["constants"].items()))
-        print(f"  notes: {cat['notes']}")
+            say("constants", ", ".join(f"{k} = {v:g}" for k, v in cat["constants"].items()))
+        say("notes", cat["notes"])
         if cat.get("vessel_notes"):
-            print(f"  vessel notes: {cat['vessel_notes']}")
+            say("vessel notes", cat["vessel_notes"])
     for o in d.get("options", []):
-        print(f"  option {o['name']} = {o['default']!r}: {o['description']}")
+        say(f"option {o['name']} = {o['default']!r}", o["description"])
 
 
 def run(args) -> int:

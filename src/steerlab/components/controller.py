@@ -27,13 +27,21 @@ controller along a recorded engine run reproduces the engine's rudder orders bit
 from __future__ import annotations
 
 import math
+from typing import TYPE_CHECKING, Any, Mapping, Optional, Union
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from steerlab.control.registry import get_controller
 from steerlab.errors import InputError
 from steerlab.guidance.reference_vector import REF_PSI, REF_R, initial_reference
 from steerlab.ships.state import IPSI, IR, IU
+
+if TYPE_CHECKING:
+    from steerlab.components.controller_vector import ControllerVector
+    from steerlab.control.design_context import DesignContext
+    from steerlab.control.registry import ControllerSpec
+    from steerlab.steering_gear import SteeringGear
 
 #: keyword arguments of :func:`controller` that describe the loop, not the law
 LOOP_ARGS = ("ship", "speed_kn", "nomoto", "b2", "gear", "dt", "ship_options", "length_m")
@@ -82,7 +90,7 @@ class Controller:
         Layout of the plant state the kernel reads (the ship's states, then ``delta``).
     """
 
-    def __init__(self, spec, design, params, ctx):
+    def __init__(self, spec: ControllerSpec, design: Any, params: ArrayLike, ctx: DesignContext) -> None:
         self.type = spec.name
         self.spec = spec
         self.design = design
@@ -111,7 +119,8 @@ class Controller:
         x[IR] = _finite("yaw_rate", yaw_rate)
         x[self._nx - 1] = self._last if rudder is None else _finite("rudder", rudder)
 
-    def reset(self, heading=0.0, yaw_rate=0.0, heading_ref=None, yaw_rate_ref=0.0, rudder=0.0, speed=None):
+    def reset(self, heading: float = 0.0, yaw_rate: float = 0.0, heading_ref: Optional[float] = None,
+              yaw_rate_ref: float = 0.0, rudder: float = 0.0, speed: Optional[float] = None) -> Controller:
         """Start again from this situation (the law's ``init_state``); returns ``self``.
 
         ``heading_ref`` defaults to ``heading`` (hold the present course). Units as in :meth:`step`.
@@ -128,7 +137,8 @@ class Controller:
         self._last = float(rudder)
         return self
 
-    def step(self, t, heading, yaw_rate, heading_ref, yaw_rate_ref=0.0, rudder=None, speed=None) -> float:
+    def step(self, t: float, heading: float, yaw_rate: float, heading_ref: float, yaw_rate_ref: float = 0.0,
+             rudder: Optional[float] = None, speed: Optional[float] = None) -> float:
         """One controller sample: the rudder order [rad] (see the module docstring for units)."""
         x = self._x
         self._fill(x, heading, yaw_rate, rudder, speed)
@@ -139,7 +149,7 @@ class Controller:
                                            f"with the whole plant state {self.plant_state_names}")
         return u
 
-    def step_state(self, t, x, heading_ref, yaw_rate_ref=0.0) -> float:
+    def step_state(self, t: float, x: ArrayLike, heading_ref: float, yaw_rate_ref: float = 0.0) -> float:
         """One sample from the whole plant state ``x`` (layout ``plant_state_names``, SI)."""
         x = np.asarray(x, dtype=np.float64)
         if x.shape != (self._nx,):
@@ -156,21 +166,24 @@ class Controller:
         self._last = u
         return u
 
-    def transfer_function(self):
+    def transfer_function(self) -> Any:
         """``C(s)`` as a ``control.TransferFunction`` (PID-family laws; :func:`steerlab.components.linear.transfer_function`)."""
         from steerlab.components.linear import transfer_function
 
         return transfer_function(self)
 
-    def vector(self, n: int):
+    def vector(self, n: int) -> ControllerVector:
         """``n`` copies of this controller (same design, same state) stepped in one compiled call."""
         from steerlab.components.controller_vector import ControllerVector
 
         return ControllerVector([self] * int(n))
 
 
-def controller(type: str, *, ship=None, speed_kn=None, nomoto=None, b2=None, gear=None, dt=0.1,
-               ship_options=None, length_m=None, **cfg) -> Controller:
+def controller(type: str, *, ship: Optional[str] = None, speed_kn: Optional[float] = None,
+               nomoto: Optional[tuple[float, float]] = None, b2: Optional[float] = None,
+               gear: Union[SteeringGear, Mapping[str, float], None] = None, dt: float = 0.1,
+               ship_options: Optional[Mapping[str, Any]] = None, length_m: Optional[float] = None,
+               **cfg: Any) -> Controller:
     """Design a registered controller (``steerlab controllers``) for a loop outside steerlab.
 
     Parameters

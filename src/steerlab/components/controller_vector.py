@@ -10,17 +10,22 @@ from its own design (different gains), as long as the type and sample time are t
 from __future__ import annotations
 
 from functools import lru_cache
+from typing import TYPE_CHECKING, Any, Callable, Iterable, Optional, Union
 
 import numba
 import numpy as np
+from numpy.typing import ArrayLike
 
 from steerlab.errors import InputError
 from steerlab.guidance.reference_vector import initial_reference
 from steerlab.ships.state import IPSI, IR, IU
 
+if TYPE_CHECKING:
+    from steerlab.components.controller import Controller
+
 
 @lru_cache(maxsize=None)
-def vector_kernel(update):
+def vector_kernel(update: Callable[..., float]) -> Callable[..., None]:
     """``run(Z, P, t, X, R, h, out)``: ``out[i] = update(Z[i], P[i], t, X[i], R[i], h)`` for each i."""
 
     @numba.njit
@@ -51,7 +56,7 @@ class ControllerVector:
         ``h`` [s].
     """
 
-    def __init__(self, items):
+    def __init__(self, items: Iterable[Controller]) -> None:
         items = list(items)
         if not items:
             raise InputError("controllers", "give at least one controller")
@@ -79,10 +84,12 @@ class ControllerVector:
         self._last = np.zeros(n)
         self._run = vector_kernel(first.spec.update)
 
-    def __len__(self):
+    def __len__(self) -> int:
         return self.n
 
-    def reset(self, heading=0.0, yaw_rate=0.0, heading_ref=None, yaw_rate_ref=0.0, rudder=0.0, speed=None):
+    def reset(self, heading: ArrayLike = 0.0, yaw_rate: ArrayLike = 0.0, heading_ref: Optional[ArrayLike] = None,
+              yaw_rate_ref: ArrayLike = 0.0, rudder: ArrayLike = 0.0, speed: Optional[ArrayLike] = None
+              ) -> ControllerVector:
         """Reset every controller (arguments scalars or (N,) arrays, as in ``Controller.reset``)."""
         n = self.n
         h = _column("heading", heading, n)
@@ -97,7 +104,9 @@ class ControllerVector:
         self._last[:] = args["rudder"]
         return self
 
-    def step(self, t, heading, yaw_rate, heading_ref, yaw_rate_ref=0.0, rudder=None, speed=None) -> np.ndarray:
+    def step(self, t: float, heading: ArrayLike, yaw_rate: ArrayLike, heading_ref: ArrayLike,
+             yaw_rate_ref: ArrayLike = 0.0, rudder: Optional[ArrayLike] = None, speed: Optional[ArrayLike] = None
+             ) -> np.ndarray:
         """One sample of every controller: the (N,) rudder orders [rad] (a new array).
 
         Arguments are (N,) arrays or scalars, units as in ``Controller.step``.
@@ -121,7 +130,7 @@ class ControllerVector:
         return self._out.copy()
 
 
-def controllers(type_or_items, n: int | None = None, **kw) -> ControllerVector:
+def controllers(type_or_items: Union[str, Iterable[Controller]], n: int | None = None, **kw: Any) -> ControllerVector:
     """N controllers in one compiled call: ``controllers("pid", n=64, nomoto=(K, T), Kp=...)``
     (N copies of one design) or ``controllers([c1, c2, ...])`` (designed ``Controller`` objects)."""
     if isinstance(type_or_items, str):

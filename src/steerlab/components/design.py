@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any, Mapping, NoReturn, Optional, Union
 
 from steerlab.control.design_context import DesignContext
 from steerlab.errors import InputError, require_finite_range
@@ -49,22 +50,22 @@ class NoModel:
     options_model = None
 
     @staticmethod
-    def _need(what: str):
+    def _need(what: str) -> NoReturn:
         raise InputError("nomoto", f"this design needs the ship's {what}: give nomoto=(K [1/s], T [s]) "
                                    "(plus b2=... [1/s^2] if it differs from K/T), or ship=ID, speed_kn=...")
 
     @property
-    def dims(self):
+    def dims(self) -> NoReturn:
         self._need("length (dims)")
 
-    def nomoto(self, speed, options=None):
+    def nomoto(self, speed: float, options: object = None) -> NoReturn:
         self._need("Nomoto K, T")
 
-    def b2(self, speed, method, options=None):
+    def b2(self, speed: float, method: str, options: object = None) -> NoReturn:
         self._need("rudder efficiency b2")
 
 
-def make_gear(gear) -> SteeringGear:
+def make_gear(gear: Union[SteeringGear, Mapping[str, float], None]) -> SteeringGear:
     """A :class:`SteeringGear` from ``None`` (35 deg, 2.33 deg/s, T_sg 1 s), a ``SteeringGear``,
     or a dict of the scenario's ``[gear]`` keys (``delta_max_deg``, ``rate_max_deg_s``,
     ``T_sg``, ``dead_zone_deg``)."""
@@ -85,8 +86,11 @@ def make_gear(gear) -> SteeringGear:
     raise InputError("gear", f"must be None, a SteeringGear or a dict of [gear] keys, got {type(gear).__name__}")
 
 
-def design_context(ship=None, speed_kn=None, nomoto=None, b2=None, gear=None, sample_time=0.1,
-                   ship_options=None, length_m=None) -> DesignContext:
+def design_context(ship: Optional[str] = None, speed_kn: Optional[float] = None,
+                   nomoto: Optional[tuple[float, float]] = None, b2: Optional[float] = None,
+                   gear: Union[SteeringGear, Mapping[str, float], None] = None, sample_time: float = 0.1,
+                   ship_options: Optional[Mapping[str, Any]] = None, length_m: Optional[float] = None
+                   ) -> DesignContext:
     """The :class:`DesignContext` of a controller built outside a scenario (see the module doc).
 
     Parameters

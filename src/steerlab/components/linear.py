@@ -25,18 +25,24 @@ reference response of the law as run (no derivative kick) is the two-degree-of-f
 from __future__ import annotations
 
 import math
+from typing import TYPE_CHECKING, Any, Callable, Mapping, Optional, Union
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from steerlab.errors import InputError, require_finite_range
 from steerlab.ships.registry import get_ship
 from steerlab.units import knots_to_ms
 from steerlab.ships.state import IU
 
+if TYPE_CHECKING:
+    from steerlab.components.controller import Controller
+    from steerlab.ships.registry import ShipSpec
+
 _REL_STEP = 1e-7
 
 
-def default_speed_kn(spec) -> float:
+def default_speed_kn(spec: ShipSpec) -> float:
     """A ship's design speed [kn]: its catalogue entry's nominal speed, else the middle of its
     validity range, else 16 kn (the Esso tanker's speed in Zwierzewicz et al. 2021, the CLI default)."""
     cat = getattr(spec, "catalogue", None)
@@ -49,7 +55,8 @@ def default_speed_kn(spec) -> float:
     return 16.0
 
 
-def jacobian(rhs, x0, delta0, ps, w=None):
+def jacobian(rhs: Callable[..., None], x0: np.ndarray, delta0: float, ps: np.ndarray,
+             w: Optional[np.ndarray] = None) -> tuple[np.ndarray, np.ndarray]:
     """``(A, B)``: central-difference Jacobian of ``rhs(t, x, delta, w, ps, dx)`` at ``(x0, delta0)``.
 
     ``A[i, j] = d x_i' / d x_j`` over the ship's states, ``B[i] = d x_i' / d delta`` (SI).
@@ -98,7 +105,7 @@ def _steering_states(A, names) -> list[int]:
     return sorted(kept)
 
 
-def linear_model(ship, speed_kn=None, ship_options=None) -> dict:
+def linear_model(ship: Union[str, ShipSpec], speed_kn: Optional[float] = None, ship_options: Optional[Mapping[str, Any]] = None) -> dict:
     """The matrices and names :func:`linearize` puts into a StateSpace (plain numpy, no python-control)."""
     from steerlab.ships.ship_traits import straight_rudder
 
@@ -139,7 +146,7 @@ def linear_model(ship, speed_kn=None, ship_options=None) -> dict:
             "method": method}
 
 
-def linearize(ship, speed_kn=None, ship_options=None):
+def linearize(ship: Union[str, ShipSpec], speed_kn: Optional[float] = None, ship_options: Optional[Mapping[str, Any]] = None) -> Any:
     """A ship's linear steering model as a ``control.StateSpace`` (see the module docstring).
 
     Parameters
@@ -163,7 +170,7 @@ def linearize(ship, speed_kn=None, ship_options=None):
                       outputs=list(m["outputs"]), name=f"{m['ship']}@{m['speed_kn']:g}kn")
 
 
-def pid_gains(ctrl) -> tuple[float, float, float]:
+def pid_gains(ctrl: Controller) -> tuple[float, float, float]:
     """``(Kp, Ki, Kd)`` of a controller run by the PID kernel, else :class:`InputError`."""
     from steerlab.control.pid import C_KD, C_KI, C_KP, pid_update
 
@@ -174,7 +181,7 @@ def pid_gains(ctrl) -> tuple[float, float, float]:
     return float(p[C_KP]), float(p[C_KI]), float(p[C_KD])
 
 
-def transfer_function(ctrl):
+def transfer_function(ctrl: Controller) -> Any:
     """``C(s) = Kp + Ki/s + Kd s`` of a PID-family :class:`Controller` as ``control.TransferFunction``
     (input ``e`` heading error [rad], output ``delta_c`` rudder order [rad]; unsaturated)."""
     import control
@@ -185,7 +192,7 @@ def transfer_function(ctrl):
     return control.tf([kd, kp, ki], [1.0, 0.0], inputs="e", outputs="delta_c", name=ctrl.type)
 
 
-def summary(ship, speed_kn=None, ship_options=None) -> dict:
+def summary(ship: Union[str, ShipSpec], speed_kn: Optional[float] = None, ship_options: Optional[Mapping[str, Any]] = None) -> dict:
     """What ``steerlab linearize`` prints for a ship without a sway-yaw linearisation (SI, JSON-able)."""
     m = linear_model(ship, speed_kn, ship_options)
     A, B = m["A"], m["B"]

@@ -21,8 +21,10 @@ values or a dict ``{channel name: value}`` (e.g. ``{"d_rudder": 0.01}``), held o
 from __future__ import annotations
 
 import math
+from typing import TYPE_CHECKING, Any, Mapping, Optional, Union
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from steerlab.environment.channels import CHANNEL_NAMES, N_CHANNELS
 from steerlab.errors import InputError, require_finite_range
@@ -30,8 +32,15 @@ from steerlab.ships.registry import get_ship
 from steerlab.units import knots_to_ms
 from steerlab.ships.state import IPSI, IR, IU, IX, IY
 
+if TYPE_CHECKING:
+    from steerlab.ships.registry import ShipSpec
+    from steerlab.steering_gear import SteeringGear
 
-def disturbance_row(disturbance) -> np.ndarray:
+Disturbance = Union[ArrayLike, Mapping[str, float], None]
+"""A disturbance row: None (calm), ``N_CHANNELS`` values or ``{channel name: value}`` (SI)."""
+
+
+def disturbance_row(disturbance: Disturbance) -> np.ndarray:
     """One disturbance row (``N_CHANNELS`` values, SI) from None, an array or a ``{name: value}`` dict."""
     w = np.zeros(N_CHANNELS)
     if disturbance is None:
@@ -68,7 +77,7 @@ class Ship:
         Approach speed [m/s].
     """
 
-    def __init__(self, spec, speed, ps, gear):
+    def __init__(self, spec: ShipSpec, speed: float, ps: ArrayLike, gear: SteeringGear) -> None:
         from steerlab.sim.kernels import plant_step
 
         self.spec = spec
@@ -88,7 +97,8 @@ class Ship:
     def __repr__(self):
         return f"Ship({self.name!r}, speed={self.speed:.4g} m/s, t={self.t:g} s)"
 
-    def reset(self, heading=0.0, yaw_rate=0.0, rudder=0.0, position=(0.0, 0.0)):
+    def reset(self, heading: float = 0.0, yaw_rate: float = 0.0, rudder: float = 0.0,
+              position: tuple[float, float] = (0.0, 0.0)) -> Ship:
         """Start at ``position`` (north, east [m]) on ``heading`` [rad] at the approach speed,
         turning at ``yaw_rate`` [rad/s] with the rudder at ``rudder`` [rad]; ``t = 0``. Returns ``self``."""
         x = self.state
@@ -99,10 +109,11 @@ class Ship:
         x[IR] = require_finite_range("yaw_rate", yaw_rate)
         x[-1] = require_finite_range("rudder", rudder, -self.gear.delta_max, self.gear.delta_max)
         self.t = 0.0
-        self._t0, self._k, self._h = 0.0, 0, None
+        self._h: Optional[float] = None
+        self._t0, self._k = 0.0, 0
         return self
 
-    def step(self, rudder_order, dt, disturbance=None) -> np.ndarray:
+    def step(self, rudder_order: float, dt: float, disturbance: Disturbance = None) -> np.ndarray:
         """Advance by ``dt`` [s] with ``rudder_order`` [rad] held; returns a copy of the state.
 
         Raises :class:`InputError` on a non-finite order or ``dt``, and when the state stops
@@ -125,7 +136,8 @@ class Ship:
                                      "(the model diverged)")
         return self.state.copy()
 
-    def step_state(self, x, rudder_order, dt, disturbance=None, t=0.0) -> np.ndarray:
+    def step_state(self, x: ArrayLike, rudder_order: float, dt: float, disturbance: Disturbance = None,
+                   t: float = 0.0) -> np.ndarray:
         """The functional form: plant state ``x`` (layout ``state_names``) advanced by ``dt`` [s]
         with ``rudder_order`` [rad] held, as a new array; the object's own state is untouched."""
         x = np.array(x, dtype=np.float64)
@@ -166,7 +178,8 @@ class Ship:
         return dict(zip(self.state_names, self.state.tolist()))
 
 
-def ship(name: str, speed_kn: float, *, gear=None, ship_options=None, rpm=None) -> Ship:
+def ship(name: str, speed_kn: float, *, gear: Union[SteeringGear, Mapping[str, float], None] = None,
+         ship_options: Optional[Mapping[str, Any]] = None, rpm: Optional[float] = None) -> Ship:
     """A catalogue ship (``steerlab ships``) at ``speed_kn`` [kn] with a steering gear.
 
     ``gear``: None (35 deg, 2.33 deg/s, T_sg 1 s), a ``SteeringGear`` or a dict of the

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 from steerlab.steering_gear import SteeringGear
 from steerlab.units import rad
@@ -19,7 +20,7 @@ class DesignContext:
     ship's options are honoured.
     """
 
-    ship: object
+    ship: Any                  # a ShipSpec, or components.design.NoModel for a design without a ship
     speed: float
     gear: SteeringGear
     dt: float

@@ -14,7 +14,7 @@ compare their ADRC with Kp = 3.81, Kd = 3.95, Ki = 0.00547.
 
 from __future__ import annotations
 
-from typing import Literal, Optional
+from typing import TYPE_CHECKING, Literal, Optional
 
 import numba
 import numpy as np
@@ -28,6 +28,10 @@ from steerlab.records import Layout
 from steerlab.units import rad
 from steerlab.ships.state import IPSI, IR
 from steerlab.guidance.reference_vector import REF_PSI, REF_R
+
+if TYPE_CHECKING:   # Layout.export below writes this module's index constants: ints, for type checkers
+    def __getattr__(name: str) -> int: ...
+
 
 PARAMS = Layout("controller", "C_", [
     RecordField("KP", "Kp", "rad/rad", "proportional gain (Zwierzewicz et al. 2021, Sec. 7: 3.81)",

@@ -28,7 +28,13 @@ The layout is declared once, as :data:`CHANNELS` (:mod:`steerlab.records`); the 
 constants, ``N_CHANNELS``, the names and the units are generated from it.
 """
 
+from typing import TYPE_CHECKING
+
 from steerlab.records import Field, Layout
+
+if TYPE_CHECKING:   # Layout.export below writes this module's index constants: ints, for type checkers
+    def __getattr__(name: str) -> int: ...
+
 
 CHANNELS = Layout("environment", "W_", [
     Field("RUDDER", "d_rudder", "rad", "equivalent rudder angle, > 0 pushes the ship to starboard"),

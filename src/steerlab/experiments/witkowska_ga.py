@@ -217,7 +217,7 @@ def ranking(costs: dict) -> str:
     return " < ".join(sorted(costs, key=lambda k: costs[k]))
 
 
-PROGRESS_PERIOD = 5.0
+PROGRESS_PERIOD = 1.0
 """Seconds between two progress lines of the whole reproduction (and one at the end)."""
 _last_progress = [-math.inf]
 
@@ -228,7 +228,7 @@ def _overall_progress(say, done: int, total: int, what: str):
     import re
     import time
 
-    from steerlab.progress import bar
+    from steerlab.progress import bar_message
 
     def progress(msg: str) -> None:
         now = time.perf_counter()
@@ -237,7 +237,7 @@ def _overall_progress(say, done: int, total: int, what: str):
         if now - _last_progress[0] >= PROGRESS_PERIOD or (last_gen and done + 1 == total):
             _last_progress[0] = now
             frac = done + (int(gen.group(1)) / int(gen.group(2)) if gen else 0.0)
-            say(f"{bar(frac, total)} {what}" + (f", generation {gen.group(1)}/{gen.group(2)}" if gen else ""))
+            say(bar_message(frac, total, what + (f", generation {gen.group(1)}/{gen.group(2)}" if gen else "")))
 
     return progress
 

@@ -15,7 +15,13 @@ The layout is declared once, as :data:`REFERENCE` (:mod:`steerlab.records`); the
 constants, ``N_REF``, the names and the units are generated from it.
 """
 
+from typing import TYPE_CHECKING
+
 from steerlab.records import Field, Layout
+
+if TYPE_CHECKING:   # Layout.export below writes this module's index constants: ints, for type checkers
+    def __getattr__(name: str) -> int: ...
+
 
 REFERENCE = Layout("reference", "REF_", [
     Field("PSI", "psi_ref", "rad", "reference heading"),

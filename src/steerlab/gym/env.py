@@ -29,15 +29,17 @@ offset of up to ``initial_offset_deg``), ``course_change`` (``steerlab/CourseCha
 from __future__ import annotations
 
 import math
+from typing import Any, Optional
 
 import gymnasium as gym
 import numpy as np
+from numpy.typing import ArrayLike
 
 from steerlab.guidance.reference_vector import REF_XTE
 from steerlab.gym.episodes import Episodes
 
 
-def spaces():
+def spaces() -> tuple[gym.spaces.Box, gym.spaces.Box]:
     """``(observation_space, action_space)`` of one ship."""
     hi = np.array([math.pi, math.pi, math.pi / 2])   # e [rad], r [rad/s] (180 deg/s: no ship), delta [rad]
     obs = gym.spaces.Box(low=-hi, high=hi, shape=(3,), dtype=np.float64)
@@ -50,23 +52,24 @@ class SteeringEnv(gym.Env):
 
     metadata = {"render_modes": []}
 
-    def __init__(self, task="course_keeping", render_mode=None, **kw):
+    def __init__(self, task: str = "course_keeping", render_mode: Optional[str] = None, **kw: Any) -> None:
         self.core = Episodes(1, task=task, **kw)
         self.observation_space, self.action_space = spaces()
         self.render_mode = render_mode
         self._done = True
 
-    def reset(self, *, seed=None, options=None):
+    def reset(self, *, seed: Optional[int] = None, options: Optional[dict[str, Any]] = None
+              ) -> tuple[np.ndarray, dict[str, Any]]:
         super().reset(seed=seed)
         info = self.core.reset_lanes([0], [seed])[0]
         self._done = False
         return self.core.obs[0].copy(), info
 
-    def step(self, action):
+    def step(self, action: ArrayLike) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
         if self._done:
             raise RuntimeError("episode over: call reset() first")
         obs, rew, term, trunc = self.core.step(np.asarray(action).reshape(1))
-        info = {"t": float(self.core.J[0] * self.core.control_dt)}
+        info: dict[str, Any] = {"t": float(self.core.J[0] * self.core.control_dt)}
         xte = float(self.core.REF[0, REF_XTE])
         if xte == xte:                                   # NaN without a route
             info["xte"] = xte

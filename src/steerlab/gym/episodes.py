@@ -30,8 +30,10 @@ from __future__ import annotations
 
 import math
 from dataclasses import replace
+from typing import Any, Iterable, Mapping, Optional, Sequence, Union
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from steerlab.environment.disturbance import N_CHANNELS, W_RUDDER, build_disturbance
 from steerlab.environment.iir_filter import _padded
@@ -74,10 +76,12 @@ def _scenario(task, ship, speed_kn, gear, environment, ship_options, dt, episode
 class Episodes:
     """N lanes (see the module docstring); all arrays SI."""
 
-    def __init__(self, n, task="course_keeping", ship="esso", speed_kn=16.0, gear=None, environment=None,
-                 ship_options=None, dt=0.1, control_dt=1.0, episode_s=300.0, lam=0.1,
-                 initial_offset_deg=10.0, change_deg=20.0, change_t=10.0, guidance=None, reward="speed_loss",
-                 vectorised=False):
+    def __init__(self, n: int, task: str = "course_keeping", ship: str = "esso", speed_kn: float = 16.0,
+                 gear: Optional[Mapping[str, float]] = None, environment: Optional[Mapping[str, Any]] = None,
+                 ship_options: Optional[Mapping[str, Any]] = None, dt: float = 0.1, control_dt: float = 1.0,
+                 episode_s: float = 300.0, lam: float = 0.1, initial_offset_deg: float = 10.0,
+                 change_deg: float = 20.0, change_t: float = 10.0, guidance: Optional[Mapping[str, Any]] = None,
+                 reward: str = "speed_loss", vectorised: bool = False) -> None:
         from steerlab.environment.sea import uses_sea
         from steerlab.gym.plant_batch import REWARDS, lane_stepper, resetter, vector_stepper
         from steerlab.guidance.reference_models import course_guide
@@ -169,7 +173,8 @@ class Episodes:
         return (self.lazy, self.S, self.Z, self._base, self._hold, self._fb, self._fa, W_RUDDER)
 
     # ----------------------------------------------------------------- reset
-    def reset_lanes(self, lanes, seeds=None):
+    def reset_lanes(self, lanes: Union[Iterable[int], np.ndarray],
+                    seeds: Optional[Sequence[Optional[int]]] = None) -> list[dict[str, Any]]:
         """Reset ``lanes`` (indices) to their next episode; ``seeds[i]`` (int or None) first
         keys lane ``lanes[i]`` with that seed (episode 0). A lane never keyed is keyed from
         the operating system's entropy. Returns one info dict per lane."""
@@ -198,7 +203,7 @@ class Episodes:
         return infos
 
     # ----------------------------------------------------------------- step
-    def orders(self, actions) -> np.ndarray:
+    def orders(self, actions: ArrayLike) -> np.ndarray:
         """Rudder orders [rad] from actions in [-1, 1] (fraction of the gear limit); refuses others."""
         a = np.asarray(actions, dtype=np.float64).reshape(self.n)
         if not (np.abs(a) <= 1.0).all():                 # NaN fails the comparison too
@@ -209,7 +214,7 @@ class Episodes:
         return InputError("action", f"must be finite and in [-1, 1] (rudder order / gear limit "
                                     f"{math.degrees(self.delta_max):g} deg), got {value!r}")
 
-    def step(self, actions, active=None):
+    def step(self, actions: ArrayLike, active: Optional[np.ndarray] = None):
         """Advance the ``active`` lanes (default all) by one env step with the scalar kernel (the
         single environment); fills ``obs``, ``rew``, ``bad``; returns ``(obs, rew, terminated,
         truncated)``."""

@@ -17,8 +17,11 @@ before anything moves; a diverged ship ends its episode (``terminated``,
 
 from __future__ import annotations
 
+from typing import Any, Optional, Sequence, Union
+
 import gymnasium as gym
 import numpy as np
+from numpy.typing import ArrayLike
 from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
@@ -30,7 +33,8 @@ from steerlab.gym.episodes import Episodes
 class SteeringVectorEnv(VectorEnv):
     metadata = {"render_modes": [], "autoreset_mode": AutoresetMode.NEXT_STEP}
 
-    def __init__(self, num_envs: int = 1, task="course_keeping", render_mode=None, **kw):
+    def __init__(self, num_envs: int = 1, task: str = "course_keeping", render_mode: Optional[str] = None,
+                 **kw: Any) -> None:
         self.num_envs = int(num_envs)
         self.core = Episodes(self.num_envs, task=task, vectorised=True, **kw)
         self.single_observation_space, self.single_action_space = spaces()
@@ -42,8 +46,10 @@ class SteeringVectorEnv(VectorEnv):
         self._trunc = np.zeros(self.num_envs, dtype=np.bool_)
         self._reset_done = False
 
-    def reset(self, *, seed=None, options=None):
+    def reset(self, *, seed: Union[int, Sequence[Optional[int]], None] = None,
+              options: Optional[dict[str, Any]] = None) -> tuple[np.ndarray, dict[str, Any]]:
         n = self.num_envs
+        seeds: list[int | None]
         if seed is None:
             seeds = None
         elif isinstance(seed, (int, np.integer)) and not isinstance(seed, (bool, np.bool_)):
@@ -61,12 +67,13 @@ class SteeringVectorEnv(VectorEnv):
         self._reset_done = True
         return self.core.obs.copy(), {}
 
-    def step(self, actions):
+    def step(self, actions: ArrayLike
+             ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, dict[str, Any]]:
         c = self.core
         if not self._reset_done:
             raise RuntimeError("call reset() before step()")
         c.step_autoreset(actions, self._autoreset, self._term, self._trunc)
-        infos = {}
+        infos: dict[str, Any] = {}
         if self._term.any():
             infos["reason"] = np.where(self._term, "diverged", "")
             infos["_reason"] = self._term.copy()

@@ -10,13 +10,16 @@ package: :func:`register_ship`, the entry-point group ``steerlab.ships`` or the
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Callable
+from typing import TYPE_CHECKING, Any, Callable, Mapping, Optional
 
 from pydantic import ValidationError
 
 from steerlab.errors import InputError
 from steerlab.plugins import Registry
 from steerlab.ships.b2_estimate import b2_estimate
+
+if TYPE_CHECKING:
+    from steerlab.config_base import FrozenConfig
 
 
 @dataclass(frozen=True)
@@ -47,7 +50,7 @@ class ShipSpec:
     dims: tuple
     source: str
     linearise: Callable | None = None
-    options_model: type | None = None
+    options_model: type[FrozenConfig] | None = None
     nomoto_KT: Callable | None = None
     speed_range: tuple = (0.0, float("inf"))   #: validity range of the model [m/s]
     #: ``(speed, options) -> delta0 [rad]`` holding a straight course (None: 0, a symmetric hull)
@@ -55,7 +58,7 @@ class ShipSpec:
     #: ``(speed, options) -> bool``: whether delta -> -delta mirrors the response (None: True)
     symmetric: Callable | None = None
 
-    def b2(self, speed: float, method: str, options=None) -> float:
+    def b2(self, speed: float, method: str, options: Optional[FrozenConfig] = None) -> float:
         """Rudder efficiency [1/s^2], steerlab sign: ``exact`` (linearisation) or ``estimate`` (eq 29).
 
         ``options``: the validated ``[ship.options]`` (passed on to ``b2_exact`` when the ship
@@ -68,7 +71,7 @@ class ShipSpec:
             return b2_estimate(c_B, L, B, speed)
         raise InputError("controller.c0", f"must be a number, 'estimate' or 'exact', got {method!r}")
 
-    def nomoto(self, speed: float, options=None) -> tuple[float, float]:
+    def nomoto(self, speed: float, options: Optional[FrozenConfig] = None) -> tuple[float, float]:
         """First-order Nomoto ``(K [1/s], T [s])`` at ``speed`` [m/s] (``options`` as in :meth:`b2`)."""
         if self.nomoto_KT is not None:
             return self.nomoto_KT(speed, options) if self.options_model is not None else self.nomoto_KT(speed)
@@ -79,7 +82,7 @@ class ShipSpec:
         n = nomoto_from_linear(*self.linearise(speed))
         return n["K"], n["T"]
 
-    def options(self, raw: dict | None):
+    def options(self, raw: Mapping[str, Any] | None) -> Optional[FrozenConfig]:
         """Validate ``[ship.options]`` against ``options_model`` (errors name ``ship.options.X``)."""
         raw = dict(raw or {})
         if self.options_model is None:

@@ -22,7 +22,13 @@ states declares them as a layout of its own and appends it with :func:`ship_stat
 continues the numbering after the planar prefix (``I_RDOT = 6`` for a Van Leeuwen ship).
 """
 
+from typing import TYPE_CHECKING
+
 from steerlab.records import Field, Layout
+
+if TYPE_CHECKING:   # Layout.export below writes this module's index constants: ints, for type checkers
+    def __getattr__(name: str) -> int: ...
+
 
 PLANAR = Layout("ship state", "I", [
     Field("X", "x_n", "m", "north position of the ship's origin"),

@@ -31,12 +31,19 @@ keeps a decimated log. Every run is independent and deterministic, so splitting 
 from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
+from typing import TYPE_CHECKING, Callable, Optional
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from steerlab.errors import InputError
 from steerlab.metrics_online import N_ACC
 from steerlab.sim.lanes import LANES
+
+if TYPE_CHECKING:
+    import pandas
+
+    from steerlab.sim.setup import SimSetup
 
 
 @dataclass
@@ -78,7 +85,7 @@ class BatchResult:
         weight lambda = 0.1 in ``J``; :meth:`to_pandas` for another) and the final states."""
         return self.to_pandas()
 
-    def to_pandas(self, lam: float = 0.1):
+    def to_pandas(self, lam: float = 0.1) -> "pandas.DataFrame":
         """One row per run: integral metrics and final states (:func:`steerlab.sim.frames.batch_frame`)."""
         from steerlab.sim.frames import batch_frame
 
@@ -248,8 +255,8 @@ class PackedBatch:
         return BatchResult(acc, X, np.arange(n_rec) * rec * self.dt, out_x, out_cmd, out_ref, self.state_names)
 
 
-def simulate_batch(setups, record_every: int | None = None, lanes: int = LANES,
-                   progress=None) -> BatchResult:
+def simulate_batch(setups: list[SimSetup], record_every: int | None = None, lanes: int = LANES,
+                   progress: Optional[Callable[[int, int], None]] = None) -> BatchResult:
     """Run every setup with the compiled engine, in parallel over the available cores.
 
     The one batch front end: ``PackedBatch.from_setups(setups).run(record_every, progress, lanes)``.
@@ -273,7 +280,7 @@ def simulate_batch(setups, record_every: int | None = None, lanes: int = LANES,
     return PackedBatch.from_setups(setups, "setups").run(record_every, progress, lanes)
 
 
-def vary_controller(setup, pc_rows) -> list:
+def vary_controller(setup: SimSetup, pc_rows: ArrayLike) -> list[SimSetup]:
     """Copies of ``setup`` with the controller parameters replaced by each row of ``pc_rows``."""
     rows = np.asarray(pc_rows, dtype=float)
     if rows.ndim != 2 or rows.shape[1] != setup.pc.shape[0]:

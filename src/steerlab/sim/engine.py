@@ -7,6 +7,8 @@ runs with ``NUMBA_DISABLE_JIT=1``); the compiled loop is what ``steerlab run`` u
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING, Union
+
 import numpy as np
 
 from steerlab.angles import wrap_to_pi_array
@@ -16,6 +18,9 @@ from steerlab.metrics_online import accumulate, new_accumulator
 from steerlab.sim.kernels import closed_loop, plant_step
 from steerlab.sim.result import Result
 from steerlab.sim.setup import SimSetup, build
+
+if TYPE_CHECKING:
+    from steerlab.sim.scenario import Scenario
 
 ENGINES = ("compiled", "readable")
 
@@ -45,7 +50,7 @@ def _result(s: SimSetup, X, cmd, ref, engine: str) -> Result:
     return res
 
 
-def simulate_readable(scenario_or_setup) -> Result:
+def simulate_readable(scenario_or_setup: Union[Scenario, SimSetup]) -> Result:
     """The closed loop written out step by step in Python (same kernels as the compiled one)."""
     s = _as_setup(scenario_or_setup)
     rk4_step = plant_step(s.ship.rhs)
@@ -81,7 +86,7 @@ def simulate_readable(scenario_or_setup) -> Result:
     return _result(s, X, cmd_log, ref_log, "readable")
 
 
-def simulate_compiled(scenario_or_setup) -> Result:
+def simulate_compiled(scenario_or_setup: Union[Scenario, SimSetup]) -> Result:
     """The compiled closed loop (numba), recording every step."""
     s = _as_setup(scenario_or_setup)
     run = closed_loop(s.ship.rhs, s.controller.update, s.x0.shape[0], s.guide)
@@ -99,7 +104,7 @@ def simulate_compiled(scenario_or_setup) -> Result:
     return res
 
 
-def simulate(scenario_or_setup, engine: str = "compiled") -> Result:
+def simulate(scenario_or_setup: Union[Scenario, SimSetup], engine: str = "compiled") -> Result:
     """Run one scenario (a :class:`Scenario` or a built :class:`SimSetup`)."""
     if engine == "compiled":
         return simulate_compiled(scenario_or_setup)

@@ -3,13 +3,18 @@
 from __future__ import annotations
 
 import math
+import os
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING, Any, Optional, Sequence
 
 import numpy as np
 
 from steerlab.angles import wrap_to_pi_array
 from steerlab.environment.channels import CHANNEL_NAMES, CHANNEL_UNITS
+
+if TYPE_CHECKING:
+    import pandas
 
 
 @dataclass
@@ -39,19 +44,19 @@ class Result:
         return self.states[:, self.state_names.index(name)]
 
     @property
-    def psi(self):
+    def psi(self) -> np.ndarray:
         return self.col("psi")
 
     @property
-    def r(self):
+    def r(self) -> np.ndarray:
         return self.col("r")
 
     @property
-    def delta(self):
+    def delta(self) -> np.ndarray:
         return self.col("delta")
 
     @property
-    def heading_error(self):
+    def heading_error(self) -> np.ndarray:
         """``wrap_to_pi(psi_ref - psi)`` [rad]."""
         return wrap_to_pi_array(self.psi_ref - self.psi)
 
@@ -71,13 +76,13 @@ class Result:
             cols[f"{n} [{u}]"] = c
         return cols
 
-    def to_pandas(self):
+    def to_pandas(self) -> pandas.DataFrame:
         """A ``pandas.DataFrame``: index ``time [s]``, columns ``name [unit]`` as in :meth:`columns`."""
         from steerlab.sim.frames import result_frame
 
         return result_frame(self)
 
-    def plot(self, axes=None, title: str = ""):
+    def plot(self, axes: Optional[Sequence[Any]] = None, title: str = "") -> Any:
         """Heading, rudder and yaw rate in three Axes (``axes``: three matplotlib Axes, or None
         for a new pyplot figure); returns the Axes (:func:`steerlab.report.draw_heading` etc.)."""
         from steerlab.report import draw_heading, draw_rudder, draw_yaw_rate
@@ -93,14 +98,14 @@ class Result:
             draw(ax, self, title)
         return axes
 
-    def to_csv(self, path) -> Path:
+    def to_csv(self, path: str | os.PathLike[str]) -> Path:
         path = Path(path)
         cols = self.columns()
         data = np.column_stack(list(cols.values()))
         np.savetxt(path, data, delimiter=",", header=",".join(cols), comments="", fmt="%.10g")
         return path
 
-    def to_parquet(self, path) -> Path:
+    def to_parquet(self, path: str | os.PathLike[str]) -> Path:
         """Write Parquet (needs the optional ``pyarrow``)."""
         try:
             import pyarrow as pa

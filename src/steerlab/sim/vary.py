@@ -21,8 +21,12 @@ from __future__ import annotations
 
 import copy
 import itertools
+from typing import TYPE_CHECKING, Any, Mapping, Sequence
 
 from steerlab.errors import InputError
+
+if TYPE_CHECKING:
+    from steerlab.sim.scenario import Scenario
 
 MAX_VARIATIONS = 100_000
 MODES = ("grid", "zip")
@@ -78,7 +82,7 @@ def _set(d: dict, path: tuple, value) -> None:
     node[path[-1]] = value
 
 
-def vary(scenario, changes: dict, mode: str = "grid") -> list:
+def vary(scenario: Scenario, changes: Mapping[str, Sequence[Any]], mode: str = "grid") -> list[Scenario]:
     """Validated copies of ``scenario`` with the dotted names of ``changes`` set (module docstring).
 
     Parameters

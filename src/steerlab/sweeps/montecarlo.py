@@ -94,6 +94,15 @@ def default_record_every(n_runs: int, n_steps: int, nx: int) -> int:
     return max(1, int(math.ceil((n_steps + 1) * per_row / LOG_BUDGET)))
 
 
+def _has_random_sea(env) -> bool:
+    """True when the seed changes the sea: eq (39) or modelled waves, gusts, a random-walk current."""
+    wave, gusts, cur = env.wave, env.gusts, env.current_variation
+    return bool(env.waves or (wave is not None and wave.model != "none")
+                or (gusts is not None and (gusts.speed_std > 0.0 or gusts.dir_std_deg > 0.0))
+                or (cur is not None and cur.kind == "random_walk"
+                    and (cur.speed_amplitude > 0.0 or cur.dir_amplitude_deg > 0.0)))
+
+
 def run_montecarlo(scenario, n_runs: int, lam: float = 0.1, record_every: int | None = None,
                    executor=None, progress=None) -> MonteCarloResult:
     """Run the scenario over ``n_runs`` seeds (see the module docstring).
@@ -109,8 +118,11 @@ def run_montecarlo(scenario, n_runs: int, lam: float = 0.1, record_every: int | 
         raise InputError("--runs", f"must be in [2, {MAX_RUNS}], got {n_runs}")
     if not (math.isfinite(lam) and lam >= 0):
         raise InputError("--lambda", f"must be a finite number >= 0, got {lam}")
-    if not scenario.environment.waves:
-        say("note: the scenario has no random disturbance ([environment] waves = false): "
+    sensors = scenario.sensors
+    noisy_sensors = sensors is not None and (sensors.heading_noise_std_deg > 0.0 or sensors.yaw_rate_noise_std_deg_s > 0.0
+                                             or sensors.dropout_probability > 0.0)
+    if not (_has_random_sea(scenario.environment) or noisy_sensors):
+        say("note: the scenario has nothing random (no waves, gusts, current variation or sensor noise): "
             "every realisation is the same")
     executor = executor or LocalExecutor()
     report = runs_progress(say)
@@ -129,8 +141,7 @@ def run_montecarlo(scenario, n_runs: int, lam: float = 0.1, record_every: int | 
             if record_every < 1:
                 raise InputError("--record-every", f"must be >= 1, got {record_every}")
             say(f"{n_runs} runs of {batch.n_steps} steps ({batch.ship_name} + {batch.controller_name}), "
-                f"log every {record_every} step(s), in chunks of up to {CHUNK_RUNS}; first call "
-                "compiles the loop")
+                f"log every {record_every} step(s), chunks of <= {CHUNK_RUNS} runs")
         out = executor.run(batch, record_every, lambda done, _n, s0=start: report(s0 + done, n_runs))
         nd = batch.X.shape[1] - 1
         diverged[start:start + m] = out.diverged

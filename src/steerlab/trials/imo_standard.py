@@ -42,14 +42,18 @@ def run_imo(cond: TrialConditions, progress=None) -> tuple[dict, list]:
     """Run the standard set; returns ``(report dict, [(label, kind, trial), ...])``."""
     cond = cond.resolved()
     say = progress or (lambda msg: None)
+    from steerlab.progress import bar_message
+
     trials, results, criteria = [], {}, []
-    for label, kind, opts in standard_set(cond):
-        say(f"{label} ...")
+    todo = standard_set(cond)
+    for i, (label, kind, opts) in enumerate(todo):
+        say(bar_message(i, len(todo), f"trial {i + 1}/{len(todo)}: {label}"))
         trial, metrics = run_trial(kind, cond, **dict(opts))
         trials.append((label, kind, trial))
         results[label] = {"trial_kind": kind, **{k: v for k, v in metrics.items() if k != "conditions"}}
         for c in metrics.get("imo", []):
             criteria.append({"trial": label, **c})
+    say(bar_message(len(todo), len(todo), f"{len(todo)} trials done"))
     verdicts = [c["pass"] for c in criteria]
     overall = None if any(v is None for v in verdicts) else all(verdicts)
     spiral = results["spiral 10 deg"]

@@ -38,7 +38,7 @@ from pathlib import Path
 import numpy as np
 
 from steerlab.errors import InputError
-from steerlab.progress import bar
+from steerlab.progress import bar_message
 
 METHODS = ("de", "ga", "nsga2")
 CHECKPOINT_VERSION = 1
@@ -127,8 +127,7 @@ class _Progress:
     def __call__(self, gen: int, n_sims: int, best_f, best_x) -> None:
         params = ", ".join(f"{n}={v:.4g}" for n, v in zip(self.names, best_x))
         best = ", ".join(f"{v:.6g}" for v in np.atleast_1d(best_f))
-        self.say(f"{bar(gen, self.n_gen)} gen {gen}/{self.n_gen}  sims {n_sims}  "
-                 f"best {best}  ({params})")
+        self.say(bar_message(gen, self.n_gen, f"gen {gen}/{self.n_gen}  sims {n_sims}  best {best}  ({params})"))
 
 
 def run_optimiser(evaluator, method: str, generations: int, pop_size: int, seed: int,
