@@ -141,7 +141,7 @@ def _vectorisation(kind, name, setup, strict: bool) -> tuple[int | None, list]:
     from steerlab.sim.batch import simulate_batch
     from steerlab.sim.lanes import vectorisation_report
 
-    if not numba.config.LOOP_VECTORIZE:       # NUMBA_LOOP_VECTORIZE=0: nothing to inspect
+    if not numba.config.LOOP_VECTORIZE:  # type: ignore[attr-defined]   # NUMBA_LOOP_VECTORIZE=0
         return None, []
     simulate_batch([setup, setup])            # compiles (or loads) the batch group of the combination
     rep = vectorisation_report(setup.ship.rhs, setup.controller.update, setup.x0.size, setup.guide)

@@ -214,7 +214,8 @@ class Episodes:
         return InputError("action", f"must be finite and in [-1, 1] (rudder order / gear limit "
                                     f"{math.degrees(self.delta_max):g} deg), got {value!r}")
 
-    def step(self, actions: ArrayLike, active: Optional[np.ndarray] = None):
+    def step(self, actions: ArrayLike, active: Optional[np.ndarray] = None
+             ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """Advance the ``active`` lanes (default all) by one env step with the scalar kernel (the
         single environment); fills ``obs``, ``rew``, ``bad``; returns ``(obs, rew, terminated,
         truncated)``."""
@@ -228,7 +229,7 @@ class Episodes:
         truncated = self.J >= self.n_env_steps
         return self.obs, self.rew, self.bad.copy(), truncated & ~self.bad
 
-    def step_autoreset(self, actions, redo, term, trunc):
+    def step_autoreset(self, actions: ArrayLike, redo: np.ndarray, term: np.ndarray, trunc: np.ndarray) -> None:
         """The vector environment's step (:func:`steerlab.gym.plant_batch.vector_stepper`, one
         compiled call): the lanes not in ``redo`` (N,) bool advance with ``actions`` (N,) in
         [-1, 1], the ``redo`` lanes reset to their next episode (action ignored, reward 0);

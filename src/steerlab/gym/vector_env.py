@@ -49,14 +49,14 @@ class SteeringVectorEnv(VectorEnv):
     def reset(self, *, seed: Union[int, Sequence[Optional[int]], None] = None,
               options: Optional[dict[str, Any]] = None) -> tuple[np.ndarray, dict[str, Any]]:
         n = self.num_envs
-        seeds: list[int | None]
+        seeds: Optional[list[Optional[int]]]
         if seed is None:
             seeds = None
         elif isinstance(seed, (int, np.integer)) and not isinstance(seed, (bool, np.bool_)):
             seeds = [int(seed) + i for i in range(n)]
         else:
             try:
-                seeds = list(seed)
+                seeds = list(seed)  # type: ignore[arg-type]   # a bad value: refused just below
             except TypeError:
                 seeds = None
             if seeds is None or len(seeds) != n:

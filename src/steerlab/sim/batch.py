@@ -31,7 +31,7 @@ keeps a decimated log. Every run is independent and deterministic, so splitting 
 from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
-from typing import TYPE_CHECKING, Callable, Optional
+from typing import TYPE_CHECKING, Any, Callable, Iterable, Optional
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -80,7 +80,7 @@ class BatchResult:
         return diverged_rows(self.final_states, self.acc)
 
     @property
-    def metrics(self):
+    def metrics(self) -> "pandas.DataFrame":
         """pandas DataFrame, one row per run (index ``run``): the integral metrics (rudder
         weight lambda = 0.1 in ``J``; :meth:`to_pandas` for another) and the final states."""
         return self.to_pandas()
@@ -143,7 +143,7 @@ class PackedBatch:
         return self.X.shape[0]
 
     @classmethod
-    def from_setups(cls, setups, what: str = "setups") -> "PackedBatch":
+    def from_setups(cls, setups: "Iterable[SimSetup]", what: str = "setups") -> "PackedBatch":
         """Pack validated setups (same ship model, controller, guidance kind, dt, sample time
         and length); ``what`` names the list in an error (``setups[3]``)."""
         setups = list(setups)
@@ -162,7 +162,7 @@ class PackedBatch:
                                  "all runs of a batch need the same dt, controller sample time and duration")
         # share identical disturbance sequences (same array object) instead of copying them n times
         w_ids: dict[int, int] = {}
-        w_list = []
+        w_list: list[np.ndarray] = []
         w_index = np.empty(len(setups), dtype=np.int64)
         for i, s in enumerate(setups):
             if id(s.w) not in w_ids:
@@ -183,7 +183,7 @@ class PackedBatch:
                    stack("z0"), stack("ps"), stack("pg"), stack("pc"), stack("gd"), W, w_index,
                    tuple(s0.state_names), s0.guide, GZ, s0.rpm_slot, s0.ship.rhs, s0.controller.update)
 
-    def take(self, idx) -> "PackedBatch":
+    def take(self, idx: ArrayLike) -> "PackedBatch":
         """The runs ``idx`` (any integer index array), with only the disturbances they use."""
         idx = np.asarray(idx, dtype=np.int64)
         used, w_new = np.unique(self.w_index[idx], return_inverse=True)
@@ -206,7 +206,7 @@ class PackedBatch:
         Z = self.Z if Z is None else np.ascontiguousarray(Z, dtype=np.float64)
         return replace(self, PC=PC, Z=Z)
 
-    def kernels(self):
+    def kernels(self) -> tuple[Any, Any]:
         """``(rhs, update)``: the setups' kernels, else found by name (wrappers included)."""
         rhs, update = self.rhs, self.update
         if rhs is None:
@@ -219,7 +219,8 @@ class PackedBatch:
             update = controller_spec(self.controller_name).update     # "+wf", "+sensors" included
         return rhs, update
 
-    def run(self, record_every: int | None = None, progress=None, lanes: int = LANES) -> BatchResult:
+    def run(self, record_every: int | None = None, progress: Optional[Callable[[int, int], None]] = None,
+            lanes: int = LANES) -> BatchResult:
         """Run every row with the compiled batch engine, in parallel over the local cores.
 
         ``record_every``: log interval in steps (None: only the initial row). ``lanes`` runs
