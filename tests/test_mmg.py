@@ -136,6 +136,49 @@ def test_bad_options_name_the_field(opts, msg):
     assert ei.value.field.split(".")[2] in opts
 
 
+KOSOKO_TOML = (__import__("importlib").resources.files("steerlab.ships") / "data" / "mmg_kosoko.toml").read_text(
+    encoding="utf-8")
+
+
+@pytest.mark.parametrize("line, repl, field, msg", [
+    ("C_b = 0.55", "C_b = nan", "hull.C_b", "finite"),                       # NaN
+    ("C_b = 0.55", "C_b = 1.5", "hull.C_b", "less than 1"),                  # out of range, bound named
+    ("D = 0.08 ", "", "propeller.D", "required"),                           # missing
+    ("w_p = 0.20", "w_p = inf", "propeller.w_p", "finite"),
+    ("kt = [0.30,", "kt = [nan,", "propeller.kt.0", "finite"),
+    ("kt = [0.30,", "kt = [-0.30,", "propeller.kt", r"K_T\(0\) must be > 0"),  # no bollard thrust
+    ("area = 0.0069", "area = 0.0", "rudder.area", "greater than 0"),
+    ("C = 0.104", "C = nan", "wind.C", "finite"),
+    ("speed_range_m_s = [0.05, 1.5]", "speed_range_m_s = [1.5, 0.05]", "speed_range_m_s", "lo < hi"),
+    ("speed_m_s = 0.5 ", "speed_m_s = 2.0 ", "design.speed_m_s", "outside the data's speed_range"),
+])
+def test_bad_kosoko_data_is_refused_naming_the_field(line, repl, field, msg):
+    """A missing, NaN or out-of-range coefficient of an MMG data file: one InputError naming the field."""
+    from steerlab.ships.mmg import load_mmg_data
+
+    assert line in KOSOKO_TOML
+    load_mmg_data(KOSOKO_TOML, "k.toml")                                     # the shipped file is valid
+    with pytest.raises(InputError, match=msg) as ei:
+        load_mmg_data(KOSOKO_TOML.replace(line, repl), "k.toml")
+    assert ei.value.field == f"k.toml: {field}" and "\n" not in str(ei.value)
+
+
+def test_kosoko_speed_outside_the_data_validity_is_refused():
+    """speed_range_m_s = [0.05, 1.5] m/s (model scale): 5 kn = 2.57 m/s is refused by the trials and
+    flagged in a scenario run, naming the speed field."""
+    from steerlab.trials.runner import TrialConditions
+
+    with pytest.raises(InputError, match="validity range") as ei:
+        TrialConditions(ship="kosoko", speed_kn=5.0).resolved()
+    assert ei.value.field == "speed_kn"
+    # a scenario run is allowed but flagged (a warning naming the field, written to metrics.json)
+    from steerlab.sim.sanity import scenario_warnings
+
+    flagged = scenario_warnings(scenario_from_dict({"ship": {"model": "kosoko", "speed_kn": 5.0}}))
+    assert any(w.startswith("ship.speed_kn") and "2.92 kn" in w for w in flagged), flagged
+    assert not scenario_warnings(scenario_from_dict({"ship": {"model": "kosoko", "speed_kn": 1.0}}))
+
+
 def test_rpm_and_schedule_together_is_an_error():
     with pytest.raises(InputError) as ei:
         build(scenario_from_dict({"ship": {"model": "kosoko", "speed_kn": 1.0, "rpm": 600.0,

@@ -180,8 +180,15 @@ def load_mmg_data(text: str, name: str = "ship data") -> MMGShipData:
     except tomllib.TOMLDecodeError as err:
         raise InputError(name, f"malformed TOML: {err}") from None
     except ValidationError as err:
-        first = err.errors()[0]
-        raise InputError(f"{name}: " + ".".join(str(p) for p in first["loc"]), first["msg"]) from None
+        raise data_error(name, err) from None
+    if data.propeller.kt[0] <= 0.0:
+        raise InputError(f"{name}: propeller.kt", f"k0 = K_T(0) must be > 0 (got {data.propeller.kt[0]})")
+    lo, hi = data.speed_range_m_s
+    if not (0.0 <= lo < hi):
+        raise InputError(f"{name}: speed_range_m_s", f"must be [lo, hi] with 0 <= lo < hi (got [{lo}, {hi}])")
+    if not (lo <= data.design.speed_m_s <= hi):
+        raise InputError(f"{name}: design.speed_m_s", f"{data.design.speed_m_s} m/s is outside the data's "
+                                                      f"speed_range_m_s [{lo}, {hi}]")
     if data.rudder.slipstream > 0.0:
         R = slipstream_drag_ratio(data)
         if R > 1.0:
@@ -192,6 +199,16 @@ def load_mmg_data(text: str, name: str = "ship data") -> MMGShipData:
                 f"with D = {data.propeller.D} m), which drives a hard-over turn astern; allowed only when that "
                 f"ratio is <= 1 (see steerlab.ships.mmg.slipstream_drag_ratio)")
     return data
+
+
+def data_error(name: str, err: ValidationError) -> InputError:
+    """The :class:`InputError` for the first problem pydantic found in ship data file ``name``:
+    the field's dotted path, the message and, for a bound, the allowed range."""
+    first = err.errors()[0]
+    ctx = first.get("ctx") or {}
+    bounds = [f"{k.replace('_', ' ')} {v}" for k, v in ctx.items() if k in ("gt", "ge", "lt", "le")]
+    msg = first["msg"] + (f" (allowed: {', '.join(bounds)})" if bounds else "")
+    return InputError(f"{name}: " + ".".join(str(p) for p in first["loc"]), msg)
 
 
 def shipped_data_files(prefix: str) -> list:

@@ -146,11 +146,9 @@ def load_mmgstd_data(text: str, name: str = "ship data") -> MMGStdShipData:
     try:
         data = MMGStdShipData.model_validate(raw)
     except ValidationError as err:
-        first = err.errors()[0]
-        ctx = first.get("ctx") or {}
-        bounds = [f"{k.replace('_', ' ')} {v}" for k, v in ctx.items() if k in ("gt", "ge", "lt", "le")]
-        msg = first["msg"] + (f" (allowed: {', '.join(bounds)})" if bounds else "")
-        raise InputError(f"{name}: " + ".".join(str(p) for p in first["loc"]), msg) from None
+        from steerlab.ships.mmg import data_error
+
+        raise data_error(name, err) from None
     if not all(math.isfinite(k) for k in data.propeller.kt):
         raise InputError(f"{name}: propeller.kt", "must be finite numbers")
     if data.propeller.kt[0] <= 0.0:
