@@ -246,6 +246,31 @@ def test_mss_tanker_shallow_water_turns_wider():
     assert deep < h25 < h20 and h20 > 4 * deep
 
 
+def test_mss_tanker_kernel_equals_an_independent_rederivation_of_the_published_equations():
+    """tanker_rhs (steerlab sign, packed record) vs the plain-Python transcription of MSS tanker.m's
+    equations (MSS sign) at random states, deep and shallow water (both sides of z = 0.8)."""
+    from steerlab.environment.channels import N_CHANNELS
+    from steerlab.experiments import tanker_reference as tr
+
+    rng = np.random.default_rng(16)
+    w = np.zeros(N_CHANNELS)
+    for depth in (None, 60.0, 25.0, 20.0):
+        p_by_n = {}
+        for _ in range(100):
+            u, v, r = rng.uniform(1.0, 9.0), rng.uniform(-2.0, 2.0), rng.uniform(-0.01, 0.01)
+            d, n = rng.uniform(-0.6, 0.6), round(rng.uniform(0.3, 1.4), 2)
+            p = p_by_n.setdefault(n, mt.pack(n, depth_m=depth))
+            x = np.zeros(mt.N_STATES)
+            x[mt.IU], x[mt.IV], x[mt.IR] = u, v, r
+            dx = np.zeros(mt.N_STATES)
+            mt.tanker_rhs(0.0, x, d, w, p, dx)
+            ref = tr.accelerations(u, v, r, -d, n, depth)
+            np.testing.assert_allclose(dx[mt.IU:mt.IR + 1], ref, rtol=1e-11, atol=1e-16)
+    # the two drift-angle forms differ only through beta: equal with v = 0, not with drift
+    assert tr.accelerations(8.0, 0.0, 0.003, 0.3, 1.3, beta_form="ratio") == tr.accelerations(8.0, 0.0, 0.003, 0.3, 1.3)
+    assert tr.accelerations(8.0, 2.0, 0.003, 0.3, 1.3, beta_form="ratio") != tr.accelerations(8.0, 2.0, 0.003, 0.3, 1.3)
+
+
 # ------------------------------------------------------------------ Kosoko: slipstream refusal
 
 def test_kosoko_slipstream_that_would_drive_the_turn_astern_is_refused():
@@ -280,6 +305,18 @@ def test_esso_models_experiment(tmp_path):
         by["35 deg turn to starboard: advance / L"]["paper"], rel=1e-9)
     assert by["35 deg turn to port: advance / L"]["steerlab"] != pytest.approx(
         by["35 deg turn to starboard: advance / L"]["steerlab"], rel=1e-3)
+    # cross-check rows: the kernel = the independent re-derivation (to rounding), the PVS beta form is not
+    cross = [r for r in rows if r["quantity"].startswith("original model cross-check")]
+    assert len(cross) == len(em.CROSS_CHECKS) == 6
+    for r in cross:
+        assert "80 rpm" in r["note"] and "rudder held" in r["note"]
+        if "PythonVehicleSimulator's beta" in r["quantity"]:
+            assert r["steerlab"] / r["paper"] == pytest.approx(0.972, abs=0.005)
+        else:
+            assert r["steerlab"] == pytest.approx(r["paper"], rel=1e-10)
+    steady20 = by["original model cross-check: 20 deg rudder held, deep water: steady turning diameter / L"]
+    assert steady20["paper"] == pytest.approx(2.95, abs=0.01)          # as test_mss_tanker_shallow_water_turns_wider
+    assert by["original model cross-check: 35 deg rudder to port held, deep water: steady rate of turn"]["paper"] < 0
     for f in ("esso_turning_track.png", "mss-tanker_turning_track.png", "mss-tanker_10_10_zigzag.png"):
         assert (tmp_path / "out" / f).stat().st_size > 10_000
 
