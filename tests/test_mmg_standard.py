@@ -155,6 +155,23 @@ def test_experiment_rows(tmp_path, kv_trials):
     assert sum("open-source MMG" in r["quantity"] for r in rows) == 4
 
 
+def test_published_rows_show_the_gap_and_a_reason_beyond_5_percent(monkeypatch, kv_trials):
+    """The mechanics of PUBLISHED / WHY_NOT with stand-in values (not published numbers): a
+    turning quantity more than 5 % off needs a reason in the note, else the experiment stops."""
+    from steerlab.experiments import kvlcc2_validation as kv
+
+    full, model = kv_trials
+    s = full["nd"]["advance_starboard"]
+    monkeypatch.setattr(kv, "PUBLISHED", {"advance_starboard": (s / 1.02, "stand-in source A")})
+    row = kv.comparison_rows(full, model)[0]
+    assert row["paper"] == pytest.approx(s / 1.02) and "stand-in source A; gap +2.0 %" in row["note"]
+    monkeypatch.setattr(kv, "PUBLISHED", {"advance_starboard": (s / 1.10, "stand-in source B")})
+    with pytest.raises(ValueError, match="WHY_NOT"):
+        kv.comparison_rows(full, model)
+    monkeypatch.setattr(kv, "WHY_NOT", {"advance_starboard": "stand-in reason"})
+    assert kv.comparison_rows(full, model)[0]["note"].endswith("not reproduced within 5 %: stand-in reason")
+
+
 # ------------------------------------------------------------------ bad input
 
 GOOD = (ms.resources.files("steerlab.ships") / "data" / "mmgstd_kvlcc2.toml").read_text(encoding="utf-8")
