@@ -288,6 +288,30 @@ def test_mss_tanker_kernel_equals_an_independent_rederivation_of_the_published_e
     assert tr.accelerations(8.0, 2.0, 0.003, 0.3, 1.3, beta_form="ratio") != tr.accelerations(8.0, 2.0, 0.003, 0.3, 1.3)
 
 
+def test_the_four_planar_kernels_share_one_start():
+    """kinematics.planar_start: track rates (current included), psi' = r, d = delta + equivalent
+    rudder; esso, mmg, mmg_standard and mss_tanker call it (one definition of the preamble)."""
+    import inspect
+
+    from steerlab.environment.channels import W_CURRENT_E, W_CURRENT_N, W_RUDDER
+    from steerlab.ships import kinematics
+    from steerlab.ships.state import IPSI, IX, IY
+
+    x = np.array([5.0, 7.0, math.radians(30.0), 4.0, -0.5, 0.01])
+    w = np.zeros(N_CHANNELS)
+    w[W_RUDDER], w[W_CURRENT_N], w[W_CURRENT_E] = 0.02, 0.3, -0.2
+    dx = np.zeros(6)
+    psi, u, v, r, d = kinematics.planar_start(x, 0.1, w, dx)
+    assert (psi, u, v, r) == (x[2], 4.0, -0.5, 0.01) and d == 0.1 + 0.02
+    c, s = math.cos(x[2]), math.sin(x[2])
+    assert dx[IX] == pytest.approx(4.0 * c + 0.5 * s + 0.3, rel=1e-14)
+    assert dx[IY] == pytest.approx(4.0 * s - 0.5 * c - 0.2, rel=1e-14)
+    assert dx[IPSI] == 0.01
+    for kernel in (esso_3dof.esso_rhs, mmg.mmg_rhs, ms.mmgstd_rhs, mt.tanker_rhs):
+        src = inspect.getsource(kernel.py_func)
+        assert "planar_start(x, delta, w, dx)" in src and "earth_velocity" not in src, kernel
+
+
 # ------------------------------------------------------------------ Kosoko: slipstream refusal
 
 def test_kosoko_slipstream_that_would_drive_the_turn_astern_is_refused():

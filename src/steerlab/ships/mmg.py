@@ -61,7 +61,7 @@ import numpy as np
 from pydantic import Field, ValidationError, field_validator
 
 from steerlab.config_base import FrozenConfig
-from steerlab.environment.channels import (W_CURRENT_E, W_CURRENT_N, W_RUDDER, W_WIND_DIR,
+from steerlab.environment.channels import (W_CURRENT_E, W_CURRENT_N, W_WIND_DIR,
                                            W_WIND_SPEED, W_YAW_MOMENT)
 from steerlab.environment.wind_fujiwara import (RHO_AIR, WindGeometry, fujiwara_coefficients,
                                                 relative_wind, wind_force)
@@ -70,9 +70,9 @@ from steerlab.ships.clarke import (ClarkeDerivatives, PrimeMass, clarke_derivati
                                    prime_mass, state_space_eq10)
 from steerlab.records import Field as RecordField
 from steerlab.records import Layout
-from steerlab.ships.kinematics import earth_velocity
+from steerlab.ships.kinematics import planar_start
 from steerlab.ships.rpm_schedule import RATE, check_rpm_schedule, pack_with_rate, scheduled_rate
-from steerlab.ships.state import IPSI, IR, IU, IV, N_PLANAR, PLANAR_NAMES, PLANAR_UNITS
+from steerlab.ships.state import IR, IU, IV, N_PLANAR, PLANAR_NAMES, PLANAR_UNITS
 from steerlab.sincos import sincos
 
 # ---------------------------------------------------------------------------------------------
@@ -385,17 +385,11 @@ def mmg_rhs(t, x, delta, w, p, dx):
     dx : ndarray
         Output derivatives.
     """
-    psi = x[IPSI]
-    u = x[IU]
-    v = x[IV]
-    r = x[IR]
-    d = delta + w[W_RUDDER]
+    psi, u, v, r, d = planar_start(x, delta, w, dx)
     # current (north, east components) in body axes
     sp, cp = sincos(psi)
     uc = w[W_CURRENT_N] * cp + w[W_CURRENT_E] * sp
     vcb = w[W_CURRENT_E] * cp - w[W_CURRENT_N] * sp
-    earth_velocity(psi, u, v, w, dx)
-    dx[IPSI] = r
     U = math.sqrt(u * u + v * v)
     # propeller
     n = propeller_rate(t, p)

@@ -56,12 +56,12 @@ import numpy as np
 from pydantic import Field, ValidationError
 
 from steerlab.config_base import FrozenConfig
-from steerlab.environment.channels import W_RUDDER, W_YAW_MOMENT
+from steerlab.environment.channels import W_YAW_MOMENT
 from steerlab.errors import InputError
 from steerlab.records import Field as RecordField
 from steerlab.records import Layout
-from steerlab.ships.kinematics import earth_velocity
-from steerlab.ships.state import IPSI, IR, IU, IV, N_PLANAR, PLANAR_NAMES, PLANAR_UNITS
+from steerlab.ships.kinematics import planar_start
+from steerlab.ships.state import IR, IU, IV, N_PLANAR, PLANAR_NAMES, PLANAR_UNITS
 from steerlab.sincos import sincos
 from steerlab.vecmath import atan2, exp_neg
 
@@ -312,13 +312,7 @@ def mmgstd_rhs(t, x, delta, w, p, dx):
     dx : ndarray
         Output derivatives.
     """
-    psi = x[IPSI]
-    u = x[IU]
-    v = x[IV]
-    r = x[IR]
-    d = delta + w[W_RUDDER]
-    earth_velocity(psi, u, v, w, dx)
-    dx[IPSI] = r
+    _psi, u, v, r, d = planar_start(x, delta, w, dx)
     L = p[P_L]
     U2 = u * u + v * v
     U = math.sqrt(U2)
