@@ -46,6 +46,8 @@ import numba
 import numpy as np
 
 from steerlab.errors import require_finite_range
+from steerlab.sincos import sincos
+from steerlab.vecmath import atan2
 
 RHO_AIR = 1.226
 """Air density [kg/m^3] (15 degC, sea level)."""
@@ -111,6 +113,17 @@ def fujiwara_coefficients(g: WindGeometry) -> np.ndarray:
     return np.array([X0, X1, X3, X5, Y1, Y3, Y5, N1, N2, N3], dtype=np.float64)
 
 
+@numba.njit(cache=True, inline="always")
+def _eq13(c, o, ca, c3, c5, sa, s2, s3, s5):
+    """Eq (13) from the trigonometric values of the attack angle: the one definition both
+    :func:`wind_coefficients` (C library) and :func:`wind_force_arith` (plain arithmetic) use;
+    the ten coefficients are ``c[o:o + 10]``."""
+    cx = c[o] + c[o + 1] * ca + c[o + 2] * c3 + c[o + 3] * c5
+    cy = c[o + 4] * sa + c[o + 5] * s3 + c[o + 6] * s5
+    cn = c[o + 7] * sa + c[o + 8] * s2 + c[o + 9] * s3
+    return cx, cy, cn
+
+
 @numba.njit(cache=True)
 def wind_coefficients(c, alpha):
     """Eq (13): ``(C_wx, C_wy, C_wn)`` at Fujiwara's attack angle ``alpha`` [rad].
@@ -118,10 +131,8 @@ def wind_coefficients(c, alpha):
     ``c`` holds the ten coefficients of :func:`fujiwara_coefficients` (in that order)
     starting at index 0 (a view may be passed).
     """
-    cx = c[0] + c[1] * math.cos(alpha) + c[2] * math.cos(3.0 * alpha) + c[3] * math.cos(5.0 * alpha)
-    cy = c[4] * math.sin(alpha) + c[5] * math.sin(3.0 * alpha) + c[6] * math.sin(5.0 * alpha)
-    cn = c[7] * math.sin(alpha) + c[8] * math.sin(2.0 * alpha) + c[9] * math.sin(3.0 * alpha)
-    return cx, cy, cn
+    return _eq13(c, 0, math.cos(alpha), math.cos(3.0 * alpha), math.cos(5.0 * alpha), math.sin(alpha),
+                 math.sin(2.0 * alpha), math.sin(3.0 * alpha), math.sin(5.0 * alpha))
 
 
 @numba.njit(cache=True)
@@ -148,10 +159,39 @@ def relative_wind(u_g, v_g, psi, wind_speed, wind_from):
         +pi/2 from starboard), in (-pi, pi].
     """
     rel = wind_from - psi
-    # air velocity (moving towards wind_from + pi) in body axes, minus the ship's
-    ua = -wind_speed * math.cos(rel) - u_g
-    va = -wind_speed * math.sin(rel) - v_g
+    ua, va = _air_velocity(math.sin(rel), math.cos(rel), u_g, v_g, wind_speed)
     return math.sqrt(ua * ua + va * va), math.atan2(-va, -ua)
+
+
+@numba.njit(cache=True, inline="always")
+def _air_velocity(s, c, u_g, v_g, wind_speed):
+    """Air velocity relative to the ship in body axes [m/s]: the wind (moving towards
+    ``wind_from + pi``; ``s, c`` = sin, cos of ``wind_from - psi``) minus the ship's velocity."""
+    return -wind_speed * c - u_g, -wind_speed * s - v_g
+
+
+@numba.njit(cache=True, inline="always")
+def relative_wind_arith(u_g, v_g, psi, wind_speed, wind_from):
+    """:func:`relative_wind` in plain arithmetic (:func:`steerlab.sincos.sincos`,
+    :func:`steerlab.vecmath.atan2`), for ship kernels that vectorise; a few units in the last
+    place from it (and ``psi_a = pi``, not ``-pi``, for a relative wind from dead astern)."""
+    s, c = sincos(wind_from - psi)
+    ua, va = _air_velocity(s, c, u_g, v_g, wind_speed)
+    return math.sqrt(ua * ua + va * va), atan2(-va, -ua)
+
+
+@numba.njit(cache=True, inline="always")
+def wind_force_arith(c, o, rho_a, A_F, A_L, L, U_R, psi_a):
+    """:func:`wind_force` in plain arithmetic: the ten coefficients at ``c[o:o + 10]``, the
+    trigonometric values of the attack angle from :func:`steerlab.sincos.sincos`."""
+    alpha = -psi_a
+    sa, ca = sincos(alpha)
+    s2, _ = sincos(2.0 * alpha)
+    s3, c3 = sincos(3.0 * alpha)
+    s5, c5 = sincos(5.0 * alpha)
+    cx, cy, cn = _eq13(c, o, ca, c3, c5, sa, s2, s3, s5)
+    q = 0.5 * rho_a * U_R * U_R
+    return q * A_F * cx, q * A_L * cy, q * A_L * L * cn
 
 
 @numba.njit(cache=True)

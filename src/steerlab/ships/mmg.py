@@ -64,7 +64,7 @@ from steerlab.config_base import FrozenConfig
 from steerlab.environment.channels import (W_CURRENT_E, W_CURRENT_N, W_WIND_DIR,
                                            W_WIND_SPEED, W_YAW_MOMENT)
 from steerlab.environment.wind_fujiwara import (RHO_AIR, WindGeometry, fujiwara_coefficients,
-                                                relative_wind, wind_force)
+                                                relative_wind_arith, wind_force_arith)
 from steerlab.errors import InputError
 from steerlab.ships.clarke import (ClarkeDerivatives, PrimeMass, clarke_derivatives, nomoto_KT_eq11,
                                    prime_mass, state_space_eq10)
@@ -360,7 +360,7 @@ def pack(data: MMGShipData, n_rps: float, schedule=()) -> np.ndarray:
 # kernels
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def propeller_rate(t, p):
     """Propeller rate [rev/s] at time ``t`` [s]: constant, or the schedule (:mod:`~steerlab.ships.rpm_schedule`)."""
     return scheduled_rate(t, p, P_NCONST)
@@ -385,6 +385,36 @@ def mmg_rhs(t, x, delta, w, p, dx):
     dx : ndarray
         Output derivatives.
     """
+    _mmg_derivatives(x, delta, w, p, dx, propeller_rate(t, p))
+
+
+@numba.njit(cache=True)
+def mmg_rhs_constant_rate(t, x, delta, w, p, dx):
+    """:func:`mmg_rhs` for a record without an rpm schedule (the constant rate ``rpm.n``).
+
+    The same derivatives (the same inlined body, so the same bits), without the schedule
+    look-up: that look-up loads from the record at an index computed from the data, which
+    keeps the compiler from vectorising the batch engine's loop over runs. A ship spec picks
+    this kernel when its options give no schedule (:func:`kernel_for_options`).
+    """
+    _mmg_derivatives(x, delta, w, p, dx, p[P_NCONST])
+
+
+def kernel_for_options(options):
+    """The kernel for validated ``[ship.options]``: :func:`mmg_rhs_constant_rate` without an
+    rpm schedule, :func:`mmg_rhs` with one."""
+    return mmg_rhs if (options is not None and options.rpm_schedule) else mmg_rhs_constant_rate
+
+
+@numba.njit(cache=True, inline="always")
+def _mmg_derivatives(x, delta, w, p, dx, n):
+    """The body of the MMG kernels at propeller rate ``n`` [rev/s] (arguments as :func:`mmg_rhs`).
+
+    Straight-line arithmetic and selects (``sin`` from :mod:`steerlab.sincos`, the wind from
+    :func:`~steerlab.environment.wind_fujiwara.relative_wind_arith` and
+    :func:`~steerlab.environment.wind_fujiwara.wind_force_arith`, computed always and selected
+    by ``wind speed > 0``), so that the batch engine can vectorise it.
+    """
     psi, u, v, r, d = planar_start(x, delta, w, dx)
     # current (north, east components) in body axes
     sp, cp = sincos(psi)
@@ -392,18 +422,17 @@ def mmg_rhs(t, x, delta, w, p, dx):
     vcb = w[W_CURRENT_E] * cp - w[W_CURRENT_N] * sp
     U = math.sqrt(u * u + v * v)
     # propeller
-    n = propeller_rate(t, p)
     D = p[P_DP]
     ua = (1.0 - p[P_WP]) * u
     tp = p[P_RHO] * (p[P_KT0] * n * abs(n) * D * D * D * D + p[P_KT1] * ua * n * D * D * D
                      + p[P_KT2] * ua * abs(ua) * D * D)
     # rudder inflow and forces
-    ur2 = U * U
-    if tp > 0.0:
-        ur2 += p[P_ETA] * (8.0 / math.pi) * tp / (p[P_RHO] * D * D)
+    slip = p[P_ETA] * (8.0 / math.pi) * tp / (p[P_RHO] * D * D)
+    ur2 = U * U + (slip if tp > 0.0 else 0.0)
     yr = p[P_YD] * ur2 * d
     nr = p[P_ND] * ur2 * d
-    xr = -p[P_XD] * ur2 * d * math.sin(d)
+    sd, _ = sincos(d)
+    xr = -p[P_XD] * ur2 * d * sd
     # cross-flow drag over N_STRIPS strips
     L = p[P_L]
     dxs = L / N_STRIPS
@@ -416,12 +445,12 @@ def mmg_rhs(t, x, delta, w, p, dx):
         ycf += f
         ncf += xs * f
     # wind on the relative wind (ship velocity over ground = water-relative + current)
-    xw = 0.0
-    yw = 0.0
-    nw = 0.0
-    if w[W_WIND_SPEED] > 0.0:
-        UR, psia = relative_wind(u + uc, v + vcb, psi, w[W_WIND_SPEED], w[W_WIND_DIR])
-        xw, yw, nw = wind_force(p[P_WC:P_WC + N_WC], p[P_RHOA], p[P_AF], p[P_AL], L, UR, psia)
+    UR, psia = relative_wind_arith(u + uc, v + vcb, psi, w[W_WIND_SPEED], w[W_WIND_DIR])
+    xw, yw, nw = wind_force_arith(p, P_WC, p[P_RHOA], p[P_AF], p[P_AL], L, UR, psia)
+    windy = w[W_WIND_SPEED] > 0.0
+    xw = xw if windy else 0.0
+    yw = yw if windy else 0.0
+    nw = nw if windy else 0.0
     m = p[P_M]
     mxc = p[P_MXC]
     X = p[P_XUU] * u * abs(u) + (1.0 - p[P_TP]) * tp + xr + xw + p[P_MY] * v * r + mxc * r * r
@@ -493,7 +522,8 @@ def _spec_for(data: MMGShipData):
         name=data.id, description=data.description, rhs=mmg_rhs, n_states=N_PLANAR,
         state_names=PLANAR_NAMES, state_units=PLANAR_UNITS, pack=spec_pack, b2_exact=b2_exact,
         dims=(data.hull.C_b, data.hull.L, data.hull.B), source=data.source, linearise=linearise,
-        options_model=MMGOptions, nomoto_KT=nomoto_KT, speed_range=tuple(data.speed_range_m_s))
+        options_model=MMGOptions, nomoto_KT=nomoto_KT, speed_range=tuple(data.speed_range_m_s),
+        kernel_for_options=kernel_for_options)
 
 
 def get_mmg_data(name: str) -> MMGShipData:
