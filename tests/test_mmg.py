@@ -346,3 +346,23 @@ def test_kosoko_batch_is_vectorised_and_bit_identical_to_single_runs():
         np.testing.assert_array_equal(batch.final_states[i], simulate_compiled(s).states[-1])
     report = vectorisation_report(setup.ship.rhs, setup.controller.update, setup.x0.size)
     assert report["vectorised_stages"] >= 4 and report["per_run_library_calls"] == []
+
+
+def test_plain_arithmetic_wind_is_the_library_wind_to_rounding():
+    """air_velocity_arith + wind_force_arith (no trigonometric call but one sincos; used by the
+    vectorising kernel) against relative_wind + wind_force (C library), every direction,
+    including calm air and dead astern."""
+    from steerlab.environment.wind_fujiwara import air_velocity_arith, wind_force_arith
+
+    c = fujiwara_coefficients(KOSOKO.wind_geometry())
+    rng = np.random.default_rng(11)
+    cases = [(rng.uniform(-1, 1), rng.uniform(-0.3, 0.3), rng.uniform(-4, 4), rng.uniform(0, 20), rng.uniform(-4, 4))
+             for _ in range(2000)] + [(0.5, 0.0, 0.0, 0.0, 0.0), (0.0, 0.0, 0.3, 0.0, 1.0), (0.5, 0.0, 0.0, 3.0, math.pi)]
+    for ug, vg, psi, ws, wf in cases:
+        UR, psia = relative_wind(ug, vg, psi, ws, wf)
+        ref = wind_force(c, 1.226, 0.233, 0.398, KOSOKO.hull.L, UR, psia)
+        ua, va = air_velocity_arith(ug, vg, psi, ws, wf)
+        got = wind_force_arith(c, 0, 1.226, 0.233, 0.398, KOSOKO.hull.L, ua, va)
+        scale = 0.5 * 1.226 * UR * UR * 0.398 * KOSOKO.hull.L * 2.0 + 1e-300
+        assert math.hypot(ua, va) == pytest.approx(UR, rel=1e-14, abs=1e-15)
+        np.testing.assert_allclose(got, ref, rtol=0, atol=1e-13 * scale)

@@ -64,7 +64,7 @@ from steerlab.config_base import FrozenConfig
 from steerlab.environment.channels import (W_CURRENT_E, W_CURRENT_N, W_WIND_DIR,
                                            W_WIND_SPEED, W_YAW_MOMENT)
 from steerlab.environment.wind_fujiwara import (RHO_AIR, WindGeometry, fujiwara_coefficients,
-                                                relative_wind_arith, wind_force_arith)
+                                                air_velocity_arith, wind_force_arith)
 from steerlab.errors import InputError
 from steerlab.ships.clarke import (ClarkeDerivatives, PrimeMass, clarke_derivatives, nomoto_KT_eq11,
                                    prime_mass, state_space_eq10)
@@ -411,7 +411,7 @@ def _mmg_derivatives(x, delta, w, p, dx, n):
     """The body of the MMG kernels at propeller rate ``n`` [rev/s] (arguments as :func:`mmg_rhs`).
 
     Straight-line arithmetic and selects (``sin`` from :mod:`steerlab.sincos`, the wind from
-    :func:`~steerlab.environment.wind_fujiwara.relative_wind_arith` and
+    :func:`~steerlab.environment.wind_fujiwara.air_velocity_arith` and
     :func:`~steerlab.environment.wind_fujiwara.wind_force_arith`, computed always and selected
     by ``wind speed > 0``), so that the batch engine can vectorise it.
     """
@@ -445,8 +445,8 @@ def _mmg_derivatives(x, delta, w, p, dx, n):
         ycf += f
         ncf += xs * f
     # wind on the relative wind (ship velocity over ground = water-relative + current)
-    UR, psia = relative_wind_arith(u + uc, v + vcb, psi, w[W_WIND_SPEED], w[W_WIND_DIR])
-    xw, yw, nw = wind_force_arith(p, P_WC, p[P_RHOA], p[P_AF], p[P_AL], L, UR, psia)
+    ua, va = air_velocity_arith(u + uc, v + vcb, psi, w[W_WIND_SPEED], w[W_WIND_DIR])
+    xw, yw, nw = wind_force_arith(p, P_WC, p[P_RHOA], p[P_AF], p[P_AL], L, ua, va)
     windy = w[W_WIND_SPEED] > 0.0
     xw = xw if windy else 0.0
     yw = yw if windy else 0.0
