@@ -82,9 +82,11 @@ def test_guided_batch_any_group_size_equals_single():
 
 
 def test_ship_with_branches_and_its_own_current_handling():
-    """MMG's kernel has branches and library calls (not vectorised): still the same numbers."""
+    """MMG's kernel with an rpm schedule reads the schedule at an index computed from the data
+    (not vectorised; without a schedule the set-up picks the kernel that is): still the same numbers."""
     runs = [build(scenario_from_dict({"dt": 0.2, "duration": 60.0, "seed": s,
-                                      "ship": {"model": "kosoko"},
+                                      "ship": {"model": "kosoko",
+                                               "options": {"rpm_schedule": [[0, 600], [30, 600], [30, 500]]}},
                                       "controller": {"type": "pid", "Kp": 2.0, "Ki": 0.0, "Kd": 20.0},
                                       "guidance": {"psi0_deg": 0.0, "changes": [{"t": 5.0, "psi_deg": 10.0}]},
                                       "environment": {"current_speed": 0.3 * s, "current_dir_deg": 45.0}}))

@@ -136,6 +136,49 @@ def test_bad_options_name_the_field(opts, msg):
     assert ei.value.field.split(".")[2] in opts
 
 
+KOSOKO_TOML = (__import__("importlib").resources.files("steerlab.ships") / "data" / "mmg_kosoko.toml").read_text(
+    encoding="utf-8")
+
+
+@pytest.mark.parametrize("line, repl, field, msg", [
+    ("C_b = 0.55", "C_b = nan", "hull.C_b", "finite"),                       # NaN
+    ("C_b = 0.55", "C_b = 1.5", "hull.C_b", "less than 1"),                  # out of range, bound named
+    ("D = 0.08 ", "", "propeller.D", "required"),                           # missing
+    ("w_p = 0.20", "w_p = inf", "propeller.w_p", "finite"),
+    ("kt = [0.30,", "kt = [nan,", "propeller.kt.0", "finite"),
+    ("kt = [0.30,", "kt = [-0.30,", "propeller.kt", r"K_T\(0\) must be > 0"),  # no bollard thrust
+    ("area = 0.0069", "area = 0.0", "rudder.area", "greater than 0"),
+    ("C = 0.104", "C = nan", "wind.C", "finite"),
+    ("speed_range_m_s = [0.05, 1.5]", "speed_range_m_s = [1.5, 0.05]", "speed_range_m_s", "lo < hi"),
+    ("speed_m_s = 0.5 ", "speed_m_s = 2.0 ", "design.speed_m_s", "outside the data's speed_range"),
+])
+def test_bad_kosoko_data_is_refused_naming_the_field(line, repl, field, msg):
+    """A missing, NaN or out-of-range coefficient of an MMG data file: one InputError naming the field."""
+    from steerlab.ships.mmg import load_mmg_data
+
+    assert line in KOSOKO_TOML
+    load_mmg_data(KOSOKO_TOML, "k.toml")                                     # the shipped file is valid
+    with pytest.raises(InputError, match=msg) as ei:
+        load_mmg_data(KOSOKO_TOML.replace(line, repl), "k.toml")
+    assert ei.value.field == f"k.toml: {field}" and "\n" not in str(ei.value)
+
+
+def test_kosoko_speed_outside_the_data_validity_is_refused():
+    """speed_range_m_s = [0.05, 1.5] m/s (model scale): 5 kn = 2.57 m/s is refused by the trials and
+    flagged in a scenario run, naming the speed field."""
+    from steerlab.trials.runner import TrialConditions
+
+    with pytest.raises(InputError, match="validity range") as ei:
+        TrialConditions(ship="kosoko", speed_kn=5.0).resolved()
+    assert ei.value.field == "speed_kn"
+    # a scenario run is allowed but flagged (a warning naming the field, written to metrics.json)
+    from steerlab.sim.sanity import scenario_warnings
+
+    flagged = scenario_warnings(scenario_from_dict({"ship": {"model": "kosoko", "speed_kn": 5.0}}))
+    assert any(w.startswith("ship.speed_kn") and "2.92 kn" in w for w in flagged), flagged
+    assert not scenario_warnings(scenario_from_dict({"ship": {"model": "kosoko", "speed_kn": 1.0}}))
+
+
 def test_rpm_and_schedule_together_is_an_error():
     with pytest.raises(InputError) as ei:
         build(scenario_from_dict({"ship": {"model": "kosoko", "speed_kn": 1.0, "rpm": 600.0,
@@ -254,3 +297,72 @@ def test_35deg_turn_is_bounded_and_loses_speed():
     assert 0.2 * U0 < u[-1] < 0.8 * U0                      # speed drop in the turn
     diameter = 2 * math.hypot(u[-1], res.states[-1, 4]) / r[-1]
     assert 1.0 < diameter / KOSOKO.hull.L < 5.0              # paper Table 3: 4.24 m / 1.667 m = 2.5 L
+
+
+# ------------------------------------------------------------------ batch: the Kosoko kernel vectorises
+
+def test_kernel_follows_the_rpm_schedule_option_and_both_give_the_same_bits():
+    """Without an rpm schedule the set-up picks mmg_rhs_constant_rate (no schedule look-up, so
+    it vectorises); with one, mmg_rhs. For a record without a schedule the two are one body."""
+    from steerlab.ships import mmg
+
+    const = build(scenario_from_dict({"ship": {"model": "kosoko", "speed_kn": 0.97}}))
+    sched = build(scenario_from_dict({"ship": {"model": "kosoko", "speed_kn": 0.97,
+                                               "options": {"rpm_schedule": [[0, 600], [5, 400]]}}}))
+    assert const.ship.rhs is mmg.mmg_rhs_constant_rate and sched.ship.rhs is mmg.mmg_rhs
+    assert get_ship("kosoko").rhs is mmg.mmg_rhs                  # the catalogue entry keeps the general one
+    rng = np.random.default_rng(7)
+    w = np.zeros(N_CHANNELS)
+    for _ in range(300):
+        x = rng.normal(size=6)
+        w[W_WIND_SPEED], w[W_WIND_DIR] = rng.choice([0.0, 2.0]), rng.normal()
+        a, b = np.zeros(6), np.zeros(6)
+        d = 0.3 * rng.normal()
+        mmg.mmg_rhs(3.0, x, d, w, const.ps, a)
+        mmg.mmg_rhs_constant_rate(3.0, x, d, w, const.ps, b)
+        np.testing.assert_array_equal(a, b)
+    # a scheduled record through the general kernel does follow the schedule (600 -> 400 rpm)
+    n_at = [propeller_rate(t, sched.ps) * 60.0 for t in (0.0, 2.5, 5.0, 9.0)]
+    assert n_at == pytest.approx([600.0, 500.0, 400.0, 400.0])
+
+
+@pytest.mark.skipif(not __import__("numba").config.LOOP_VECTORIZE, reason="numba's loop vectoriser is switched off")
+def test_kosoko_batch_is_vectorised_and_bit_identical_to_single_runs():
+    """With wind and current: the batch runs the Kosoko as vector arithmetic and run i of a
+    batch equals the same run alone, bit for bit."""
+    from steerlab.sim.batch import simulate_batch, vary_controller
+    from steerlab.sim.lanes import vectorisation_report
+
+    setup = build(scenario_from_dict({
+        "dt": 0.05, "duration": 20.0, "ship": {"model": "kosoko", "speed_kn": 0.97},
+        "controller": {"type": "pid", "Kp": 1.0, "Kd": 1.0, "Ki": 0.0},
+        "environment": {"wind_speed": 1.5, "wind_dir_deg": 45.0, "current_speed": 0.05},
+        "guidance": {"changes": [{"t": 2.0, "psi_deg": 20.0}]}}))
+    pcs = np.tile(setup.pc, (3, 1))
+    pcs[1, 0] *= 2.0
+    runs = vary_controller(setup, pcs)
+    batch = simulate_batch(runs)
+    for i, s in enumerate(runs):
+        np.testing.assert_array_equal(batch.final_states[i], simulate_compiled(s).states[-1])
+    report = vectorisation_report(setup.ship.rhs, setup.controller.update, setup.x0.size)
+    assert report["vectorised_stages"] >= 4 and report["per_run_library_calls"] == []
+
+
+def test_plain_arithmetic_wind_is_the_library_wind_to_rounding():
+    """air_velocity_arith + wind_force_arith (no trigonometric call but one sincos; used by the
+    vectorising kernel) against relative_wind + wind_force (C library), every direction,
+    including calm air and dead astern."""
+    from steerlab.environment.wind_fujiwara import air_velocity_arith, wind_force_arith
+
+    c = fujiwara_coefficients(KOSOKO.wind_geometry())
+    rng = np.random.default_rng(11)
+    cases = [(rng.uniform(-1, 1), rng.uniform(-0.3, 0.3), rng.uniform(-4, 4), rng.uniform(0, 20), rng.uniform(-4, 4))
+             for _ in range(2000)] + [(0.5, 0.0, 0.0, 0.0, 0.0), (0.0, 0.0, 0.3, 0.0, 1.0), (0.5, 0.0, 0.0, 3.0, math.pi)]
+    for ug, vg, psi, ws, wf in cases:
+        UR, psia = relative_wind(ug, vg, psi, ws, wf)
+        ref = wind_force(c, 1.226, 0.233, 0.398, KOSOKO.hull.L, UR, psia)
+        ua, va = air_velocity_arith(ug, vg, psi, ws, wf)
+        got = wind_force_arith(c, 0, 1.226, 0.233, 0.398, KOSOKO.hull.L, ua, va)
+        scale = 0.5 * 1.226 * UR * UR * 0.398 * KOSOKO.hull.L * 2.0 + 1e-300
+        assert math.hypot(ua, va) == pytest.approx(UR, rel=1e-14, abs=1e-15)
+        np.testing.assert_allclose(got, ref, rtol=0, atol=1e-13 * scale)

@@ -155,6 +155,23 @@ def test_experiment_rows(tmp_path, kv_trials):
     assert sum("open-source MMG" in r["quantity"] for r in rows) == 4
 
 
+def test_published_rows_show_the_gap_and_a_reason_beyond_5_percent(monkeypatch, kv_trials):
+    """The mechanics of PUBLISHED / WHY_NOT with stand-in values (not published numbers): a
+    turning quantity more than 5 % off needs a reason in the note, else the experiment stops."""
+    from steerlab.experiments import kvlcc2_validation as kv
+
+    full, model = kv_trials
+    s = full["nd"]["advance_starboard"]
+    monkeypatch.setattr(kv, "PUBLISHED", {"advance_starboard": (s / 1.02, "stand-in source A")})
+    row = kv.comparison_rows(full, model)[0]
+    assert row["paper"] == pytest.approx(s / 1.02) and "stand-in source A; gap +2.0 %" in row["note"]
+    monkeypatch.setattr(kv, "PUBLISHED", {"advance_starboard": (s / 1.10, "stand-in source B")})
+    with pytest.raises(ValueError, match="WHY_NOT"):
+        kv.comparison_rows(full, model)
+    monkeypatch.setattr(kv, "WHY_NOT", {"advance_starboard": "stand-in reason"})
+    assert kv.comparison_rows(full, model)[0]["note"].endswith("not reproduced within 5 %: stand-in reason")
+
+
 # ------------------------------------------------------------------ bad input
 
 GOOD = (ms.resources.files("steerlab.ships") / "data" / "mmgstd_kvlcc2.toml").read_text(encoding="utf-8")
@@ -246,6 +263,55 @@ def test_mss_tanker_shallow_water_turns_wider():
     assert deep < h25 < h20 and h20 > 4 * deep
 
 
+def test_mss_tanker_kernel_equals_an_independent_rederivation_of_the_published_equations():
+    """tanker_rhs (steerlab sign, packed record) vs the plain-Python transcription of MSS tanker.m's
+    equations (MSS sign) at random states, deep and shallow water (both sides of z = 0.8)."""
+    from steerlab.environment.channels import N_CHANNELS
+    from steerlab.experiments import tanker_reference as tr
+
+    rng = np.random.default_rng(16)
+    w = np.zeros(N_CHANNELS)
+    for depth in (None, 60.0, 25.0, 20.0):
+        p_by_n = {}
+        for _ in range(100):
+            u, v, r = rng.uniform(1.0, 9.0), rng.uniform(-2.0, 2.0), rng.uniform(-0.01, 0.01)
+            d, n = rng.uniform(-0.6, 0.6), round(rng.uniform(0.3, 1.4), 2)
+            p = p_by_n.setdefault(n, mt.pack(n, depth_m=depth))
+            x = np.zeros(mt.N_STATES)
+            x[mt.IU], x[mt.IV], x[mt.IR] = u, v, r
+            dx = np.zeros(mt.N_STATES)
+            mt.tanker_rhs(0.0, x, d, w, p, dx)
+            ref = tr.accelerations(u, v, r, -d, n, depth)
+            np.testing.assert_allclose(dx[mt.IU:mt.IR + 1], ref, rtol=1e-11, atol=1e-16)
+    # the two drift-angle forms differ only through beta: equal with v = 0, not with drift
+    assert tr.accelerations(8.0, 0.0, 0.003, 0.3, 1.3, beta_form="ratio") == tr.accelerations(8.0, 0.0, 0.003, 0.3, 1.3)
+    assert tr.accelerations(8.0, 2.0, 0.003, 0.3, 1.3, beta_form="ratio") != tr.accelerations(8.0, 2.0, 0.003, 0.3, 1.3)
+
+
+def test_the_four_planar_kernels_share_one_start():
+    """kinematics.planar_start: track rates (current included), psi' = r, d = delta + equivalent
+    rudder; esso, mmg, mmg_standard and mss_tanker call it (one definition of the preamble)."""
+    import inspect
+
+    from steerlab.environment.channels import W_CURRENT_E, W_CURRENT_N, W_RUDDER
+    from steerlab.ships import kinematics
+    from steerlab.ships.state import IPSI, IX, IY
+
+    x = np.array([5.0, 7.0, math.radians(30.0), 4.0, -0.5, 0.01])
+    w = np.zeros(N_CHANNELS)
+    w[W_RUDDER], w[W_CURRENT_N], w[W_CURRENT_E] = 0.02, 0.3, -0.2
+    dx = np.zeros(6)
+    psi, u, v, r, d = kinematics.planar_start(x, 0.1, w, dx)
+    assert (psi, u, v, r) == (x[2], 4.0, -0.5, 0.01) and d == 0.1 + 0.02
+    c, s = math.cos(x[2]), math.sin(x[2])
+    assert dx[IX] == pytest.approx(4.0 * c + 0.5 * s + 0.3, rel=1e-14)
+    assert dx[IY] == pytest.approx(4.0 * s - 0.5 * c - 0.2, rel=1e-14)
+    assert dx[IPSI] == 0.01
+    for kernel in (esso_3dof.esso_rhs, mmg._mmg_derivatives, ms.mmgstd_rhs, mt.tanker_rhs):
+        src = inspect.getsource(kernel.py_func)
+        assert "planar_start(x, delta, w, dx)" in src and "earth_velocity" not in src, kernel
+
+
 # ------------------------------------------------------------------ Kosoko: slipstream refusal
 
 def test_kosoko_slipstream_that_would_drive_the_turn_astern_is_refused():
@@ -280,6 +346,18 @@ def test_esso_models_experiment(tmp_path):
         by["35 deg turn to starboard: advance / L"]["paper"], rel=1e-9)
     assert by["35 deg turn to port: advance / L"]["steerlab"] != pytest.approx(
         by["35 deg turn to starboard: advance / L"]["steerlab"], rel=1e-3)
+    # cross-check rows: the kernel = the independent re-derivation (to rounding), the PVS beta form is not
+    cross = [r for r in rows if r["quantity"].startswith("original model cross-check")]
+    assert len(cross) == len(em.CROSS_CHECKS) == 6
+    for r in cross:
+        assert "80 rpm" in r["note"] and "rudder held" in r["note"]
+        if "PythonVehicleSimulator's beta" in r["quantity"]:
+            assert r["steerlab"] / r["paper"] == pytest.approx(0.972, abs=0.005)
+        else:
+            assert r["steerlab"] == pytest.approx(r["paper"], rel=1e-10)
+    steady20 = by["original model cross-check: 20 deg rudder held, deep water: steady turning diameter / L"]
+    assert steady20["paper"] == pytest.approx(2.95, abs=0.01)          # as test_mss_tanker_shallow_water_turns_wider
+    assert by["original model cross-check: 35 deg rudder to port held, deep water: steady rate of turn"]["paper"] < 0
     for f in ("esso_turning_track.png", "mss-tanker_turning_track.png", "mss-tanker_10_10_zigzag.png"):
         assert (tmp_path / "out" / f).stat().st_size > 10_000
 

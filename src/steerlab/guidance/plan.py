@@ -66,7 +66,7 @@ def propeller_slot(ship, ps: np.ndarray) -> int:
     """
     from steerlab.ships import mmg
 
-    if ship.rhs is not mmg.mmg_rhs:
+    if ship.rhs not in (mmg.mmg_rhs, mmg.mmg_rhs_constant_rate):
         raise InputError("guidance.type", f"berthing orders the propeller rate; ship {ship.name!r} has no "
                                           "rpm input (use an MMG ship, e.g. kosoko, or type = 'los')")
     if int(ps[mmg.PARAMS.index("rpm.n_points")]) != 0:

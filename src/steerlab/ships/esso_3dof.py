@@ -40,10 +40,9 @@ from typing import NamedTuple
 import numba
 import numpy as np
 
-from steerlab.environment.channels import W_RUDDER
 from steerlab.records import Field, Layout
-from steerlab.ships.kinematics import earth_velocity
-from steerlab.ships.state import IPSI, IR, IU, IV, N_PLANAR, PLANAR_NAMES, PLANAR_UNITS
+from steerlab.ships.kinematics import planar_start
+from steerlab.ships.state import IR, IU, IV, N_PLANAR, PLANAR_NAMES, PLANAR_UNITS
 
 
 class EssoTable2(NamedTuple):
@@ -155,14 +154,8 @@ def esso_rhs(t, x, delta, w, p, dx):
     dx : ndarray
         Output derivatives.
     """
-    psi = x[IPSI]
-    u = x[IU]
-    v = x[IV]
-    r = x[IR]
-    d = delta + w[W_RUDDER]
+    psi, u, v, r, d = planar_start(x, delta, w, dx)
     au = abs(u)
-    earth_velocity(psi, u, v, w, dx)
-    dx[IPSI] = r
     n = p[P_N]
     u2d = u * u * d
     dx[IU] = p[P_XVR] * v * r + p[P_XUU] * au * u + p[P_THRUST] * n * n

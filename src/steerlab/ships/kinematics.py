@@ -18,8 +18,8 @@ branches), so that the batch engine can vectorise this kernel across runs.
 
 import numba
 
-from steerlab.environment.channels import W_CURRENT_E, W_CURRENT_N
-from steerlab.ships.state import IX, IY
+from steerlab.environment.channels import W_CURRENT_E, W_CURRENT_N, W_RUDDER
+from steerlab.ships.state import IPSI, IR, IU, IV, IX, IY
 from steerlab.sincos import sincos
 
 
@@ -29,3 +29,21 @@ def earth_velocity(psi, u, v, w, dx):
     s, c = sincos(psi)
     dx[IX] = (u * c - v * s) + w[W_CURRENT_N]
     dx[IY] = (u * s + v * c) + w[W_CURRENT_E]
+
+
+@numba.njit(cache=True, inline="always")
+def planar_start(x, delta, w, dx):
+    """The start every 3-DOF ship kernel shares (``esso``, ``mmg``, ``mmg_standard``, ``mss_tanker``).
+
+    Reads ``psi, u, v, r`` from the planar state, writes the track rates (:func:`earth_velocity`)
+    and ``dx[IPSI] = r``, and returns ``(psi, u, v, r, d)`` with ``d = delta + w[W_RUDDER]`` [rad],
+    the rudder angle plus the equivalent rudder of the disturbance row (steerlab sign). Inlined
+    into each kernel, so it costs nothing and the arithmetic is the kernels' own.
+    """
+    psi = x[IPSI]
+    u = x[IU]
+    v = x[IV]
+    r = x[IR]
+    earth_velocity(psi, u, v, w, dx)
+    dx[IPSI] = r
+    return psi, u, v, r, delta + w[W_RUDDER]

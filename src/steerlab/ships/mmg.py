@@ -61,18 +61,18 @@ import numpy as np
 from pydantic import Field, ValidationError, field_validator
 
 from steerlab.config_base import FrozenConfig
-from steerlab.environment.channels import (W_CURRENT_E, W_CURRENT_N, W_RUDDER, W_WIND_DIR,
+from steerlab.environment.channels import (W_CURRENT_E, W_CURRENT_N, W_WIND_DIR,
                                            W_WIND_SPEED, W_YAW_MOMENT)
 from steerlab.environment.wind_fujiwara import (RHO_AIR, WindGeometry, fujiwara_coefficients,
-                                                relative_wind, wind_force)
+                                                air_velocity_arith, wind_force_arith)
 from steerlab.errors import InputError
 from steerlab.ships.clarke import (ClarkeDerivatives, PrimeMass, clarke_derivatives, nomoto_KT_eq11,
                                    prime_mass, state_space_eq10)
 from steerlab.records import Field as RecordField
 from steerlab.records import Layout
-from steerlab.ships.kinematics import earth_velocity
+from steerlab.ships.kinematics import planar_start
 from steerlab.ships.rpm_schedule import RATE, check_rpm_schedule, pack_with_rate, scheduled_rate
-from steerlab.ships.state import IPSI, IR, IU, IV, N_PLANAR, PLANAR_NAMES, PLANAR_UNITS
+from steerlab.ships.state import IR, IU, IV, N_PLANAR, PLANAR_NAMES, PLANAR_UNITS
 from steerlab.sincos import sincos
 
 # ---------------------------------------------------------------------------------------------
@@ -180,8 +180,15 @@ def load_mmg_data(text: str, name: str = "ship data") -> MMGShipData:
     except tomllib.TOMLDecodeError as err:
         raise InputError(name, f"malformed TOML: {err}") from None
     except ValidationError as err:
-        first = err.errors()[0]
-        raise InputError(f"{name}: " + ".".join(str(p) for p in first["loc"]), first["msg"]) from None
+        raise data_error(name, err) from None
+    if data.propeller.kt[0] <= 0.0:
+        raise InputError(f"{name}: propeller.kt", f"k0 = K_T(0) must be > 0 (got {data.propeller.kt[0]})")
+    lo, hi = data.speed_range_m_s
+    if not (0.0 <= lo < hi):
+        raise InputError(f"{name}: speed_range_m_s", f"must be [lo, hi] with 0 <= lo < hi (got [{lo}, {hi}])")
+    if not (lo <= data.design.speed_m_s <= hi):
+        raise InputError(f"{name}: design.speed_m_s", f"{data.design.speed_m_s} m/s is outside the data's "
+                                                      f"speed_range_m_s [{lo}, {hi}]")
     if data.rudder.slipstream > 0.0:
         R = slipstream_drag_ratio(data)
         if R > 1.0:
@@ -192,6 +199,16 @@ def load_mmg_data(text: str, name: str = "ship data") -> MMGShipData:
                 f"with D = {data.propeller.D} m), which drives a hard-over turn astern; allowed only when that "
                 f"ratio is <= 1 (see steerlab.ships.mmg.slipstream_drag_ratio)")
     return data
+
+
+def data_error(name: str, err: ValidationError) -> InputError:
+    """The :class:`InputError` for the first problem pydantic found in ship data file ``name``:
+    the field's dotted path, the message and, for a bound, the allowed range."""
+    first = err.errors()[0]
+    ctx = first.get("ctx") or {}
+    bounds = [f"{k.replace('_', ' ')} {v}" for k, v in ctx.items() if k in ("gt", "ge", "lt", "le")]
+    msg = first["msg"] + (f" (allowed: {', '.join(bounds)})" if bounds else "")
+    return InputError(f"{name}: " + ".".join(str(p) for p in first["loc"]), msg)
 
 
 def shipped_data_files(prefix: str) -> list:
@@ -343,7 +360,7 @@ def pack(data: MMGShipData, n_rps: float, schedule=()) -> np.ndarray:
 # kernels
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def propeller_rate(t, p):
     """Propeller rate [rev/s] at time ``t`` [s]: constant, or the schedule (:mod:`~steerlab.ships.rpm_schedule`)."""
     return scheduled_rate(t, p, P_NCONST)
@@ -368,31 +385,54 @@ def mmg_rhs(t, x, delta, w, p, dx):
     dx : ndarray
         Output derivatives.
     """
-    psi = x[IPSI]
-    u = x[IU]
-    v = x[IV]
-    r = x[IR]
-    d = delta + w[W_RUDDER]
+    _mmg_derivatives(x, delta, w, p, dx, propeller_rate(t, p))
+
+
+@numba.njit(cache=True)
+def mmg_rhs_constant_rate(t, x, delta, w, p, dx):
+    """:func:`mmg_rhs` for a record without an rpm schedule (the constant rate ``rpm.n``).
+
+    The same derivatives (the same inlined body, so the same bits), without the schedule
+    look-up: that look-up loads from the record at an index computed from the data, which
+    keeps the compiler from vectorising the batch engine's loop over runs. A ship spec picks
+    this kernel when its options give no schedule (:func:`kernel_for_options`).
+    """
+    _mmg_derivatives(x, delta, w, p, dx, p[P_NCONST])
+
+
+def kernel_for_options(options):
+    """The kernel for validated ``[ship.options]``: :func:`mmg_rhs_constant_rate` without an
+    rpm schedule, :func:`mmg_rhs` with one."""
+    return mmg_rhs if (options is not None and options.rpm_schedule) else mmg_rhs_constant_rate
+
+
+@numba.njit(cache=True, inline="always")
+def _mmg_derivatives(x, delta, w, p, dx, n):
+    """The body of the MMG kernels at propeller rate ``n`` [rev/s] (arguments as :func:`mmg_rhs`).
+
+    Straight-line arithmetic and selects (``sin`` from :mod:`steerlab.sincos`, the wind from
+    :func:`~steerlab.environment.wind_fujiwara.air_velocity_arith` and
+    :func:`~steerlab.environment.wind_fujiwara.wind_force_arith`, computed always and selected
+    by ``wind speed > 0``), so that the batch engine can vectorise it.
+    """
+    psi, u, v, r, d = planar_start(x, delta, w, dx)
     # current (north, east components) in body axes
     sp, cp = sincos(psi)
     uc = w[W_CURRENT_N] * cp + w[W_CURRENT_E] * sp
     vcb = w[W_CURRENT_E] * cp - w[W_CURRENT_N] * sp
-    earth_velocity(psi, u, v, w, dx)
-    dx[IPSI] = r
     U = math.sqrt(u * u + v * v)
     # propeller
-    n = propeller_rate(t, p)
     D = p[P_DP]
     ua = (1.0 - p[P_WP]) * u
     tp = p[P_RHO] * (p[P_KT0] * n * abs(n) * D * D * D * D + p[P_KT1] * ua * n * D * D * D
                      + p[P_KT2] * ua * abs(ua) * D * D)
     # rudder inflow and forces
-    ur2 = U * U
-    if tp > 0.0:
-        ur2 += p[P_ETA] * (8.0 / math.pi) * tp / (p[P_RHO] * D * D)
+    slip = p[P_ETA] * (8.0 / math.pi) * tp / (p[P_RHO] * D * D)
+    ur2 = U * U + (slip if tp > 0.0 else 0.0)
     yr = p[P_YD] * ur2 * d
     nr = p[P_ND] * ur2 * d
-    xr = -p[P_XD] * ur2 * d * math.sin(d)
+    sd, _ = sincos(d)
+    xr = -p[P_XD] * ur2 * d * sd
     # cross-flow drag over N_STRIPS strips
     L = p[P_L]
     dxs = L / N_STRIPS
@@ -405,12 +445,12 @@ def mmg_rhs(t, x, delta, w, p, dx):
         ycf += f
         ncf += xs * f
     # wind on the relative wind (ship velocity over ground = water-relative + current)
-    xw = 0.0
-    yw = 0.0
-    nw = 0.0
-    if w[W_WIND_SPEED] > 0.0:
-        UR, psia = relative_wind(u + uc, v + vcb, psi, w[W_WIND_SPEED], w[W_WIND_DIR])
-        xw, yw, nw = wind_force(p[P_WC:P_WC + N_WC], p[P_RHOA], p[P_AF], p[P_AL], L, UR, psia)
+    ua, va = air_velocity_arith(u + uc, v + vcb, psi, w[W_WIND_SPEED], w[W_WIND_DIR])
+    xw, yw, nw = wind_force_arith(p, P_WC, p[P_RHOA], p[P_AF], p[P_AL], L, ua, va)
+    windy = w[W_WIND_SPEED] > 0.0
+    xw = xw if windy else 0.0
+    yw = yw if windy else 0.0
+    nw = nw if windy else 0.0
     m = p[P_M]
     mxc = p[P_MXC]
     X = p[P_XUU] * u * abs(u) + (1.0 - p[P_TP]) * tp + xr + xw + p[P_MY] * v * r + mxc * r * r
@@ -482,7 +522,8 @@ def _spec_for(data: MMGShipData):
         name=data.id, description=data.description, rhs=mmg_rhs, n_states=N_PLANAR,
         state_names=PLANAR_NAMES, state_units=PLANAR_UNITS, pack=spec_pack, b2_exact=b2_exact,
         dims=(data.hull.C_b, data.hull.L, data.hull.B), source=data.source, linearise=linearise,
-        options_model=MMGOptions, nomoto_KT=nomoto_KT, speed_range=tuple(data.speed_range_m_s))
+        options_model=MMGOptions, nomoto_KT=nomoto_KT, speed_range=tuple(data.speed_range_m_s),
+        kernel_for_options=kernel_for_options)
 
 
 def get_mmg_data(name: str) -> MMGShipData:

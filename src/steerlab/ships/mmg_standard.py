@@ -56,12 +56,12 @@ import numpy as np
 from pydantic import Field, ValidationError
 
 from steerlab.config_base import FrozenConfig
-from steerlab.environment.channels import W_RUDDER, W_YAW_MOMENT
+from steerlab.environment.channels import W_YAW_MOMENT
 from steerlab.errors import InputError
 from steerlab.records import Field as RecordField
 from steerlab.records import Layout
-from steerlab.ships.kinematics import earth_velocity
-from steerlab.ships.state import IPSI, IR, IU, IV, N_PLANAR, PLANAR_NAMES, PLANAR_UNITS
+from steerlab.ships.kinematics import planar_start
+from steerlab.ships.state import IR, IU, IV, N_PLANAR, PLANAR_NAMES, PLANAR_UNITS
 from steerlab.sincos import sincos
 from steerlab.vecmath import atan2, exp_neg
 
@@ -146,11 +146,9 @@ def load_mmgstd_data(text: str, name: str = "ship data") -> MMGStdShipData:
     try:
         data = MMGStdShipData.model_validate(raw)
     except ValidationError as err:
-        first = err.errors()[0]
-        ctx = first.get("ctx") or {}
-        bounds = [f"{k.replace('_', ' ')} {v}" for k, v in ctx.items() if k in ("gt", "ge", "lt", "le")]
-        msg = first["msg"] + (f" (allowed: {', '.join(bounds)})" if bounds else "")
-        raise InputError(f"{name}: " + ".".join(str(p) for p in first["loc"]), msg) from None
+        from steerlab.ships.mmg import data_error
+
+        raise data_error(name, err) from None
     if not all(math.isfinite(k) for k in data.propeller.kt):
         raise InputError(f"{name}: propeller.kt", "must be finite numbers")
     if data.propeller.kt[0] <= 0.0:
@@ -314,13 +312,7 @@ def mmgstd_rhs(t, x, delta, w, p, dx):
     dx : ndarray
         Output derivatives.
     """
-    psi = x[IPSI]
-    u = x[IU]
-    v = x[IV]
-    r = x[IR]
-    d = delta + w[W_RUDDER]
-    earth_velocity(psi, u, v, w, dx)
-    dx[IPSI] = r
+    _psi, u, v, r, d = planar_start(x, delta, w, dx)
     L = p[P_L]
     U2 = u * u + v * v
     U = math.sqrt(U2)

@@ -54,13 +54,13 @@ from pydantic import Field
 from pydantic import field_validator
 
 from steerlab.config_base import FrozenConfig
-from steerlab.environment.channels import W_RUDDER, W_YAW_MOMENT
+from steerlab.environment.channels import W_YAW_MOMENT
 from steerlab.errors import InputError
 from steerlab.records import Field as RecordField
 from steerlab.records import Layout
-from steerlab.ships.kinematics import earth_velocity
+from steerlab.ships.kinematics import planar_start
 from steerlab.ships.rpm_schedule import RATE, check_rpm_schedule, pack_with_rate, scheduled_rate
-from steerlab.ships.state import IPSI, IR, IU, IV, ship_state
+from steerlab.ships.state import IR, IU, IV, ship_state
 
 
 COEFFICIENTS = Layout("mss-tanker coefficients", "K_", [
@@ -216,13 +216,8 @@ def tanker_rhs(t, x, delta, w, p, dx):
     dx : ndarray
         Output derivatives.
     """
-    psi = x[IPSI]
-    u = x[IU]
-    v = x[IV]
-    r = x[IR]
-    d = -(delta + w[W_RUDDER])          # MSS sign
-    earth_velocity(psi, u, v, w, dx)
-    dx[IPSI] = r
+    _psi, u, v, r, d = planar_start(x, delta, w, dx)
+    d = -d                              # MSS sign
     L = p[P_L]
     n = p[P_N] + x[I_DN]
     dx[I_DN] = (scheduled_rate(t, p, P_RATE) - n) * p[P_INV_TM]

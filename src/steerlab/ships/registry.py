@@ -9,7 +9,7 @@ package: :func:`register_ship`, the entry-point group ``steerlab.ships`` or the
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING, Any, Callable, Mapping, Optional
 
 from pydantic import ValidationError
@@ -57,6 +57,17 @@ class ShipSpec:
     equilibrium_rudder: Callable | None = None
     #: ``(speed, options) -> bool``: whether delta -> -delta mirrors the response (None: True)
     symmetric: Callable | None = None
+    #: ``options -> kernel``: a kernel suited to these validated options (None: always ``rhs``);
+    #: it must give the same derivatives as ``rhs`` for every record ``pack`` makes with them
+    kernel_for_options: Callable | None = None
+
+    def for_options(self, options: Any) -> "ShipSpec":
+        """This spec with the kernel :attr:`kernel_for_options` picks for ``options`` (e.g. the
+        MMG kernel without the rpm-schedule look-up, which vectorises, when there is no schedule)."""
+        if self.kernel_for_options is None:
+            return self
+        rhs = self.kernel_for_options(options)
+        return self if rhs is self.rhs else replace(self, rhs=rhs)
 
     def b2(self, speed: float, method: str, options: Optional[FrozenConfig] = None) -> float:
         """Rudder efficiency [1/s^2], steerlab sign: ``exact`` (linearisation) or ``estimate`` (eq 29).

@@ -138,6 +138,7 @@ class Design:
         ship = get_ship(s.ship.model)
         speed = knots_to_ms(s.ship.speed_kn)
         ship_options = ship.options(s.ship.options)
+        ship = ship.for_options(ship_options)
         ps = ship.pack(speed, s.ship.rpm, ship_options)
         gear = scenario_gear(s)
         pg = gear.pack()
