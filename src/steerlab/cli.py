@@ -39,8 +39,20 @@ def _progress(quiet: bool):
 
 
 def cmd_run(args) -> int:
+    from steerlab.report import figure_worker
+
+    # a child imports matplotlib now and draws the figures once the run is done
+    # (steerlab.figure_worker); it goes away with this command, however it ends
+    figures = figure_worker().start()
+    try:
+        return _run(args, figures)
+    finally:
+        figures.cancel()
+
+
+def _run(args, figures) -> int:
     from steerlab.metrics import METRIC_UNITS, compute_metrics
-    from steerlab.report import format_metrics_table, report_title, run_figure_jobs, write_run_report
+    from steerlab.report import FIGURE_NAMES, format_metrics_table, report_title, write_run_report
     from steerlab.sim.engine import simulate
     from steerlab.commands._guard import design_checked
     from steerlab.sim.divergence import check_run
@@ -62,17 +74,17 @@ def cmd_run(args) -> int:
     metrics = compute_metrics(result, lam=args.lam)
     say("writing time series, metrics, figures and report")
     with staged_output(Path(args.out)) as stage:
-        # the figures are drawn in forked children while this process writes the data files
-        with run_figure_jobs(stage, result, report_title(result, scenario)) as figures:
-            result.to_csv(stage / "timeseries.csv")
-            if args.parquet:
-                result.to_parquet(stage / "timeseries.parquet")
-            extra = {"warnings": warnings} if warnings else {}
-            dump_json({"scenario": scenario.name, "seed": scenario.seed, "engine": args.engine,
-                       "metrics": metrics, "units": {k: METRIC_UNITS.get(k, "") for k in metrics}, **extra},
-                      stage / "metrics.json", digits=None)
-            (stage / "scenario.json").write_text(scenario.model_dump_json(indent=2) + "\n", encoding="utf-8")
-        write_run_report(stage, result, metrics, scenario, figures=figures.paths)
+        figures.submit(stage, result, report_title(result, scenario))   # drawn while the data is written
+        result.to_csv(stage / "timeseries.csv")
+        if args.parquet:
+            result.to_parquet(stage / "timeseries.parquet")
+        extra = {"warnings": warnings} if warnings else {}
+        dump_json({"scenario": scenario.name, "seed": scenario.seed, "engine": args.engine,
+                   "metrics": metrics, "units": {k: METRIC_UNITS.get(k, "") for k in metrics}, **extra},
+                  stage / "metrics.json", digits=None)
+        (stage / "scenario.json").write_text(scenario.model_dump_json(indent=2) + "\n", encoding="utf-8")
+        figures.wait()
+        write_run_report(stage, result, metrics, scenario, figures=[stage / name for name in FIGURE_NAMES])
     print(format_metrics_table(metrics))
     say(f"wrote {args.out}/report.html")
     return 0

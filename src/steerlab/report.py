@@ -60,8 +60,8 @@ def _new_figure(figsize=TIME_SERIES_SIZE):
     fig : matplotlib.figure.Figure
     ax : matplotlib.axes.Axes
     """
-    # matplotlib is imported here, not with the module: a run's figures are drawn in forked
-    # children (run_figure_jobs), which then import it in parallel with the parent's CSV
+    # matplotlib is imported here, not with the module: a run's figures are drawn in a forked
+    # child (figure_worker) that imports it while the parent designs and simulates
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
@@ -311,44 +311,21 @@ def write_run_figures(out_dir: Path, result, title: str = "") -> list[Path]:
     return [_PLOTTERS[name](out_dir / name, result, title) for name in FIGURE_NAMES]
 
 
-def run_figure_jobs(out_dir: Path, result, title: str = "", processes: int = 2):
-    """The run's figures as :class:`steerlab.forked_jobs.ForkedJobs`, drawn in parallel with
-    whatever the caller does until :meth:`~steerlab.forked_jobs.ForkedJobs.wait`.
+def warm_figures() -> None:
+    """Import matplotlib and lay out one small figure with text (fonts, text engine), drawn
+    to memory: what the first real figure of a process would otherwise pay."""
+    fig, ax = _new_figure((2.0, 1.5))
+    ax.set_title("steerlab", parse_math=False)
+    ax.plot([0.0, 1.0], [0.0, 1.0])
+    fig.canvas.draw()
 
-    Same files and bytes as :func:`write_run_figures`; use as a context manager around the
-    rest of the output writing::
 
-        with run_figure_jobs(stage, result, title) as figures:
-            result.to_csv(stage / "timeseries.csv")
-        write_run_report(stage, result, metrics, scenario, figures=figures.paths)
+def figure_worker():
+    """A :class:`steerlab.figure_worker.FigureWorker` that draws :func:`write_run_figures`
+    (``submit(out_dir, result, title)``) after importing matplotlib while the caller works."""
+    from steerlab.figure_worker import FigureWorker
 
-    Parameters
-    ----------
-    out_dir : pathlib.Path
-        Output folder (created if missing).
-    result : steerlab.sim.result.Result
-        The run.
-    title : str, optional
-        Prefix of every plot title.
-    processes : int, optional
-        Number of child processes (the figures are dealt out round-robin).
-
-    Returns
-    -------
-    steerlab.forked_jobs.ForkedJobs
-        Not started; ``.paths`` lists the files in :data:`FIGURE_NAMES` order.
-    """
-    import functools
-
-    from steerlab.forked_jobs import ForkedJobs
-
-    out_dir = Path(out_dir)
-    out_dir.mkdir(parents=True, exist_ok=True)
-    jobs = [functools.partial(_PLOTTERS[name], out_dir / name, result, title) for name in FIGURE_NAMES]
-    n = max(1, int(processes))
-    forked = ForkedJobs([jobs[i::n] for i in range(n)])
-    forked.paths = [out_dir / name for name in FIGURE_NAMES]
-    return forked
+    return FigureWorker(write_run_figures, warm=warm_figures)
 
 
 # --------------------------------------------------------------------------------------------
@@ -530,7 +507,7 @@ def write_run_report(out_dir: Path, result, metrics: dict, scenario=None,
     title : str, optional
         Page and plot title; default: the scenario name, else ``result.meta["name"]``.
     figures : list of pathlib.Path, optional
-        The figures, already written (:func:`run_figure_jobs`); default: drawn here.
+        The figures, already written (:func:`figure_worker`); default: drawn here.
 
     Returns
     -------
