@@ -4,7 +4,7 @@ A run's four PNGs with matplotlib's import cost about 0.7 s of CPU, more than th
 the metrics and the CSV together, and the machines steerlab runs on have two or more cores.
 ``steerlab run`` starts a :class:`FigureWorker` first thing: the worker forks a child that
 imports matplotlib and lays out a first figure (fonts, text engine) while the parent loads the
-scenario, designs and simulates. The parent then :meth:`~FigureWorker.submit`\\ s the result
+scenario, designs and simulates (``parts=n`` forks n children that share the figures). The parent then :meth:`~FigureWorker.submit`\\ s the result
 (pickled through a pipe, a few MB), writes the CSV and the JSON while the child draws, and
 :meth:`~FigureWorker.wait`\\ s: a failure in the child is raised in the parent as one
 :class:`RuntimeError` with the child's error line. The parent never imports matplotlib.
@@ -49,111 +49,126 @@ def _write_all(fd: int, data: bytes) -> None:
 
 
 class FigureWorker:
-    """Draw ``draw(*args)`` in a child forked at :meth:`start`, with ``args`` given later.
+    """Draw ``draw(*args, part=k, parts=n)`` in ``n`` children forked at :meth:`start`, with
+    ``args`` given later.
 
     Parameters
     ----------
     draw : callable
-        ``draw(*args)``: writes the figures (e.g. :func:`steerlab.report.write_run_figures`).
+        ``draw(*args, part=k, parts=n)``: writes part ``k`` of ``n`` of the figures (e.g.
+        :func:`steerlab.report.write_run_figures`).
     warm : callable, optional
-        Called in the child right after the fork, while the parent works (imports, a first
+        Called in each child right after the fork, while the parent works (imports, a first
         figure).
+    parts : int, optional
+        Number of children (each draws its part; inline, the parts are drawn in order).
     """
 
-    def __init__(self, draw: Callable[..., Any], warm: Optional[Callable[[], Any]] = None):
+    def __init__(self, draw: Callable[..., Any], warm: Optional[Callable[[], Any]] = None, parts: int = 1):
         self.draw = draw
         self.warm = warm
-        self.pid: Optional[int] = None
-        self._job_w: Optional[int] = None
-        self._done_r: Optional[int] = None
+        self.parts = max(1, int(parts))
+        self._children: list[tuple[int, int, int]] = []     # (pid, job pipe write end, done pipe read end)
         self._args: Optional[tuple] = None
         self._inline = False
 
+    @property
+    def pid(self) -> Optional[int]:
+        """The first child's process id (None: no child, the parent draws)."""
+        return self._children[0][0] if self._children else None
+
     # ------------------------------------------------------------------ parent side
     def start(self) -> "FigureWorker":
-        """Fork the child (if :func:`fork_allowed`); it warms up, then waits for :meth:`submit`."""
+        """Fork the children (if :func:`fork_allowed`); they warm up, then wait for :meth:`submit`."""
         if not fork_allowed():
             return self
         sys.stdout.flush()
         sys.stderr.flush()
-        job_r, job_w = os.pipe()
-        done_r, done_w = os.pipe()
-        pid = os.fork()
-        if pid == 0:                                   # child: never returns
-            os.close(job_w)
-            os.close(done_r)
-            self._child(job_r, done_w)
-        os.close(job_r)
-        os.close(done_w)
-        self.pid, self._job_w, self._done_r = pid, job_w, done_r
+        for part in range(self.parts):
+            job_r, job_w = os.pipe()
+            done_r, done_w = os.pipe()
+            pid = os.fork()
+            if pid == 0:                               # child: never returns
+                for _, w, r in self._children:         # the earlier children's pipes are not ours
+                    os.close(w)
+                    os.close(r)
+                os.close(job_w)
+                os.close(done_r)
+                self._child(job_r, done_w, part)
+            os.close(job_r)
+            os.close(done_w)
+            self._children.append((pid, job_w, done_r))
         return self
 
     def submit(self, *args: Any) -> None:
-        """Hand ``args`` to the child (or keep them for :meth:`wait` to draw inline)."""
+        """Hand ``args`` to the children (or keep them for :meth:`wait` to draw inline)."""
         self._args = args
-        if self.pid is None:
+        if not self._children:
             self._inline = True
             return
+        data = pickle.dumps(args, protocol=pickle.HIGHEST_PROTOCOL)
         try:
-            _write_all(self._job_w, pickle.dumps(args, protocol=pickle.HIGHEST_PROTOCOL))
-        except (BrokenPipeError, OSError, pickle.PicklingError):
-            self.cancel()                              # the child is gone: draw here instead
+            for _, job_w, _ in self._children:
+                _write_all(job_w, data)
+                os.close(job_w)
+        except (BrokenPipeError, OSError):
+            self.cancel()                              # a child is gone: draw here instead
             self._inline = True
             return
-        os.close(self._job_w)
-        self._job_w = None
+        self._children = [(pid, -1, done_r) for pid, _, done_r in self._children]
 
     def wait(self) -> None:
-        """Wait for the child's figures (or draw them here); raise the child's error."""
+        """Wait for the children's figures (or draw them here); raise a child's error."""
         if self._inline:
             self._inline = False
-            self.draw(*self._args)
+            for part in range(self.parts):
+                self.draw(*self._args, part=part, parts=self.parts)
             return
-        if self.pid is None:
-            return
-        message = _read_all(self._done_r).decode("utf-8", "replace")
-        os.close(self._done_r)
-        self._done_r = None
-        _, status = os.waitpid(self.pid, 0)
-        self.pid = None
-        if status != 0:
-            raise RuntimeError(f"drawing the figures failed: {message or f'exit status {status}'}")
+        errors = []
+        for pid, _, done_r in self._children:
+            message = _read_all(done_r).decode("utf-8", "replace")
+            os.close(done_r)
+            _, status = os.waitpid(pid, 0)
+            if status != 0:
+                errors.append(message or f"exit status {status}")
+        self._children = []
+        if errors:
+            raise RuntimeError(f"drawing the figures failed: {errors[0]}")
 
     def cancel(self) -> None:
-        """Kill the child (if any) and close the pipes; nothing is drawn."""
-        for fd in (self._job_w, self._done_r):
-            if fd is not None:
-                try:
-                    os.close(fd)
-                except OSError:
-                    pass
-        self._job_w = self._done_r = None
-        if self.pid is not None:
+        """Kill the children (if any) and close the pipes; nothing is drawn."""
+        for pid, job_w, done_r in self._children:
+            for fd in (job_w, done_r):
+                if fd >= 0:
+                    try:
+                        os.close(fd)
+                    except OSError:
+                        pass
             try:
-                os.kill(self.pid, 9)
-                os.waitpid(self.pid, 0)
+                os.kill(pid, 9)
+                os.waitpid(pid, 0)
             except OSError:
                 pass
-            self.pid = None
+        self._children = []
 
     def __enter__(self) -> "FigureWorker":
         return self.start()
 
     def __exit__(self, exc_type, exc, tb) -> None:
-        if exc_type is None and (self._inline or self._args is not None):
+        if exc_type is None and (self._inline or self._children):
             self.wait()
         else:                                          # failed, or nothing was submitted
             self.cancel()
 
     # ------------------------------------------------------------------ child side
-    def _child(self, job_r: int, done_w: int) -> None:
+    def _child(self, job_r: int, done_w: int, part: int) -> None:
         code = 0
         try:
             if self.warm is not None:
                 self.warm()
             data = _read_all(job_r)
             if data:                                   # empty: the parent cancelled or died
-                self.draw(*pickle.loads(data))
+                self.draw(*pickle.loads(data), part=part, parts=self.parts)
         except BaseException as err:                   # noqa: BLE001 - reported to the parent
             try:
                 os.write(done_w, f"{type(err).__name__}: {err}".encode("utf-8", "replace")[:4000])

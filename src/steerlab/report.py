@@ -289,7 +289,7 @@ _PLOTTERS = {
 }
 
 
-def write_run_figures(out_dir: Path, result, title: str = "") -> list[Path]:
+def write_run_figures(out_dir: Path, result, title: str = "", part: int = 0, parts: int = 1) -> list[Path]:
     """Write the run's PNG figures into ``out_dir`` (created if missing).
 
     Parameters
@@ -300,15 +300,17 @@ def write_run_figures(out_dir: Path, result, title: str = "") -> list[Path]:
         The run.
     title : str, optional
         Prefix of every plot title (plain text, not mathtext).
+    part, parts : int, optional
+        Draw only the figures ``FIGURE_NAMES[part::parts]`` (one process's share).
 
     Returns
     -------
     list of pathlib.Path
-        ``heading.png``, ``rudder.png``, ``yaw_rate.png``, ``track.png`` in ``out_dir``.
+        ``heading.png``, ``rudder.png``, ``yaw_rate.png``, ``track.png`` in ``out_dir`` (or the part's).
     """
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
-    return [_PLOTTERS[name](out_dir / name, result, title) for name in FIGURE_NAMES]
+    return [_PLOTTERS[name](out_dir / name, result, title) for name in FIGURE_NAMES[part::parts]]
 
 
 def warm_figures() -> None:
@@ -322,10 +324,12 @@ def warm_figures() -> None:
 
 def figure_worker():
     """A :class:`steerlab.figure_worker.FigureWorker` that draws :func:`write_run_figures`
-    (``submit(out_dir, result, title)``) after importing matplotlib while the caller works."""
+    (``submit(out_dir, result, title)``) in one child, after importing matplotlib while the
+    caller works. (Two children, two figures each, were slower on a 2-core machine: their
+    warm-ups compete with the parent's design and simulation.)"""
     from steerlab.figure_worker import FigureWorker
 
-    return FigureWorker(write_run_figures, warm=warm_figures)
+    return FigureWorker(write_run_figures, warm=warm_figures, parts=1)
 
 
 # --------------------------------------------------------------------------------------------
