@@ -243,7 +243,10 @@ def main(argv=None) -> int:
         from steerlab.sim import drivers
 
         drivers.on_compile = lambda msg: print(msg, file=sys.stderr, flush=True)
+    restore = None
     try:
+        if getattr(args, "out", None):        # every command that writes: --out checked before any work
+            restore = _prepare_out(args.out)
         return args.func(args)
     except InputError as err:
         print(f"steerlab: error: {one_line(err)}", file=sys.stderr)
@@ -251,9 +254,37 @@ def main(argv=None) -> int:
     except DivergedError as err:
         print(f"steerlab: error: {one_line(err, 2 * MAX_MESSAGE)}", file=sys.stderr)
         return EXIT_DIVERGED
-    except KeyboardInterrupt:
+    except KeyboardInterrupt as err:
         print("steerlab: interrupted", file=sys.stderr)
-        return 130
+        return 143 if isinstance(err, _Terminated) else 130
+    finally:
+        if restore is not None:
+            restore()
+
+
+class _Terminated(KeyboardInterrupt):
+    """SIGTERM during a command that writes: unwinds like Ctrl-C (exit 143)."""
+
+
+def _prepare_out(out: str):
+    """Refuse a bad ``--out`` before any work, repair leftovers of killed runs, and make SIGTERM
+    unwind like Ctrl-C so the stage folder is removed (docs/reliability-outputs.md). Returns the
+    function that restores the default SIGTERM handling (or None)."""
+    import signal
+    import threading
+
+    from steerlab.outputs import prepare_out
+
+    prepare_out(out)
+    if threading.current_thread() is not threading.main_thread() \
+            or signal.getsignal(signal.SIGTERM) is not signal.SIG_DFL:
+        return None
+
+    def _terminated(signum, frame):
+        raise _Terminated
+
+    signal.signal(signal.SIGTERM, _terminated)
+    return lambda: signal.signal(signal.SIGTERM, signal.SIG_DFL)
 
 
 if __name__ == "__main__":  # pragma: no cover
