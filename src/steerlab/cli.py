@@ -57,18 +57,34 @@ def cmd_run(args) -> int:
     if not (args.lam >= 0.0 and math.isfinite(args.lam)):
         raise InputError("--lambda", f"must be a finite number >= 0, got {args.lam}")
     say(f"scenario {one_line(scenario.name, 80)!r} from {path}")
+    from steerlab.commands import _run_options as ro
+
+    ro.check_run_options(args, scenario)      # --record-every, memory estimate: before any allocation
     setup, warnings = design_checked(scenario)
     say(f"simulating {setup.n_steps} steps of {setup.dt} s with the {args.engine} engine "
         f"({setup.ship.name} + {setup.controller.name})")
-    result = simulate(setup, engine=args.engine)
-    check_run(result, setup)                  # a diverged run or a spin: exit 3, no metrics
+    result = simulate(setup, engine=args.engine, record_every=args.record_every)
+    try:
+        check_run(result, setup)              # a diverged run or a spin: exit 3, no metrics
+        ro.check_accumulator(result, setup)
+    except DivergedError as err:
+        if args.keep_diverged:                # the rows before it, marked diverged; exit 3 all the same
+            with staged_output(Path(args.out)) as stage:
+                rows = ro.write_diverged(stage, result, scenario, err, args)
+            say(f"kept {rows} rows up to the divergence in {args.out} (metrics.json: diverged)")
+        raise
     metrics = compute_metrics(result, lam=args.lam)
     say("writing time series, metrics, figures and report")
     with staged_output(Path(args.out)) as stage:
-        result.to_csv(stage / "timeseries.csv")
+        result.to_csv(stage / "timeseries.csv", ro.csv_progress(say, len(result.time)))
         if args.parquet:
             result.to_parquet(stage / "timeseries.parquet")
         extra = {"warnings": warnings} if warnings else {}
+        if args.record_every != 1:
+            extra["record_every"] = args.record_every
+            extra["note"] = ("integral metrics (iae, ise, itae, J, travel, reversals, mean rudder, max error) "
+                             "from every step; step metrics, final error, max rudder and min speed from the "
+                             f"log, every {args.record_every * setup.dt:g} s")
         dump_json({"scenario": scenario.name, "seed": scenario.seed, "engine": args.engine,
                    "metrics": metrics, "units": {k: METRIC_UNITS.get(k, "") for k in metrics}, **extra},
                   stage / "metrics.json", digits=None)
@@ -194,6 +210,9 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("--lambda", dest="lam", type=float, default=0.1,
                    help="rudder weight of the speed-loss criterion J (default 0.1)")
     r.add_argument("--parquet", action="store_true", help="also write timeseries.parquet (needs pyarrow)")
+    from steerlab.commands._run_options import add_run_options
+
+    add_run_options(r)
     r.add_argument("--quiet", action="store_true", help="no progress messages")
     r.set_defaults(func=cmd_run)
 

@@ -46,7 +46,7 @@ def cmd_montecarlo(args) -> int:
     design_checked(scenario)
     executor = executor_from_args(args)
     try:
-        res = run_montecarlo(scenario, args.runs, args.lam, args.record_every, executor, say)
+        res = run_montecarlo(scenario, args.runs, args.lam, args.record_every, executor, say, args.max_memory)
     finally:
         executor.close()
     if res.n_diverged:

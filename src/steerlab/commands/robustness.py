@@ -55,7 +55,8 @@ def cmd_robustness(args) -> int:
     variations = [parse_vary(v, scenario) for v in args.vary]
     executor = executor_from_args(args)
     try:
-        res = run_robustness(scenario, variations, args.metric, args.lam, args.redesign, executor, say)
+        res = run_robustness(scenario, variations, args.metric, args.lam, args.redesign, executor, say,
+                             args.max_memory)
     finally:
         executor.close()
     if "diverged" in res.table:
