@@ -32,7 +32,7 @@ def _ref_columns(s: SimSetup) -> int:
 
 
 def _result(s: SimSetup, X, cmd, ref, engine: str, record_every: int = 1) -> Result:
-    time = np.arange(X.shape[0]) * (record_every * s.dt)
+    time = np.arange(0, X.shape[0] * record_every, record_every) * s.dt   # t_k = k dt, k = 0, N, 2N ...
     w = s.w if record_every == 1 else s.w[::record_every]
     res = Result(time=time, states=X, state_names=s.state_names, state_units=s.state_units,
                  delta_cmd=cmd, psi_ref=ref[:, 0], r_ref=ref[:, 1], disturbance=w,
