@@ -61,6 +61,8 @@ def test_the_default_run_and_a_one_row_table(tmp_path):
     r = sl.simulate(sl.default_scenario().replace(duration=200.0))
     cols = r.columns()
     _check(np.column_stack(list(cols.values())), tmp_path, block_rows=333)
+    write_csv(tmp_path / "cols.csv", list(cols), list(cols.values()), block_rows=333)   # columns, no copy
+    assert (tmp_path / "cols.csv").read_bytes() == _reference(np.column_stack(list(cols.values())), list(cols))
     _check(np.array([[1.5, -2.0]]), tmp_path)
 
 
@@ -71,4 +73,6 @@ def test_progress_and_shape_check(tmp_path):
     assert seen == [(4, 10), (8, 10), (10, 10)]
     with pytest.raises(ValueError, match="header"):
         write_csv(tmp_path / "q.csv", ["a"], np.ones((3, 2)))
+    with pytest.raises(ValueError, match="header"):
+        write_csv(tmp_path / "q.csv", ["a", "b"], [np.ones(3), np.ones(2)])
     assert format_block(np.array([[1.0, 2.0]])) == b"1,2\n"

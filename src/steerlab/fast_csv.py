@@ -170,39 +170,72 @@ def _compile():
     return _kernel
 
 
-def format_block(block: np.ndarray) -> bytes:
-    """Rows of ``block`` (n, m) float64 as CSV lines (``%.10g``, ``,``, ``\\n``), as bytes."""
+class _Buffers:
+    """Scratch arrays reused from block to block (fresh ones would be page-faulted in each time)."""
+
+    def __init__(self):
+        self.cells = self.lens = self.out = None
+
+    def get(self, n_values: int):
+        if self.cells is None or self.cells.shape[0] < n_values:
+            self.cells = np.empty((n_values, SLOT), np.uint8)
+            self.lens = np.empty(n_values, np.int64)
+            self.out = np.empty(n_values * (SLOT + 1), np.uint8)
+        return self.cells[:n_values], self.lens[:n_values], self.out
+
+
+def _format(block: np.ndarray, buffers: _Buffers):
+    """The CSV lines of ``block`` as a uint8 view into ``buffers`` (valid until the next call)."""
     block = np.ascontiguousarray(block, dtype=np.float64)
     n, m = block.shape
     flat = block.ravel()
-    cells = np.empty((flat.size, SLOT), np.uint8)
-    lens = np.empty(flat.size, np.int64)
+    cells, lens, out = buffers.get(flat.size)
     format_g10, join = _compile()
     format_g10(flat, cells, lens)
     for i in np.nonzero(lens < 0)[0]:               # tie band or out of range: Python's own %.10g
         text = ("%.10g" % float(flat[i])).encode("ascii")
         cells[i, :len(text)] = np.frombuffer(text, np.uint8)
         lens[i] = len(text)
-    out = np.empty(int(lens.sum()) + flat.size, np.uint8)
     used = join(cells, lens, m, out)
-    return out[:used].tobytes()
+    return out[:used]
 
 
-def write_csv(path, header: list[str], data: np.ndarray, progress=None, block_rows: int = BLOCK_ROWS) -> Path:
-    """Write ``data`` (n, m) under a one-line ``header``, byte-identical to
+def format_block(block: np.ndarray) -> bytes:
+    """Rows of ``block`` (n, m) float64 as CSV lines (``%.10g``, ``,``, ``\\n``), as bytes."""
+    return _format(block, _Buffers()).tobytes()
+
+
+def write_csv(path, header: list[str], data, progress=None, block_rows: int = BLOCK_ROWS) -> Path:
+    """Write ``data`` under a one-line ``header``, byte-identical to
     ``np.savetxt(path, data, delimiter=",", header=",".join(header), comments="", fmt="%.10g")``.
 
-    ``progress(rows_done, rows)`` is called after each block of ``block_rows`` rows.
+    ``data``: an (n, m) array, or a list of m columns of length n (stacked a block at a time,
+    so no full copy of the table is made). ``progress(rows_done, rows)`` is called after each
+    block of ``block_rows`` rows.
     """
     path = Path(path)
-    data = np.asarray(data, dtype=np.float64)
-    if data.ndim != 2 or data.shape[1] != len(header):
-        raise ValueError(f"data of shape {data.shape} does not match {len(header)} header names")
-    n = data.shape[0]
+    if isinstance(data, (list, tuple)):
+        columns = [np.asarray(c, dtype=np.float64) for c in data]
+        n = len(columns[0]) if columns else 0
+        if len(columns) != len(header) or any(c.shape != (n,) for c in columns):
+            raise ValueError(f"{len(columns)} columns of lengths {[c.shape for c in columns][:4]}... do not match "
+                             f"{len(header)} header names")
+
+        def block(a):
+            return np.column_stack([c[a:a + block_rows] for c in columns])
+    else:
+        data = np.asarray(data, dtype=np.float64)
+        if data.ndim != 2 or data.shape[1] != len(header):
+            raise ValueError(f"data of shape {data.shape} does not match {len(header)} header names")
+        n = data.shape[0]
+
+        def block(a):
+            return data[a:a + block_rows]
+    buffers = _Buffers()
     with open(path, "wb") as fh:
         fh.write((",".join(header) + "\n").encode("latin1"))
         for a in range(0, n, block_rows):
-            fh.write(format_block(data[a:a + block_rows]))
+            fh.write(memoryview(_format(block(a), buffers)))
             if progress is not None:
                 progress(min(a + block_rows, n), n)
     return path

@@ -103,7 +103,7 @@ class Result:
         from steerlab.fast_csv import write_csv
 
         cols = self.columns()
-        return write_csv(path, list(cols), np.column_stack(list(cols.values())), progress)
+        return write_csv(path, list(cols), list(cols.values()), progress)   # stacked block by block
 
     def to_parquet(self, path) -> Path:
         """Write Parquet (needs the optional ``pyarrow``)."""
