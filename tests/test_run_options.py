@@ -182,3 +182,18 @@ def test_montecarlo_estimate_names_runs(tmp_path, capsys):
                  "--max-memory", "2", "--out", str(tmp_path / "o"), "--quiet"])
     err = capsys.readouterr().err
     assert code == 2 and "--runs: 100000 runs of 3000 steps logged every 1 step(s) needs about 10 GB" in err, err
+
+
+def test_every_command_checks_the_set_up_before_building_it(tmp_path, capsys):
+    """50 M steps: the disturbance sequence alone (5.85 GB) is refused before build() allocates
+    it; the Monte-Carlo estimate comes first of all (nothing built), each with --max-memory."""
+    big = str(_write(tmp_path, dt=0.02, duration=1e6))
+    t0 = time.perf_counter()
+    assert main(["robustness", big, "--vary", "speed_kn=10:12:1", "--max-memory", "1",
+                 "--out", str(tmp_path / "o")]) == 2
+    err = capsys.readouterr().err
+    assert "duration: the disturbance sequence of 50000000 steps (duration 1e+06 s / dt 0.02 s) needs about 5.85 GB" \
+        in err and "limit of 1 GB" in err
+    assert main(["montecarlo", big, "--runs", "4", "--max-memory", "7", "--out", str(tmp_path / "o")]) == 2
+    assert "--runs: 4 runs of 50000000 steps" in capsys.readouterr().err
+    assert time.perf_counter() - t0 < 20.0                                  # nothing was built

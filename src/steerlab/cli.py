@@ -60,7 +60,7 @@ def cmd_run(args) -> int:
     from steerlab.commands import _run_options as ro
 
     ro.check_run_options(args, scenario)      # --record-every, memory estimate: before any allocation
-    setup, warnings = design_checked(scenario)
+    setup, warnings = design_checked(scenario, args.max_memory)
     say(f"simulating {setup.n_steps} steps of {setup.dt} s with the {args.engine} engine "
         f"({setup.ship.name} + {setup.controller.name})")
     result = simulate(setup, engine=args.engine, record_every=args.record_every)

@@ -88,6 +88,18 @@ def check_run_memory(scenario, record_every: int = 1, limit_gb: float | None = N
     return need
 
 
+def check_setup_memory(scenario, limit_gb: float | None = None) -> float:
+    """Refuse a scenario whose set-up alone (its disturbance sequence, twice for the sea's
+    temporaries) would not fit (field ``duration``); every command designs the scenario first."""
+    from steerlab.environment.channels import N_CHANNELS
+
+    n = scenario.n_steps
+    need = BASE_BYTES + 2.0 * 8.0 * (n + 1) * N_CHANNELS
+    check_memory("duration", need, f"the disturbance sequence of {n} steps (duration {scenario.duration:g} s / "
+                                   f"dt {scenario.dt:g} s)", "shorten duration or raise dt", limit_gb)
+    return need
+
+
 CSV_BYTES_PER_VALUE = 16     #: disk estimate of one ``%.10g`` number and its separator [bytes]
 
 

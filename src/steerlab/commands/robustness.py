@@ -51,7 +51,7 @@ def cmd_robustness(args) -> int:
     scenario = with_controller(load_scenario(args.scenario), args.controller)
     from steerlab.commands._guard import design_checked
 
-    design_checked(scenario)
+    design_checked(scenario, args.max_memory)
     variations = [parse_vary(v, scenario) for v in args.vary]
     executor = executor_from_args(args)
     try:

@@ -68,7 +68,7 @@ def cmd_tune(args) -> int:
     from steerlab.commands._guard import design_checked
     from steerlab.tuning.session import with_controller
 
-    design_checked(with_controller(scenario, args.controller))
+    design_checked(with_controller(scenario, args.controller), args.max_memory)
     names = [n.strip() for n in args.params.split(",") if n.strip()]
     if not names:
         raise InputError("--params", "needs at least one parameter name")

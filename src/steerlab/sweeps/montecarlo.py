@@ -103,6 +103,24 @@ def montecarlo_bytes(n_runs: int, n_steps: int, nx: int, record_every: int) -> f
     return BASE_BYTES + sweep_bytes(m, n_steps) + 8.0 * (m * rows * (nx + 3) + 4 * n_runs * rows)
 
 
+def check_montecarlo_memory(scenario, n_runs: int, record_every: int | None = None,
+                            max_memory: float | None = None) -> int:
+    """Refuse a Monte-Carlo whose memory estimate is above the limit (field ``--runs``, before
+    anything is built); returns the log interval (``record_every`` or its default)."""
+    from steerlab.resources import check_memory
+    from steerlab.ships.registry import get_ship
+
+    nx = get_ship(scenario.ship.model).n_states + 1
+    if record_every is None:
+        record_every = default_record_every(n_runs, scenario.n_steps, nx)
+    if record_every < 1:
+        raise InputError("--record-every", f"must be >= 1, got {record_every}")
+    check_memory("--runs", montecarlo_bytes(n_runs, scenario.n_steps, nx, record_every),
+                 f"{n_runs} runs of {scenario.n_steps} steps logged every {record_every} step(s)",
+                 "use fewer runs, a larger --record-every or a shorter duration", max_memory)
+    return record_every
+
+
 def run_montecarlo(scenario, n_runs: int, lam: float = 0.1, record_every: int | None = None,
                    executor=None, progress=None, max_memory: float | None = None) -> MonteCarloResult:
     """Run the scenario over ``n_runs`` seeds (see the module docstring).
@@ -121,17 +139,7 @@ def run_montecarlo(scenario, n_runs: int, lam: float = 0.1, record_every: int | 
     if not scenario.environment.waves:
         say("note: the scenario has no random disturbance ([environment] waves = false): "
             "every realisation is the same")
-    from steerlab.resources import check_memory
-    from steerlab.ships.registry import get_ship
-
-    nx = get_ship(scenario.ship.model).n_states + 1
-    if record_every is None:
-        record_every = default_record_every(n_runs, scenario.n_steps, nx)
-    if record_every < 1:
-        raise InputError("--record-every", f"must be >= 1, got {record_every}")
-    check_memory("--runs", montecarlo_bytes(n_runs, scenario.n_steps, nx, record_every),
-                 f"{n_runs} runs of {scenario.n_steps} steps logged every {record_every} step(s)",
-                 "use fewer runs, a larger --record-every or a shorter duration", max_memory)
+    record_every = check_montecarlo_memory(scenario, n_runs, record_every, max_memory)
     executor = executor or LocalExecutor()
     report = runs_progress(say)
     per_run: dict = {}
