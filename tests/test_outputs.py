@@ -156,3 +156,18 @@ def test_existing_foreign_folder_is_kept_and_refused(tmp_path, capsys):
     assert main(["run", "--out", str(out), "--quiet"]) == 2
     assert "did not write" in capsys.readouterr().err
     assert _files(out) == ["thesis.tex"]
+
+
+def test_an_output_of_an_earlier_version_without_marker_is_replaced(tmp_path):
+    out = tmp_path / "zw"
+    out.mkdir()
+    for name in ("comparison.json", "fig_2.png", "table.csv"):
+        (out / name).write_text("old")
+    check_out(out)                                          # accepted: it is steerlab's
+    (out / "notes.txt").write_text("mine")
+    with pytest.raises(InputError, match="did not write"):  # a file of another kind: refused
+        check_out(out)
+    (out / "notes.txt").unlink()
+    (out / "comparison.json").unlink()
+    with pytest.raises(InputError, match="did not write"):  # no command's JSON: refused
+        check_out(out)

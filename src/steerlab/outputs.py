@@ -14,8 +14,9 @@ leftover of a run whose process is gone (:func:`repair_leftovers`): a stage with
 folder is an unfinished run (deleted); a stage *with* an old folder means the kill fell between
 the two renames, so the stage is complete and the swap is finished (roll forward); an old folder
 alone is a kill during the final delete (deleted). A folder that exists, is not empty and was
-not written by steerlab (no :data:`MARKER` file) is never replaced: the command refuses it
-before doing any work (:func:`check_out`).
+not written by steerlab (no :data:`MARKER` file, and not an output of an earlier version: only
+.json/.csv/.parquet/.png/.html files, one of them a command's JSON such as ``metrics.json``) is
+never replaced: the command refuses it before doing any work (:func:`check_out`).
 """
 
 from __future__ import annotations
@@ -36,6 +37,27 @@ MARKER_TEXT = "written by steerlab: the next run with --out here replaces this f
 
 PARTIAL = ".partial-"   #: infix of a stage folder: ``.NAME.partial-PID``
 OLD = ".old-"           #: infix of a replaced folder awaiting deletion: ``.NAME.old-PID``
+
+
+SIGNATURES = frozenset({"metrics.json", "comparison.json", "montecarlo.json", "robustness.json", "result.json",
+                        "tuning.json", "sea.json", "imo.json", "fit.json", "turning.json", "zigzag.json",
+                        "spiral.json", "pullout.json"})
+"""The JSON file each command writes: one of them marks a folder of an earlier steerlab version."""
+OUTPUT_SUFFIXES = frozenset({".json", ".csv", ".parquet", ".png", ".html"})
+
+
+def _earlier_steerlab_output(folder: Path) -> bool:
+    """A folder written by a steerlab version before :data:`MARKER`: only files, each with an
+    output suffix, one of them a command's JSON (:data:`SIGNATURES`)."""
+    try:
+        entries = list(folder.iterdir())
+    except OSError:
+        return False
+    if not entries or len(entries) > 10_000:
+        return False
+    if any(not p.is_file() or p.is_symlink() or p.suffix not in OUTPUT_SUFFIXES for p in entries):
+        return False
+    return any(p.name in SIGNATURES for p in entries)
 
 
 def _pid_alive(pid: int) -> bool:
@@ -73,7 +95,7 @@ def check_out(out_dir) -> Path:
     if target == cwd or target in cwd.parents:
         raise InputError("--out", f"{shown!r} is the current folder or one of its parents; the whole "
                                   "folder is replaced on success, so give a folder of its own")
-    if target.is_dir() and not (target / MARKER).exists():
+    if target.is_dir() and not (target / MARKER).exists() and not _earlier_steerlab_output(target):
         try:
             empty = next(target.iterdir(), None) is None
         except OSError as err:
