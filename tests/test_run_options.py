@@ -197,3 +197,12 @@ def test_every_command_checks_the_set_up_before_building_it(tmp_path, capsys):
     assert main(["montecarlo", big, "--runs", "4", "--max-memory", "7", "--out", str(tmp_path / "o")]) == 2
     assert "--runs: 4 runs of 50000000 steps" in capsys.readouterr().err
     assert time.perf_counter() - t0 < 20.0                                  # nothing was built
+
+
+def test_tune_estimate_names_seeds(tmp_path, capsys):
+    t0 = time.perf_counter()
+    code = main(["tune", str(_write(tmp_path)), "--params", "kp", "--bounds", "0.5:5", "--seeds", "500",
+                 "--max-memory", "0.3", "--out", str(tmp_path / "o"), "--quiet"])
+    err = capsys.readouterr().err
+    assert code == 2 and "--seeds: 500 conditions of 3000 steps x a population of 30 needs about" in err, err
+    assert time.perf_counter() - t0 < 20.0
