@@ -4,9 +4,10 @@ A run's arrays grow with its steps: the disturbance sequence ``(n_steps + 1) x N
 (every step), the log ``(n_steps / record_every + 1) x (nx + 1 + n_ref + 1)`` (states, rudder
 order, reference, time) and the temporaries of the checks, metrics and report (about
 :data:`TEMP_COLUMNS` more columns of the log); each number is 8 bytes (float64). Sweeps hold
-the disturbance sequences of the runs they pack at once and their logs. The estimate is
-compared, with :data:`BASE_BYTES` for the process itself, with the limit (:func:`memory_limit`) *before* anything is allocated; above it, an
-:class:`~steerlab.errors.InputError` names the field to change and gives the estimate.
+the disturbance sequences of the runs they pack at once and their logs. The estimate, plus
+:data:`BASE_BYTES` for the process itself, is compared with the limit (:func:`memory_limit`)
+*before* anything is allocated; above it, an :class:`~steerlab.errors.InputError` names the
+field to change and gives the estimate.
 
 The limit is, in this order: an explicit ``limit`` (the ``--max-memory GB`` option), the
 environment variable ``STEERLAB_MAX_MEMORY`` (GB), or :data:`DEFAULT_FRACTION` of this

@@ -23,8 +23,9 @@ object (its population and random state), for DE the population, its costs and t
 of the random generator. A resumed run continues bit-identically to an uninterrupted one
 (same generations, same best, same history and simulation count): for DE the checkpoint
 holds scipy's solver state (unit-scaled population, energies, feasibility, evaluation
-count, the sample index it shuffles in place) and the random state after the generation, restored into a fresh solver, so nothing
-is evaluated twice. A checkpoint of the earlier DE format (before this) is refused. A checkpoint stores the problem
+count, the sample index it shuffles in place) and the random state after the generation,
+restored into a fresh solver, so nothing is evaluated twice. A DE checkpoint of the earlier
+format is refused. A checkpoint stores the problem
 it belongs to (scenario, controller, parameters, bounds, costs, conditions, method, seed)
 and refuses to resume another. Checkpoints are pickles: load only your own.
 """
