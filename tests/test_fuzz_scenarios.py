@@ -33,7 +33,7 @@ class _Reached(Exception):
     """Raised by the stub engine: the scenario was accepted and designed."""
 
 
-def _stub_simulate(setup, engine="compiled"):
+def _stub_simulate(setup, engine="compiled", record_every=1):
     raise _Reached(setup.n_steps)
 
 

@@ -111,6 +111,40 @@ def test_de_resume_continues(lq_conditions, tmp_path):
     assert second.f[0] <= first.f[0]
 
 
+def test_de_resume_is_identical_to_an_uninterrupted_run_and_leaves_no_temporary(lq_conditions, tmp_path):
+    """3 + 3 generations through a checkpoint = 6 generations in one go: same best, same
+    history, same simulation count (the checkpoint holds scipy's solver and random state)."""
+    import subprocess
+    import sys
+
+    pm = build_param_map(lq_conditions, ["kp", "kd"], np.array([[0.1, 5.0], [1.0, 100.0]]))
+
+    def ev():
+        return PopulationEvaluator(lq_conditions, pm, [parse_cost("ise")])
+
+    full = run_optimiser(ev(), "de", 6, 10, 0)
+    ck = tmp_path / "de.ckpt"
+    p = subprocess.Popen([sys.executable, "-c", "pass"])
+    p.wait()
+    stale = tmp_path / f".de.ckpt.tmp-{p.pid}"        # a writer killed mid-write (its process is gone)
+    stale.write_bytes(b"trunc")
+    run_optimiser(ev(), "de", 3, 10, 0, checkpoint=ck)
+    assert not stale.exists()
+    resumed = run_optimiser(ev(), "de", 6, 10, 0, checkpoint=ck)
+    assert resumed.resumed_from == 3
+    assert np.array_equal(resumed.x, full.x) and np.array_equal(resumed.f, full.f)
+    assert resumed.history == full.history and resumed.n_sims == full.n_sims
+    assert sorted(f.name for f in tmp_path.iterdir()) == ["de.ckpt"]
+
+
+def test_a_failed_checkpoint_write_leaves_no_temporary(tmp_path):
+    from steerlab.tuning.optimisers import _atomic_pickle
+
+    with pytest.raises(Exception):
+        _atomic_pickle({"f": lambda: 0}, tmp_path / "x.ckpt")     # a lambda cannot be pickled
+    assert list(tmp_path.iterdir()) == []
+
+
 def test_nsga2_front_is_nondominated_and_trades_off(lq_conditions):
     pm = build_param_map(lq_conditions, ["kp", "kd"], np.array([[0.1, 5.0], [1.0, 100.0]]))
     ev = PopulationEvaluator(lq_conditions, pm, [parse_cost("itae"), parse_cost("travel")])

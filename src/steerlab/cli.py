@@ -66,19 +66,35 @@ def _run(args, figures) -> int:
     if not (args.lam >= 0.0 and math.isfinite(args.lam)):
         raise InputError("--lambda", f"must be a finite number >= 0, got {args.lam}")
     say(f"scenario {one_line(scenario.name, 80)!r} from {path}")
-    setup, warnings = design_checked(scenario)
+    from steerlab.commands import _run_options as ro
+
+    ro.check_run_options(args, scenario)      # --record-every, memory estimate: before any allocation
+    setup, warnings = design_checked(scenario, args.max_memory)
     say(f"simulating {setup.n_steps} steps of {setup.dt} s with the {args.engine} engine "
         f"({setup.ship.name} + {setup.controller.name})")
-    result = simulate(setup, engine=args.engine)
-    check_run(result, setup)                  # a diverged run or a spin: exit 3, no metrics
+    result = simulate(setup, engine=args.engine, record_every=args.record_every)
+    try:
+        check_run(result, setup)              # a diverged run or a spin: exit 3, no metrics
+        ro.check_accumulator(result, setup)
+    except DivergedError as err:
+        if args.keep_diverged:                # the rows before it, marked diverged; exit 3 all the same
+            with staged_output(Path(args.out)) as stage:
+                rows = ro.write_diverged(stage, result, scenario, err, args)
+            say(f"kept {rows} rows up to the divergence in {args.out} (metrics.json: diverged)")
+        raise
     metrics = compute_metrics(result, lam=args.lam)
     say("writing time series, metrics, figures and report")
     with staged_output(Path(args.out)) as stage:
         figures.submit(stage, result, report_title(result, scenario))   # drawn while the data is written
-        result.to_csv(stage / "timeseries.csv")
+        result.to_csv(stage / "timeseries.csv", ro.csv_progress(say, len(result.time)))
         if args.parquet:
             result.to_parquet(stage / "timeseries.parquet")
         extra = {"warnings": warnings} if warnings else {}
+        if args.record_every != 1:
+            extra["record_every"] = args.record_every
+            extra["note"] = ("integral metrics (iae, ise, itae, J, travel, reversals, mean rudder, max error) "
+                             "from every step; step metrics, final error, max rudder and min speed from the "
+                             f"log, every {args.record_every * setup.dt:g} s")
         dump_json({"scenario": scenario.name, "seed": scenario.seed, "engine": args.engine,
                    "metrics": metrics, "units": {k: METRIC_UNITS.get(k, "") for k in metrics}, **extra},
                   stage / "metrics.json", digits=None)
@@ -201,6 +217,9 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("--lambda", dest="lam", type=float, default=0.1,
                    help="rudder weight of the speed-loss criterion J (default 0.1)")
     r.add_argument("--parquet", action="store_true", help="also write timeseries.parquet (needs pyarrow)")
+    from steerlab.commands._run_options import add_run_options
+
+    add_run_options(r)
     r.add_argument("--quiet", action="store_true", help="no progress messages")
     r.set_defaults(func=cmd_run)
 
@@ -250,7 +269,10 @@ def main(argv=None) -> int:
         from steerlab.sim import drivers
 
         drivers.on_compile = _say_compiling
+    restore = None
     try:
+        if getattr(args, "out", None):        # every command that writes: --out checked before any work
+            restore = _prepare_out(args.out)
         return args.func(args)
     except InputError as err:
         _close_progress()
@@ -265,12 +287,14 @@ def main(argv=None) -> int:
 
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 0
-    except KeyboardInterrupt:
+    except KeyboardInterrupt as err:
         _close_progress()
         print("steerlab: interrupted", file=sys.stderr)
-        return 130
+        return 143 if isinstance(err, _Terminated) else 130
     finally:
         _close_progress(forget=True)
+        if restore is not None:
+            restore()
 
 
 def _say_compiling(msg: str) -> None:
@@ -286,6 +310,31 @@ def _close_progress(forget: bool = False) -> None:
     progress = sys.modules.get("steerlab.progress")
     if progress is not None:
         progress.close_all(forget)
+
+
+class _Terminated(KeyboardInterrupt):
+    """SIGTERM during a command that writes: unwinds like Ctrl-C (exit 143)."""
+
+
+def _prepare_out(out: str):
+    """Refuse a bad ``--out`` before any work, repair leftovers of killed runs, and make SIGTERM
+    unwind like Ctrl-C so the stage folder is removed (docs/reliability-outputs.md). Returns the
+    function that restores the default SIGTERM handling (or None)."""
+    import signal
+    import threading
+
+    from steerlab.outputs import prepare_out
+
+    prepare_out(out)
+    if threading.current_thread() is not threading.main_thread() \
+            or signal.getsignal(signal.SIGTERM) is not signal.SIG_DFL:
+        return None
+
+    def _terminated(signum, frame):
+        raise _Terminated
+
+    signal.signal(signal.SIGTERM, _terminated)
+    return lambda: signal.signal(signal.SIGTERM, signal.SIG_DFL)
 
 
 if __name__ == "__main__":  # pragma: no cover

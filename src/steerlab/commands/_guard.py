@@ -35,12 +35,16 @@ def warn(lines) -> None:
         print(f"steerlab: warning: {one_line(line)}", file=sys.stderr, flush=True)
 
 
-def design_checked(scenario):
+def design_checked(scenario, max_memory: float | None = None):
     """``(setup, warnings)``: the scenario refused if impossible, built under :func:`design_guard`,
-    its warnings printed (see :mod:`steerlab.sim.sanity`)."""
+    its warnings printed (see :mod:`steerlab.sim.sanity`); refused first if its set-up would not fit
+    in memory (``max_memory`` [GB], :mod:`steerlab.resources`)."""
     from steerlab.sim.sanity import check_scenario, scenario_warnings
     from steerlab.sim.setup import build
 
+    from steerlab.resources import check_setup_memory
+
+    check_setup_memory(scenario, max_memory)  # before build() allocates the disturbance sequence
     with design_guard():
         check_scenario(scenario)
         setup = build(scenario)

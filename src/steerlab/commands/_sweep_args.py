@@ -28,6 +28,8 @@ def add_executor_args(p) -> None:
                    help="run chunks of the batch on a dask.distributed cluster: a scheduler address "
                         "(tcp://HOST:8786) or 'local' (a LocalCluster on 127.0.0.1); needs steerlab[dask]")
     p.add_argument("--chunk-size", type=int, default=256, help="runs per dask task (default 256)")
+    p.add_argument("--max-memory", type=float, default=None, metavar="GB",
+                   help="memory the sweep may plan to use (default: STEERLAB_MAX_MEMORY or 75%% of this machine's)")
 
 
 def add_condition_args(p, seeds_help: str = "sea realisations (seeds scenario.seed + i) per condition (default 1)") -> None:

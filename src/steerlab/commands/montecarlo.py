@@ -43,10 +43,14 @@ def cmd_montecarlo(args) -> int:
     scenario = load_scenario(args.scenario)
     from steerlab.commands._guard import design_checked
 
-    design_checked(scenario)
+    from steerlab.sweeps.montecarlo import MAX_RUNS, check_montecarlo_memory
+
+    if 2 <= args.runs <= MAX_RUNS:            # (out of range: run_montecarlo names --runs)
+        check_montecarlo_memory(scenario, args.runs, args.record_every, args.max_memory)   # before any set-up
+    design_checked(scenario, args.max_memory)
     executor = executor_from_args(args)
     try:
-        res = run_montecarlo(scenario, args.runs, args.lam, args.record_every, executor, say)
+        res = run_montecarlo(scenario, args.runs, args.lam, args.record_every, executor, say, args.max_memory)
     finally:
         executor.close()
     if res.n_diverged:

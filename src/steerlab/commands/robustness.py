@@ -51,11 +51,12 @@ def cmd_robustness(args) -> int:
     scenario = with_controller(load_scenario(args.scenario), args.controller)
     from steerlab.commands._guard import design_checked
 
-    design_checked(scenario)
+    design_checked(scenario, args.max_memory)
     variations = [parse_vary(v, scenario) for v in args.vary]
     executor = executor_from_args(args)
     try:
-        res = run_robustness(scenario, variations, args.metric, args.lam, args.redesign, executor, say)
+        res = run_robustness(scenario, variations, args.metric, args.lam, args.redesign, executor, say,
+                             args.max_memory)
     finally:
         executor.close()
     if "diverged" in res.table:

@@ -68,7 +68,7 @@ def cmd_tune(args) -> int:
     from steerlab.commands._guard import design_checked
     from steerlab.tuning.session import with_controller
 
-    design_checked(with_controller(scenario, args.controller))
+    design_checked(with_controller(scenario, args.controller), args.max_memory)
     names = [n.strip() for n in args.params.split(",") if n.strip()]
     if not names:
         raise InputError("--params", "needs at least one parameter name")
@@ -80,6 +80,7 @@ def cmd_tune(args) -> int:
     spec = TuneSpec(scenario, names, bounds, costs, args.controller, method, args.generations,
                     args.pop_size, args.seed, aggregate=args.aggregate, lam=args.lam,
                     checkpoint=args.checkpoint, **condition_kwargs(args))
+    _check_tune_memory(spec, args.max_memory)
     executor = executor_from_args(args)
     try:
         outcome = tune(spec, executor, say)
@@ -101,3 +102,16 @@ def cmd_tune(args) -> int:
     warn(s.get("warnings", ()))
     say(f"wrote {args.out}/result.json")
     return 0
+
+
+def _check_tune_memory(spec, max_memory) -> None:
+    """Refuse a tuning job whose conditions' seas (each held twice: set-up and packed batch) and
+    per-run records (population x conditions) would not fit (:mod:`steerlab.resources`), before any set-up."""
+    from steerlab.resources import BASE_BYTES, check_memory, sweep_bytes
+
+    n_cond = (max(1, len(spec.variants)) * max(1, len(spec.speeds_kn)) * max(1, len(spec.wave_powers))
+              * max(1, int(spec.n_seeds)))
+    need = BASE_BYTES + sweep_bytes(n_cond, spec.scenario.n_steps) + 8.0 * 256 * spec.pop_size * n_cond
+    check_memory("--seeds", need, f"{n_cond} conditions of {spec.scenario.n_steps} steps x a population of "
+                              f"{spec.pop_size}", "use fewer conditions or seeds, a smaller population or a shorter "
+                              "duration", max_memory)

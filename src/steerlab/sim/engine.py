@@ -36,13 +36,16 @@ def _ref_columns(s: SimSetup) -> int:
     return 2 if s.guide is None else N_REF
 
 
-def _result(s: SimSetup, X, cmd, ref, engine: str) -> Result:
-    time = np.arange(s.n_steps + 1) * s.dt
+def _result(s: SimSetup, X, cmd, ref, engine: str, record_every: int = 1) -> Result:
+    time = np.arange(0, X.shape[0] * record_every, record_every) * s.dt   # t_k = k dt, k = 0, N, 2N ...
+    w = s.w if record_every == 1 else s.w[::record_every]
     res = Result(time=time, states=X, state_names=s.state_names, state_units=s.state_units,
-                 delta_cmd=cmd, psi_ref=ref[:, REF_PSI], r_ref=ref[:, REF_R], disturbance=s.w,
+                 delta_cmd=cmd, psi_ref=ref[:, REF_PSI], r_ref=ref[:, REF_R], disturbance=w,
                  meta={"name": s.name, "seed": s.seed, "ship": s.ship.name,
                        "controller": s.controller.name, "engine": engine, "dt": s.dt,
                        "controller_sample_time": s.nc * s.dt, "n_steps": s.n_steps})
+    if record_every != 1:
+        res.meta["record_every"] = record_every
     res.meta["ship_dims"] = (float(s.ship.dims[1]), float(s.ship.dims[2]))   # L, B [m] for plots
     if s.guidance is not None and s.guide is not None:
         res.meta["guidance"] = s.guidance
@@ -86,31 +89,60 @@ def simulate_readable(scenario_or_setup: Union[Scenario, SimSetup]) -> Result:
     return _result(s, X, cmd_log, ref_log, "readable")
 
 
-def simulate_compiled(scenario_or_setup: Union[Scenario, SimSetup]) -> Result:
-    """The compiled closed loop (numba), recording every step."""
+def simulate_compiled(scenario_or_setup: Union[Scenario, SimSetup], record_every: int = 1) -> Result:
+    """The compiled closed loop (numba), recording every ``record_every``-th step (steps
+    0, N, 2N, ...); the integral metrics are accumulated on every step all the same."""
     s = _as_setup(scenario_or_setup)
     run = closed_loop(s.ship.rhs, s.controller.update, s.x0.shape[0], s.guide)
     x = s.x0.copy()
     z = s.z0.copy()
     N = s.n_steps
-    X = np.empty((N + 1, x.shape[0]))
-    cmd = np.empty(N + 1)
+    rows = N // record_every + 1
+    X = np.empty((rows, x.shape[0]))
+    cmd = np.empty(rows)
     acc = new_accumulator()
-    ref = np.empty((N + 1, _ref_columns(s)))
-    run(x, z, s.ps.copy(), s.pg, s.pc, s.gd, s.gz0.copy(), s.w, s.dt, s.nc, N, 1, X, cmd, ref,
+    ref = np.empty((rows, _ref_columns(s)))
+    run(x, z, s.ps.copy(), s.pg, s.pc, s.gd, s.gz0.copy(), s.w, s.dt, s.nc, N, record_every, X, cmd, ref,
         acc, s.rpm_slot)
-    res = _result(s, X, cmd, ref, "compiled")
+    res = _result(s, X, cmd, ref, "compiled", record_every)
     res.meta["online_metrics"] = acc
+    if record_every != 1:
+        res.meta["final_state"] = x.copy()        # the state after the last step (maybe not logged)
     return res
 
 
-def simulate(scenario_or_setup: Union[Scenario, SimSetup], engine: str = "compiled") -> Result:
-    """Run one scenario (a :class:`Scenario` or a built :class:`SimSetup`)."""
-    if engine == "compiled":
-        return simulate_compiled(scenario_or_setup)
-    if engine == "readable":
-        return simulate_readable(scenario_or_setup)
+def _thinned(res: Result, record_every: int) -> Result:
+    """A full-rate readable run cut to every ``record_every``-th row, its integral metrics kept
+    from every step (the compiled engine's log and accumulator, same numbers)."""
+    from dataclasses import replace
+
+    acc = online_metrics_from_result(res)
+    final = res.states[-1].copy()
+    k = slice(None, None, record_every)
+    out = replace(res, time=res.time[k], states=res.states[k], delta_cmd=res.delta_cmd[k],
+                  psi_ref=res.psi_ref[k], r_ref=res.r_ref[k], disturbance=res.disturbance[k], meta=dict(res.meta))
+    out.meta.update(online_metrics=acc, record_every=record_every, final_state=final)
+    return out
+
+
+def simulate(scenario_or_setup: Union[Scenario, SimSetup], engine: str = "compiled", record_every: int = 1) -> Result:
+    """Run one scenario (a :class:`Scenario` or a built :class:`SimSetup`).
+
+    ``record_every``: log every N-th step only (``time`` then steps ``k = 0, N, 2N, ...``; the
+    last step is logged only if the step count is a multiple of N). The integral metrics
+    (``meta["online_metrics"]``) still cover every step; ``meta["final_state"]`` is the state
+    after the last step.
+    """
     from steerlab.errors import InputError
+
+    if isinstance(record_every, bool) or not isinstance(record_every, (int, np.integer)) or record_every < 1:
+        raise InputError("--record-every", f"must be an integer >= 1, got {record_every!r}")
+    record_every = int(record_every)
+    if engine == "compiled":
+        return simulate_compiled(scenario_or_setup, record_every)
+    if engine == "readable":
+        res = simulate_readable(scenario_or_setup)
+        return res if record_every == 1 else _thinned(res, record_every)
     raise InputError("engine", f"must be one of {ENGINES}, got {engine!r}")
 
 

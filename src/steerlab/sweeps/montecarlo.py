@@ -103,8 +103,37 @@ def _has_random_sea(env) -> bool:
                     and (cur.speed_amplitude > 0.0 or cur.dir_amplitude_deg > 0.0)))
 
 
+def montecarlo_bytes(n_runs: int, n_steps: int, nx: int, record_every: int) -> float:
+    """Estimated peak memory [bytes] of :func:`run_montecarlo` (:mod:`steerlab.resources`): the
+    seas of one chunk, its log, and the heading-error and rudder logs of all runs (twice: the
+    percentiles copy them)."""
+    from steerlab.resources import BASE_BYTES, sweep_bytes
+
+    rows = n_steps // record_every + 1
+    m = min(CHUNK_RUNS, n_runs)
+    return BASE_BYTES + sweep_bytes(m, n_steps) + 8.0 * (m * rows * (nx + 3) + 4 * n_runs * rows)
+
+
+def check_montecarlo_memory(scenario, n_runs: int, record_every: int | None = None,
+                            max_memory: float | None = None) -> int:
+    """Refuse a Monte-Carlo whose memory estimate is above the limit (field ``--runs``, before
+    anything is built); returns the log interval (``record_every`` or its default)."""
+    from steerlab.resources import check_memory
+    from steerlab.ships.registry import get_ship
+
+    nx = get_ship(scenario.ship.model).n_states + 1
+    if record_every is None:
+        record_every = default_record_every(n_runs, scenario.n_steps, nx)
+    if record_every < 1:
+        raise InputError("--record-every", f"must be >= 1, got {record_every}")
+    check_memory("--runs", montecarlo_bytes(n_runs, scenario.n_steps, nx, record_every),
+                 f"{n_runs} runs of {scenario.n_steps} steps logged every {record_every} step(s)",
+                 "use fewer runs, a larger --record-every or a shorter duration", max_memory)
+    return record_every
+
+
 def run_montecarlo(scenario, n_runs: int, lam: float = 0.1, record_every: int | None = None,
-                   executor=None, progress=None) -> MonteCarloResult:
+                   executor=None, progress=None, max_memory: float | None = None) -> MonteCarloResult:
     """Run the scenario over ``n_runs`` seeds (see the module docstring).
 
     The runs go through the batch engine in chunks of :data:`CHUNK_RUNS` seeds, each built,
@@ -124,6 +153,7 @@ def run_montecarlo(scenario, n_runs: int, lam: float = 0.1, record_every: int | 
     if not (_has_random_sea(scenario.environment) or noisy_sensors):
         say("note: the scenario has nothing random (no waves, gusts, current variation or sensor noise): "
             "every realisation is the same")
+    record_every = check_montecarlo_memory(scenario, n_runs, record_every, max_memory)
     executor = executor or LocalExecutor()
     report = runs_progress(say)
     per_run: dict = {}
@@ -136,10 +166,6 @@ def run_montecarlo(scenario, n_runs: int, lam: float = 0.1, record_every: int | 
         batch = PackedBatch.from_setups([c.setup for c in condition_set(chunk, n_seeds=m)])
         if start == 0:
             n_steps, dt = batch.n_steps, batch.dt
-            if record_every is None:
-                record_every = default_record_every(n_runs, batch.n_steps, batch.X.shape[1])
-            if record_every < 1:
-                raise InputError("--record-every", f"must be >= 1, got {record_every}")
             say(f"{n_runs} runs of {batch.n_steps} steps ({batch.ship_name} + {batch.controller_name}), "
                 f"log every {record_every} step(s), chunks of <= {CHUNK_RUNS} runs")
         out = executor.run(batch, record_every, lambda done, _n, s0=start: report(s0 + done, n_runs))

@@ -109,7 +109,8 @@ def _set(d: dict, path: tuple, value: float) -> dict:
 
 
 def run_robustness(scenario, variations: list[Variation], metric: str = "itae", lam: float = 0.1,
-                   redesign: bool = False, executor=None, progress=None) -> RobustnessResult:
+                   redesign: bool = False, executor=None, progress=None,
+                   max_memory: float | None = None) -> RobustnessResult:
     """Evaluate ``metric`` (a cost expression) over the grid of ``variations``."""
     say = progress or (lambda msg: None)
     if not 1 <= len(variations) <= 3:
@@ -119,13 +120,17 @@ def run_robustness(scenario, variations: list[Variation], metric: str = "itae", 
     expr = parse_cost(metric, "--metric")
     if expr.needs_log:
         raise InputError("--metric", f"robustness maps use the on-line metrics only: {', '.join(ONLINE)}")
+    n_points = math.prod(len(v.values) for v in variations)   # counted before the grid is built
+    if n_points > MAX_POINTS:
+        raise InputError("--vary", f"{n_points} grid points "
+                                   f"({' x '.join(str(len(v.values)) for v in variations)}); "
+                                   f"allowed at most {MAX_POINTS}")
     points = list(itertools.product(*(v.values for v in variations)))
-    if len(points) > MAX_POINTS:
-        raise InputError("--vary", f"{len(points)} grid points; allowed at most {MAX_POINTS}")
     nominal = make_condition("nominal", scenario)
     base = scenario.model_dump()
     setups = []
-    for pt in points:
+    seas = 0                                 # distinct disturbance sequences held so far
+    for i, pt in enumerate(points):
         d = base
         for v, val in zip(variations, pt):
             d = _set(d, v.path, val)
@@ -140,6 +145,10 @@ def run_robustness(scenario, variations: list[Variation], metric: str = "itae", 
             s = replace(s, pc=nominal.setup.pc, z0=nominal.setup.z0)
         if s.w.shape == nominal.setup.w.shape and np.array_equal(s.w, nominal.setup.w):
             s = replace(s, w=nominal.setup.w)   # the same sea: the batch stores it once
+        else:
+            seas += 1
+        if i == 0 or seas == 1:               # the first point tells whether the grid varies the sea
+            _check_grid_memory(n_points if seas else 1, s.n_steps, n_points, label, max_memory)
         setups.append(s)
     say(f"{len(points)} grid points ({' x '.join(str(len(v.values)) for v in variations)}), controller "
         f"{'redesigned at every point' if redesign else 'designed for the nominal scenario'}")
@@ -163,6 +172,16 @@ def run_robustness(scenario, variations: list[Variation], metric: str = "itae", 
     nominal_row = {"metric": float(values[-1]), **{k: float(m[k][-1]) for k in sorted(names)}}
     return RobustnessResult(variations, points, expr.text, values[:-1], table, nominal_row, redesign,
                             scenario.ship.model)
+
+
+def _check_grid_memory(n_seas: int, n_steps: int, n_points: int, label: str, max_memory) -> None:
+    """Refuse a grid whose disturbance sequences (one per point when the grid varies the sea)
+    would not fit (:mod:`steerlab.resources`)."""
+    from steerlab.resources import BASE_BYTES, check_memory, sweep_bytes
+
+    need = BASE_BYTES + sweep_bytes(n_seas + 1, n_steps, shared_seas=False) + 8.0 * 64 * (n_points + 1)
+    check_memory("--vary", need, f"a grid of {n_points} points with {n_seas} distinct sea(s) of {n_steps} steps "
+                                 f"(first point: {label})", "use fewer points or a shorter duration", max_memory)
 
 
 def write_robustness_outputs(stage, res: RobustnessResult, scenario_name: str) -> None:

@@ -20,9 +20,12 @@ population x conditions):
 Checkpoints. After every generation the state is written atomically (temporary file +
 ``os.replace``) to the checkpoint file, if one was given: for pymoo the pickled algorithm
 object (its population and random state), for DE the population, its costs and the state
-of the random generator. A resumed pymoo run continues bit-identically; a resumed DE run
-restarts scipy from the saved population (``init=``) with the saved random state, so it
-re-evaluates that population once and continues from there. A checkpoint stores the problem
+of the random generator. A resumed run continues bit-identically to an uninterrupted one
+(same generations, same best, same history and simulation count): for DE the checkpoint
+holds scipy's solver state (unit-scaled population, energies, feasibility, evaluation
+count, the sample index it shuffles in place) and the random state after the generation,
+restored into a fresh solver, so nothing is evaluated twice. A DE checkpoint of the earlier
+format is refused. A checkpoint stores the problem
 it belongs to (scenario, controller, parameters, bounds, costs, conditions, method, seed)
 and refuses to resume another. Checkpoints are pickles: load only your own.
 """
@@ -91,16 +94,32 @@ class _Pickler(pickle.Pickler):
 
 
 def _atomic_pickle(obj, path: Path) -> None:
+    """Write ``obj`` to ``path`` whole: a temporary sibling, then ``os.replace``; the temporary
+    file is removed on any failure (and a killed writer's is removed by :func:`load_checkpoint`)."""
     path = Path(path)
     tmp = path.with_name(f".{path.name}.tmp-{os.getpid()}")
-    with open(tmp, "wb") as fh:
-        _Pickler(fh, protocol=pickle.HIGHEST_PROTOCOL).dump(obj)
-    os.replace(tmp, path)
+    try:
+        with open(tmp, "wb") as fh:
+            _Pickler(fh, protocol=pickle.HIGHEST_PROTOCOL).dump(obj)
+        os.replace(tmp, path)
+    except BaseException:
+        tmp.unlink(missing_ok=True)
+        raise
+
+
+def _remove_stale_temporaries(path: Path) -> None:
+    """Delete ``.NAME.tmp-PID`` siblings of ``path`` left by processes that are gone."""
+    from steerlab.outputs import _leftovers, _pid_alive
+
+    for pid, tmp in _leftovers(path.parent, path.name, ".tmp-").items():
+        if not _pid_alive(pid):
+            tmp.unlink(missing_ok=True)
 
 
 def load_checkpoint(path, problem_key: dict) -> dict | None:
     """The checkpoint at ``path`` if it exists and belongs to ``problem_key`` (else InputError)."""
     p = Path(path)
+    _remove_stale_temporaries(p)
     if not p.exists():
         return None
     try:
@@ -108,7 +127,8 @@ def load_checkpoint(path, problem_key: dict) -> dict | None:
             ck = pickle.load(fh)
     except Exception as err:
         raise InputError("--checkpoint", f"cannot read checkpoint {str(p)!r}: {err}") from None
-    if not isinstance(ck, dict) or ck.get("version") != CHECKPOINT_VERSION:
+    if not isinstance(ck, dict) or ck.get("version") != CHECKPOINT_VERSION \
+            or (ck.get("key", {}).get("method") == "de" and "solver" not in ck):
         raise InputError("--checkpoint", f"{str(p)!r} is not a steerlab tuning checkpoint")
     if ck.get("key") != problem_key:
         diff = sorted(k for k in set(problem_key) | set(ck.get("key", {}))
@@ -153,19 +173,20 @@ def run_optimiser(evaluator, method: str, generations: int, pop_size: int, seed:
 
 
 def _run_de(ev, generations, pop_size, seed, checkpoint, key, ck, prog) -> TuningResult:
-    from scipy.optimize import differential_evolution
+    # scipy's own solver object (what differential_evolution builds and runs), driven here so
+    # that a checkpoint holds its exact state: the unit-scaled population, its energies, the
+    # feasibility arrays, the evaluation count, the in-place-shuffled sample index and the
+    # random generator after the generation.
+    from scipy.optimize._differentialevolution import DifferentialEvolutionSolver
 
     bounds = ev.param_map.bounds
     d = bounds.shape[0]
     rng = np.random.default_rng(seed)
     history = []
     gen0 = 0
-    init = "latinhypercube"
     if ck is not None:
-        rng.bit_generator.state = ck["rng_state"]
         history = list(ck["history"])
         gen0 = ck["generation"]
-        init = ck["population"]
         ev.n_sims = ck["n_sims"]
     remaining = generations - gen0
     if remaining <= 0:
@@ -177,7 +198,7 @@ def _run_de(ev, generations, pop_size, seed, checkpoint, key, ck, prog) -> Tunin
 
     def callback(intermediate_result):
         state["gen"] += 1
-        pop = np.asarray(intermediate_result.population)
+        solver = state["solver"]
         energies = np.asarray(intermediate_result.population_energies)
         best_x = np.asarray(intermediate_result.x, dtype=float)
         best_f = float(intermediate_result.fun)
@@ -185,15 +206,33 @@ def _run_de(ev, generations, pop_size, seed, checkpoint, key, ck, prog) -> Tunin
                         "mean": float(np.mean(energies)), **ev.param_map.values_dict(best_x)})
         prog(state["gen"], ev.n_sims, best_f, best_x)
         state["last"] = {"version": CHECKPOINT_VERSION, "key": key, "generation": state["gen"],
-                         "population": pop, "energies": energies, "rng_state": rng.bit_generator.state,
+                         "population": np.asarray(intermediate_result.population), "energies": energies,
+                         "solver": {"population": solver.population.copy(),
+                                    "population_energies": solver.population_energies.copy(),
+                                    "feasible": np.array(solver.feasible, copy=True),
+                                    "constraint_violation": np.array(solver.constraint_violation, copy=True),
+                                    "nfev": solver._nfev,
+                                    "random_index": solver._random_population_index.copy()},
+                         "rng_state": rng.bit_generator.state,
                          "history": history, "n_sims": ev.n_sims, "best_x": best_x, "best_f": best_f}
         if checkpoint:
             _atomic_pickle(state["last"], checkpoint)
 
     popsize = max(2, int(math.ceil(pop_size / d)))
-    differential_evolution(objective, bounds, vectorized=True, updating="deferred", polish=False,
-                           rng=rng, popsize=popsize, maxiter=remaining, init=init, tol=0.0,
-                           atol=0.0, callback=callback)
+    with DifferentialEvolutionSolver(objective, bounds, vectorized=True, updating="deferred", polish=False,
+                                     rng=rng, popsize=popsize, maxiter=remaining, init="latinhypercube",
+                                     tol=0.0, atol=0.0, callback=callback) as solver:
+        state["solver"] = solver
+        if ck is not None:                   # continue exactly where the checkpoint's generation ended
+            saved = ck["solver"]
+            solver.population = saved["population"].copy()
+            solver.population_energies = saved["population_energies"].copy()
+            solver.feasible = saved["feasible"].copy()
+            solver.constraint_violation = saved["constraint_violation"].copy()
+            solver._nfev = saved["nfev"]
+            solver._random_population_index = saved["random_index"].copy()   # shuffled in place each draw
+            rng.bit_generator.state = ck["rng_state"]
+        solver.solve()
     return _de_result(state.get("last", ck), history, state["gen"], ev, resumed=gen0 or None)
 
 
