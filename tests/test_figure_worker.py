@@ -5,16 +5,23 @@ raised in the parent; a cancelled, failed or vanished child leaves nothing behin
 from __future__ import annotations
 
 import os
+import sys
 
 import pytest
 
-from steerlab.figure_worker import FigureWorker, fork_allowed
+from steerlab import figure_worker as fw
+from steerlab.figure_worker import FigureWorker
 from steerlab.report import FIGURE_NAMES, figure_worker, write_run_figures
 from steerlab.sim.engine import simulate
 from steerlab.sim.setup import build
 
-needs_fork = pytest.mark.skipif(not fork_allowed(), reason="fork is not used on this platform or "
-                                                           "in a threaded process")
+@pytest.fixture
+def forking(monkeypatch):
+    """Fork even if an earlier test in this worker left a thread running (the guard of
+    fork_allowed() is for commands; the children here run plain Python and matplotlib)."""
+    if not (sys.platform.startswith("linux") and hasattr(os, "fork")):
+        pytest.skip("the figure worker forks on Linux only")
+    monkeypatch.setattr(fw, "fork_allowed", lambda: True)
 
 
 @pytest.fixture(scope="module")
@@ -32,10 +39,10 @@ def _reaped(pid: int) -> bool:
     return False
 
 
-def test_worker_figures_are_byte_identical_to_figures_drawn_in_order(result, tmp_path):
+def test_worker_figures_are_byte_identical_to_figures_drawn_in_order(result, tmp_path, forking):
     write_run_figures(tmp_path / "inline", result, "t")
     worker = figure_worker().start()
-    assert len(worker._children) == (1 if fork_allowed() else 0)   # a child where fork is used
+    assert len(worker._children) == 1                       # drawn in a child
     worker.submit(tmp_path / "child", result, "t")
     worker.wait()
     for name in FIGURE_NAMES:
@@ -46,16 +53,20 @@ def _fail(*args, **kw):
     raise ValueError("delta_max out of range")
 
 
-def test_a_failing_child_is_raised_in_the_parent_with_its_message(tmp_path):
-    forked = fork_allowed()
-    with pytest.raises(RuntimeError if forked else ValueError,
-                       match=("ValueError: " if forked else "") + "delta_max out of range"):
+def test_a_failing_child_is_raised_in_the_parent_with_its_message(tmp_path, forking):
+    with pytest.raises(RuntimeError, match="ValueError: delta_max out of range"):
         with FigureWorker(_fail) as worker:
             worker.submit(tmp_path)
 
 
-@needs_fork
-def test_the_child_warms_up_before_the_job_and_draws_in_its_own_process(tmp_path):
+def test_inline_a_failing_draw_raises_its_own_exception(tmp_path, monkeypatch):
+    monkeypatch.setenv("STEERLAB_FORK_JOBS", "0")
+    with pytest.raises(ValueError, match="delta_max out of range"):
+        with FigureWorker(_fail) as worker:
+            worker.submit(tmp_path)
+
+
+def test_the_child_warms_up_before_the_job_and_draws_in_its_own_process(tmp_path, forking):
     def warm():
         (tmp_path / "warm").write_text(str(os.getpid()))
 
@@ -69,8 +80,7 @@ def test_the_child_warms_up_before_the_job_and_draws_in_its_own_process(tmp_path
     assert _reaped(pid)
 
 
-@needs_fork
-def test_a_command_that_fails_before_submitting_kills_the_children(tmp_path):
+def test_a_command_that_fails_before_submitting_kills_the_children(tmp_path, forking):
     with pytest.raises(KeyError):
         with FigureWorker(lambda *a, **k: (tmp_path / "drawn").write_text("x"), parts=2) as worker:
             pids = [c[0] for c in worker._children]
@@ -78,8 +88,7 @@ def test_a_command_that_fails_before_submitting_kills_the_children(tmp_path):
     assert len(pids) == 2 and all(_reaped(p) for p in pids) and not (tmp_path / "drawn").exists()
 
 
-@needs_fork
-def test_a_vanished_child_means_the_parent_draws_itself(tmp_path):
+def test_a_vanished_child_means_the_parent_draws_itself(tmp_path, forking):
     worker = FigureWorker(lambda where, part, parts: (where / "drawn").write_text(str(os.getpid()))).start()
     os.kill(worker.pid, 9)              # e.g. killed by the OOM killer while warming up
     os.waitpid(worker.pid, 0)
