@@ -61,6 +61,38 @@ def check_one(path: Path, out: Path) -> str:
     return "rejected"
 
 
+def check_one_real(path: Path, out: Path, limit_s: float = 30.0) -> str:
+    """Run ``steerlab run path --out out`` with the real engine; assert the contract of issue 15
+    for an accepted file: exit 0 with finite time series and metrics, or exit 3 (divergence)
+    with one line and nothing in ``--out``; a rejected file as :func:`check_one`. Returns
+    ``"accepted"``, ``"diverged"`` or ``"rejected"``."""
+    import json
+    import math
+
+    import numpy as np
+
+    err = io.StringIO()
+    t0 = time.perf_counter()
+    with contextlib.redirect_stderr(err), contextlib.redirect_stdout(io.StringIO()):
+        rc = main(["run", str(path), "--out", str(out), "--quiet"])
+    elapsed = time.perf_counter() - t0
+    lines = [ln for ln in err.getvalue().splitlines() if not ln.startswith("steerlab: warning: ")]
+    lines = [ln for ln in lines if "compiling" not in ln and not ln.startswith("  ")]   # compile notices
+    assert elapsed < limit_s, f"{path.name}: {elapsed:.1f} s"
+    if rc == 0:
+        data = np.loadtxt(out / "timeseries.csv", delimiter=",", skiprows=1, ndmin=2)
+        assert np.all(np.isfinite(data)), path.name
+        metrics = json.loads((out / "metrics.json").read_text())["metrics"]
+        assert all(v is None or math.isfinite(v) for v in metrics.values()), (path.name, metrics)
+        return "accepted"
+    assert len(lines) == 1 and lines[0].startswith(PREFIX), (path.name, rc, lines)
+    assert not out.exists(), path.name
+    if rc == 3:
+        return "diverged"
+    assert rc == 2, (path.name, rc, lines)
+    return "rejected"
+
+
 def test_mutated_scenarios_exit_0_or_one_line_2(tmp_path, monkeypatch):
     import steerlab.sim.engine as engine
 
@@ -72,6 +104,17 @@ def test_mutated_scenarios_exit_0_or_one_line_2(tmp_path, monkeypatch):
     # both outcomes occur (a mutator that only breaks files, or never does, tests little)
     assert outcomes["accepted"] >= 30 and outcomes["rejected"] >= 150, outcomes
     assert time.perf_counter() - t0 < 120.0
+
+
+@pytest.mark.slow
+def test_accepted_mutants_run_to_finite_results_or_a_clear_divergence(tmp_path):
+    """The real engine on mutants (no stub): an accepted file gives finite time series and
+    metrics, or exit 3 with one line and nothing written (a first run of a combination may
+    compile: 120 s per file here; the long script holds 30 s on a warm cache)."""
+    outcomes = {"accepted": 0, "diverged": 0, "rejected": 0}
+    for i, path in enumerate(scenario_mutator.mutants(60, seed=16, folder=tmp_path / "in")):
+        outcomes[check_one_real(path, tmp_path / f"out{i}", limit_s=120.0)] += 1
+    assert outcomes["accepted"] >= 5 and outcomes["rejected"] >= 20, outcomes
 
 
 def _issue_case(tmp_path, kind) -> Path:
