@@ -78,7 +78,7 @@ class MyPD:
 
     def init_state(self, x0, ref0) -> np.ndarray:
         z = np.zeros(N_STATE)
-        z[Z_D] = wrap_to_pi(ref0[0] - x0[IPSI])     # start without a derivative kick (ref0 = (psi, r))
+        z[Z_D] = wrap_to_pi(ref0[REF_PSI] - x0[IPSI])     # start without a derivative kick (ref0 = (psi, r))
         return z
 
 

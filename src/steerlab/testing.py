@@ -221,7 +221,7 @@ def _check_controller(spec, kind, name, ship, cfg, duration, vectorisation=True,
     setup = build(d.scenario)
     z, p, x = setup.z0.copy(), setup.pc.copy(), setup.x0.copy()
     ref = np.zeros(N_REF)
-    ref[REF_PSI] = d.ref0[0]
+    ref[REF_PSI] = d.ref0[REF_PSI]
     h = setup.nc * setup.dt
     _py_bounds(kind, name, spec.update.py_func, (z.copy(), p, 0.0, x.copy(), ref.copy(), h),
                {"parameter record": (1, p.shape[0]), "state": (0, z.shape[0]), "plant state": (3, x.shape[0])})

@@ -154,7 +154,7 @@ class ASA(NamedTuple):
         delta0 = float(x0[len(x0) - 1])
         wave_filter_init(z, float(x0[IPSI]), float(x0[IR]), delta0)
         z[Z_MODE] = 0.0
-        z[Z_PSI_SET] = float(ref0[0])
+        z[Z_PSI_SET] = float(ref0[REF_PSI])
         z[Z_PSI_M] = float(x0[IPSI])
         z[Z_R_M] = float(x0[IR])
         z[Z_T_START] = 0.0

@@ -169,7 +169,7 @@ class ItaePID(NamedTuple):
 
     def init_state(self, x0, ref0) -> np.ndarray:
         """Pre-filter at rest on the initial set-point; no integral."""
-        return STATE.pack(psi_p=ref0[0], r_p=0.0, integral=0.0)
+        return STATE.pack(psi_p=ref0[REF_PSI], r_p=0.0, integral=0.0)
 
 
 @numba.njit(cache=True)

@@ -137,7 +137,7 @@ class NonlinearADRC(NamedTuple):
 
     def init_state(self, x0, ref0) -> np.ndarray:
         """TD at the initial set heading, ESO at the measured heading and rate, no disturbance."""
-        return STATE.pack(v1=ref0[0], v2=0.0, z1=x0[IPSI], z2=x0[IR], z3=0.0)
+        return STATE.pack(v1=ref0[REF_PSI], v2=0.0, z1=x0[IPSI], z2=x0[IR], z3=0.0)
 
 
 @numba.njit(cache=True)

@@ -228,7 +228,7 @@ def realise(d: Design, seed: int) -> SimSetup:
         if d.plan.guide is None:
             headings = lambda t: reference_headings(gd, t)  # noqa: E731
         else:  # state-dependent guidance: its headings are unknown before the run; use the first
-            headings = lambda t: np.full(len(t), ref0[0])  # noqa: E731
+            headings = lambda t: np.full(len(t), ref0[REF_PSI])  # noqa: E731
         add_sea(w, env, SeaContext(ship, d.ps, d.x0, speed, lambda: ship.nomoto(speed, ship_options),
                                    headings, lambda: _rudder_b2(ship, speed, ship_options)),
                 s.dt, seed)
