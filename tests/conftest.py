@@ -57,6 +57,24 @@ def import_tool(name: str):
         sys.path.remove(tools)
 
 
+def batch_parity_and_vectorisation(setup):
+    """Three PID runs of ``setup`` (the middle one with Kp doubled) as a batch and one by one:
+    ``(single final states, batch final states, vectorisation report)``."""
+    import numpy as np
+
+    from steerlab.control.pid import C_KP
+    from steerlab.sim.batch import simulate_batch, vary_controller
+    from steerlab.sim.engine import simulate_compiled
+    from steerlab.sim.lanes import vectorisation_report
+
+    pcs = np.tile(setup.pc, (3, 1))
+    pcs[1, C_KP] *= 2.0
+    runs = vary_controller(setup, pcs)
+    batch = simulate_batch(runs)
+    single = np.array([simulate_compiled(s).states[-1] for s in runs])
+    return single, batch.final_states, vectorisation_report(setup.ship.rhs, setup.controller.update, setup.x0.size)
+
+
 def make_scenario_dict(**over) -> dict:
     """The base dict with top-level / nested overrides (``controller`` is replaced whole)."""
     return _merge(BASE, over)

@@ -25,6 +25,9 @@ U0 = KOSOKO.design.speed_m_s
 
 # ------------------------------------------------------------------ Clarke, eqs (5)-(11)
 
+from conftest import batch_parity_and_vectorisation  # noqa: E402
+
+
 def test_clarke_regressions_hand_computed():
     # L = 100, B = 20, T = 5, C_b = 0.5, A = 50 m^2: B/T = 4, B/L = 0.2, T/L = 0.05
     f = math.pi * 0.05**2
@@ -330,21 +333,13 @@ def test_kernel_follows_the_rpm_schedule_option_and_both_give_the_same_bits():
 def test_kosoko_batch_is_vectorised_and_bit_identical_to_single_runs():
     """With wind and current: the batch runs the Kosoko as vector arithmetic and run i of a
     batch equals the same run alone, bit for bit."""
-    from steerlab.sim.batch import simulate_batch, vary_controller
-    from steerlab.sim.lanes import vectorisation_report
-
     setup = build(scenario_from_dict({
         "dt": 0.05, "duration": 20.0, "ship": {"model": "kosoko", "speed_kn": 0.97},
         "controller": {"type": "pid", "Kp": 1.0, "Kd": 1.0, "Ki": 0.0},
         "environment": {"wind_speed": 1.5, "wind_dir_deg": 45.0, "current_speed": 0.05},
         "guidance": {"changes": [{"t": 2.0, "psi_deg": 20.0}]}}))
-    pcs = np.tile(setup.pc, (3, 1))
-    pcs[1, 0] *= 2.0
-    runs = vary_controller(setup, pcs)
-    batch = simulate_batch(runs)
-    for i, s in enumerate(runs):
-        np.testing.assert_array_equal(batch.final_states[i], simulate_compiled(s).states[-1])
-    report = vectorisation_report(setup.ship.rhs, setup.controller.update, setup.x0.size)
+    final_single, final_batch, report = batch_parity_and_vectorisation(setup)
+    np.testing.assert_array_equal(final_batch, final_single)
     assert report["vectorised_stages"] >= 4 and report["per_run_library_calls"] == []
 
 

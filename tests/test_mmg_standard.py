@@ -57,6 +57,9 @@ KV = ms.get_mmgstd_data("kvlcc2")
 U_SERVICE = 15.5 * 1852.0 / 3600.0
 
 
+from conftest import batch_parity_and_vectorisation  # noqa: E402
+
+
 def test_registered_ships_and_source():
     for name in ("kvlcc2", "kvlcc2-l7", "mss-tanker"):
         assert name in SHIPS
@@ -368,9 +371,6 @@ def test_esso_models_experiment(tmp_path):
 def test_kvlcc2_batch_is_vectorised_and_bit_identical_to_single_runs():
     """mmgstd_rhs uses steerlab.vecmath (atan2, exp) and sincos: no library call, so the batch
     engine runs it as vector arithmetic; run i of a batch equals the same run alone."""
-    from steerlab.sim.batch import simulate_batch, vary_controller
-    from steerlab.sim.engine import simulate_compiled
-    from steerlab.sim.lanes import vectorisation_report
     from steerlab.sim.scenario import scenario_from_dict
     from steerlab.sim.setup import build
 
@@ -378,11 +378,6 @@ def test_kvlcc2_batch_is_vectorised_and_bit_identical_to_single_runs():
         "dt": 0.5, "duration": 120.0, "ship": {"model": "kvlcc2", "speed_kn": 15.5},
         "controller": {"type": "pid", "Kp": 1.0, "Kd": 10.0, "Ki": 0.0},
         "guidance": {"changes": [{"t": 5.0, "psi_deg": 15.0}]}}))
-    pcs = np.tile(setup.pc, (3, 1))
-    pcs[1, 0] *= 2.0
-    runs = vary_controller(setup, pcs)
-    batch = simulate_batch(runs)
-    for i, s in enumerate(runs):
-        np.testing.assert_array_equal(batch.final_states[i], simulate_compiled(s).states[-1])
-    report = vectorisation_report(setup.ship.rhs, setup.controller.update, setup.x0.size)
+    final_single, final_batch, report = batch_parity_and_vectorisation(setup)
+    np.testing.assert_array_equal(final_batch, final_single)
     assert report["vectorised_stages"] >= 4 and report["per_run_library_calls"] == []
