@@ -143,6 +143,10 @@ class Registry(Mapping[str, S]):
         self._found: dict | None = None
         self._origin: dict = {}
         self._listeners: list = []
+        self._module_specs: dict = {}     # module name -> the specs it declares (collected once)
+        self._derived: dict = {}          # spec name -> (spec, the specs derived from it)
+        self._plugins: bool | None = None  # any entry point or STEERLAB_PLUGINS module (looked up once)
+        self._index: dict | None = None   # the index of steerlab.registry_index (read once)
 
     # ------------------------------------------------------------ discovery
     def _modules(self):
@@ -172,6 +176,22 @@ class Registry(Mapping[str, S]):
             return out
         raise InputError(self.group, f"{obj!r} is not a {self.spec_type.__name__} (nor a list or module of them)")
 
+    def _collected(self, module) -> list[S]:
+        """The specs ``module`` declares, collected once per process (a spec is one object)."""
+        specs = self._module_specs.get(module.__name__)
+        if specs is None:
+            specs = self._module_specs[module.__name__] = list(self.collect(module))
+        return specs
+
+    def _derive(self, spec) -> list[S]:
+        """``derive(spec)``, made once per spec object (a derived spec is one object too)."""
+        if self.derive is None:
+            return []
+        known = self._derived.get(spec.name)
+        if known is None or known[0] is not spec:
+            known = self._derived[spec.name] = (spec, list(self.derive(spec)))
+        return known[1]
+
     def _add(self, found: dict, spec, origin: str, replace: bool = False) -> None:
         if not isinstance(spec, self.spec_type):
             raise TypeError(f"{origin}: {spec!r} is not a {self.spec_type.__name__}")
@@ -184,28 +204,72 @@ class Registry(Mapping[str, S]):
     def _discover(self) -> dict:
         if self._found is None:
             found: dict = {}
+            index: dict = {}          # the package's own names (steerlab.registry_index)
             for module in self._modules():
-                for spec in self.collect(module):
+                for spec in self._collected(module):
                     self._add(found, spec, module.__name__)
+                    index[spec.name] = (module.__name__, None)
             for origin, obj in self._entry_point_objects():
                 for spec in self.specs_of(obj):
                     self._add(found, spec, origin)
             for ref in env_plugins():
                 for spec in self.collect(load_module(ref)):
                     self._add(found, spec, f"{PLUGINS_ENV} {ref}")
-            if self.derive is not None:
-                for spec in list(found.values()):
-                    for d in self.derive(spec):
-                        self._add(found, d, f"derived from {spec.name!r}")
+            for spec in list(found.values()):
+                for d in self._derive(spec):
+                    self._add(found, d, f"derived from {spec.name!r}")
+                    if spec.name in index and index[spec.name][1] is None:
+                        index[d.name] = (index[spec.name][0], spec.name)
             self._found = found
+            self._save_index(index)
         return self._found
+
+    # ------------------------------------------------------------ one name, one module
+    def _save_index(self, index: dict) -> None:
+        from steerlab import registry_index
+
+        if registry_index.enabled() and registry_index.read_index(self.kind) != index:
+            registry_index.write_index(self.kind, index)
+
+    def _has_plugins(self) -> bool:
+        """Whether plug-ins may declare specs (then only the full discovery is right)."""
+        if env_plugins():
+            return True
+        if self._plugins is None:
+            from importlib.metadata import entry_points
+
+            self._plugins = bool(entry_points(group=self.group))
+        return self._plugins
+
+    def _indexed_spec(self, name: str) -> S | None:
+        """The built-in spec ``name`` from the one module the index names (None: a miss)."""
+        from steerlab import registry_index
+
+        if not registry_index.enabled() or self._has_plugins():
+            return None
+        if self._index is None:
+            self._index = registry_index.read_index(self.kind) or {}
+        entry = self._index.get(name)
+        if entry is None:
+            return None
+        module_name, base = entry
+        if not (module_name == self.package or module_name.startswith(self.package + ".")):
+            return None
+        try:
+            module = importlib.import_module(module_name)
+        except ImportError:
+            return None
+        spec = next((s for s in self._collected(module) if s.name == (base or name)), None)
+        if spec is not None and base is not None:
+            spec = next((d for d in self._derive(spec) if d.name == name), None)
+        return spec
 
     # ------------------------------------------------------------ registration
     def register(self, spec: S, replace: bool = False) -> S:
         """Add ``spec`` under ``spec.name`` (``replace=True`` to override a known name); returns it."""
         found = self._discover()
         self._add(found, spec, "register", replace)
-        for d in (self.derive(spec) if self.derive is not None else ()):
+        for d in self._derive(spec):
             self._add(found, d, f"derived from {spec.name!r}", replace)
         for fn in self._listeners:
             fn(spec)
@@ -223,8 +287,8 @@ class Registry(Mapping[str, S]):
         found = self._discover()
         spec = found.pop(name, None)
         self._origin.pop(name, None)
-        if spec is not None and self.derive is not None:
-            for d in self.derive(spec):
+        if spec is not None:
+            for d in self._derive(spec):
                 if d.name in found and found[d.name] is d:
                     found.pop(d.name)
                     self._origin.pop(d.name, None)
@@ -256,7 +320,15 @@ class Registry(Mapping[str, S]):
         return len(self._discover())
 
     def get_spec(self, name: str) -> S:
-        """The spec called ``name``; an unknown name is an :class:`InputError` on :attr:`field`."""
+        """The spec called ``name``; an unknown name is an :class:`InputError` on :attr:`field`.
+
+        Before the first full discovery, a built-in name is looked up in the index of
+        :mod:`steerlab.registry_index` and only its module is imported.
+        """
+        if self._found is None and isinstance(name, str):
+            spec = self._indexed_spec(name)
+            if spec is not None:
+                return spec
         found = self._discover()
         try:
             return found[name]

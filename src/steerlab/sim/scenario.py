@@ -33,12 +33,12 @@ from __future__ import annotations
 import math
 import os
 from pathlib import Path
-from typing import TYPE_CHECKING, Annotated, Any, Literal, Mapping, Optional, Union
+from typing import TYPE_CHECKING, Annotated, Any, Literal, Mapping, Optional
 
-from pydantic import BaseModel, Field, ValidationError
+from pydantic import BaseModel, Field, ValidationError, WrapValidator
+from pydantic_core import PydanticCustomError
 
 from steerlab.config_base import FrozenConfig
-from steerlab.control.adrc import ADRCConfig
 from steerlab.control.registry import CONTROLLERS
 from steerlab.environment.sea_config import (CurrentVariationConfig, GustConfig, WaveConfig,
                                              WindRudderConfig)
@@ -66,15 +66,53 @@ class GearConfig(_Frozen):
     dead_zone_deg: float = Field(0.0, ge=0.0, le=10.0)
 
 
-def _controller_union():
-    configs = tuple(spec.config for spec in CONTROLLERS.values())
-    return Annotated[Union[configs], Field(discriminator="type")]
+def _expected_tags() -> str:
+    return ", ".join(repr(name) for name in CONTROLLERS)
 
 
-if TYPE_CHECKING:      # the union of every registered controller's config is built at run time
+def _controller_config(value: Any, _handler: Any) -> Any:
+    """``[controller]``: validated against the config of the controller its ``type`` names.
+
+    The same check as a discriminated union of every registered controller's config (the same
+    error types, so the same messages), without importing every controller module: the
+    chosen one is found by name (:meth:`steerlab.plugins.Registry.get_spec`, which imports
+    only its module when steerlab's index knows it).
+    """
+    if isinstance(value, dict):
+        tag = value.get("type", _MISSING)
+    elif isinstance(value, BaseModel):
+        tag = getattr(value, "type", _MISSING)
+    else:
+        raise PydanticCustomError("model_attributes_type",
+                                  "Input should be a valid dictionary or object to extract fields from")
+    if tag is _MISSING:
+        raise PydanticCustomError("union_tag_not_found",
+                                  "Unable to extract tag using discriminator {discriminator}",
+                                  {"discriminator": "'type'"})
+    try:
+        spec = CONTROLLERS.get_spec(tag) if isinstance(tag, str) else None
+    except InputError:
+        spec = None
+    if spec is None:
+        raise PydanticCustomError("union_tag_invalid",
+                                  "Input tag {tag} found using {discriminator} does not match any of the "
+                                  "expected tags: {expected_tags}",
+                                  {"discriminator": "'type'", "tag": str(tag), "expected_tags": _expected_tags()})
+    return spec.config.model_validate(value)
+
+
+_MISSING = object()
+
+if TYPE_CHECKING:      # any registered controller's config (FrozenConfig subclasses)
     ControllerConfig = Any
 else:
-    ControllerConfig = _controller_union()
+    ControllerConfig = Annotated[Any, WrapValidator(_controller_config)]
+
+
+def _default_controller():
+    from steerlab.control.adrc import ADRCConfig
+
+    return ADRCConfig(type="adrc")
 
 
 class CourseChange(_Frozen):
@@ -133,14 +171,6 @@ class EnvironmentConfig(_Frozen):
     wind_rudder: Optional[WindRudderConfig] = None
 
 
-def _controller_field_updated(_spec=None) -> None:
-    """A controller registered after this module was imported joins the ``[controller]`` union."""
-    field = Scenario.model_fields["controller"]
-    field.annotation = Union[tuple(spec.config for spec in CONTROLLERS.values())]  # type: ignore[assignment]
-    field.discriminator = "type"
-    Scenario.model_rebuild(force=True)
-
-
 class Scenario(_Frozen):
     name: str = "scenario"
     description: str = ""
@@ -149,7 +179,7 @@ class Scenario(_Frozen):
     duration: float = Field(3000.0, gt=0.0, le=1e6, description="[s]")
     ship: ShipConfig = ShipConfig()
     gear: GearConfig = GearConfig()
-    controller: ControllerConfig = Field(default_factory=lambda: ADRCConfig(type="adrc"))
+    controller: ControllerConfig = Field(default_factory=_default_controller)
     guidance: GuidanceConfig = GuidanceConfig()
     environment: EnvironmentConfig = EnvironmentConfig()
     sensors: Optional[SensorsConfig] = None   # steerlab.sensors: off by default
@@ -161,9 +191,6 @@ class Scenario(_Frozen):
     def replace(self, **changes: Any) -> "Scenario":
         """A validated copy with top-level fields replaced (nested: pass whole sub-configs)."""
         return scenario_from_dict({**self.model_dump(), **_dump(changes)})
-
-
-CONTROLLERS.on_register(_controller_field_updated)
 
 
 def _dump(d):
