@@ -21,6 +21,8 @@ __version__ = "0.1.0"
 
 # before any kernel is defined: cached kernels are keyed on the whole package, not one file
 from steerlab import numba_cache  # noqa: F401,E402  (isort: skip)
+# a cached kernel is loaded without numba's compile-time registries (numba_cache_load)
+from steerlab import numba_cache_load  # noqa: F401,E402  (isort: skip)
 # numba's first-use BLAS probe without the scipy.linalg package import (numba_blas_probe)
 from steerlab import numba_blas_probe  # noqa: E402  (isort: skip)
 

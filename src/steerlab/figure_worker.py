@@ -62,12 +62,20 @@ class FigureWorker:
         figure).
     parts : int, optional
         Number of children (each draws its part; inline, the parts are drawn in order).
+    split : int, optional
+        Each child, once the job has arrived, forks ``split - 1`` grandchildren and draws its
+        part in ``split`` shares at once (``draw(..., part=k * split + j, parts=parts * split)``).
+        Forked after the warm-up, a grandchild starts with matplotlib imported and costs
+        milliseconds; the parent is mostly waiting by then, so the shares use its core. A
+        grandchild dies with its child (``PR_SET_PDEATHSIG``); its error is the child's.
     """
 
-    def __init__(self, draw: Callable[..., Any], warm: Optional[Callable[[], Any]] = None, parts: int = 1):
+    def __init__(self, draw: Callable[..., Any], warm: Optional[Callable[[], Any]] = None, parts: int = 1,
+                 split: int = 1):
         self.draw = draw
         self.warm = warm
         self.parts = max(1, int(parts))
+        self.split = max(1, int(split))
         self._children: list[tuple[int, int, int]] = []     # (pid, job pipe write end, done pipe read end)
         self._args: Optional[tuple] = None
         self._inline = False
@@ -168,12 +176,74 @@ class FigureWorker:
                 self.warm()
             data = _read_all(job_r)
             if data:                                   # empty: the parent cancelled or died
-                self.draw(*pickle.loads(data), part=part, parts=self.parts)
+                self._draw_shares(pickle.loads(data), part)
         except BaseException as err:                   # noqa: BLE001 - reported to the parent
             try:
-                os.write(done_w, f"{type(err).__name__}: {err}".encode("utf-8", "replace")[:4000])
+                os.write(done_w, _error_line(err))
             except OSError:
                 pass
             code = 1
         finally:
             os._exit(code)
+
+    def _draw_shares(self, args: tuple, part: int) -> None:
+        """Draw part ``part`` in :attr:`split` shares: share 0 here, the others in grandchildren."""
+        m, n = self.split, self.parts * self.split
+        me = os.getpid()
+        grandchildren = []
+        for j in range(1, m):
+            try:
+                err_r, err_w = os.pipe()
+                pid = os.fork()
+            except OSError:                            # no fork: the child draws the rest itself
+                break
+            if pid == 0:                               # grandchild: never returns
+                os.close(err_r)
+                code = 0
+                try:
+                    _die_with_parent(me)
+                    self.draw(*args, part=part * m + j, parts=n)
+                except BaseException as err:           # noqa: BLE001 - reported to the child
+                    try:
+                        os.write(err_w, _error_line(err))
+                    except OSError:
+                        pass
+                    code = 1
+                finally:
+                    os._exit(code)
+            os.close(err_w)
+            grandchildren.append((pid, err_r))
+        for j in [0, *range(1 + len(grandchildren), m)]:
+            self.draw(*args, part=part * m + j, parts=n)
+        errors = []
+        for pid, err_r in grandchildren:
+            message = _read_all(err_r).decode("utf-8", "replace")
+            os.close(err_r)
+            _, status = os.waitpid(pid, 0)
+            if status != 0:
+                errors.append(message or f"exit status {status}")
+        if errors:
+            raise _ChildError(errors[0])
+
+
+class _ChildError(Exception):
+    """A grandchild's error line, passed on as it is."""
+
+
+def _error_line(err: BaseException) -> bytes:
+    text = str(err) if isinstance(err, _ChildError) else f"{type(err).__name__}: {err}"
+    return text.encode("utf-8", "replace")[:4000]
+
+
+def _die_with_parent(parent: int) -> None:
+    """Ask Linux to kill this process when its parent (process id ``parent``) dies (the
+    command's ``cancel`` kills only its children); exit at once if it is already gone."""
+    import ctypes
+    import signal
+
+    try:
+        ctypes.CDLL(None, use_errno=True).prctl(1, int(signal.SIGKILL))    # PR_SET_PDEATHSIG = 1
+    except (OSError, AttributeError):
+        pass
+    if os.getppid() != parent:
+        os._exit(1)

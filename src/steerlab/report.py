@@ -326,10 +326,12 @@ def figure_worker():
     """A :class:`steerlab.figure_worker.FigureWorker` that draws :func:`write_run_figures`
     (``submit(out_dir, result, title)``) in one child, after importing matplotlib while the
     caller works. (Two children, two figures each, were slower on a 2-core machine: their
-    warm-ups compete with the parent's design and simulation.)"""
+    warm-ups compete with the parent's design and simulation.) Once the result arrives, the
+    child forks a grandchild and each draws two of the four figures (``split=2``): the
+    parent is mostly waiting by then."""
     from steerlab.figure_worker import FigureWorker
 
-    return FigureWorker(write_run_figures, warm=warm_figures, parts=1)
+    return FigureWorker(write_run_figures, warm=warm_figures, parts=1, split=2)
 
 
 # --------------------------------------------------------------------------------------------
