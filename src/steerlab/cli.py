@@ -99,8 +99,8 @@ def _run(args, figures) -> int:
                    "metrics": metrics, "units": {k: METRIC_UNITS.get(k, "") for k in metrics}, **extra},
                   stage / "metrics.json", digits=None)
         (stage / "scenario.json").write_text(scenario.model_dump_json(indent=2) + "\n", encoding="utf-8")
-        figures.wait()
         write_run_report(stage, result, metrics, scenario, figures=[stage / name for name in FIGURE_NAMES])
+        figures.wait()                        # the report names the figures; they are complete here
     print(format_metrics_table(metrics))
     say(f"wrote {args.out}/report.html")
     return 0

@@ -5,7 +5,8 @@ the metrics and the CSV together, and the machines steerlab runs on have two or 
 ``steerlab run`` starts a :class:`FigureWorker` first thing: the worker forks a child that
 imports matplotlib and lays out a first figure (fonts, text engine) while the parent loads the
 scenario, designs and simulates (``parts=n`` forks n children that share the figures). The parent then :meth:`~FigureWorker.submit`\\ s the result
-(pickled through a pipe, a few MB), writes the CSV and the JSON while the child draws, and
+(pickled through a pipe, a few MB, by a thread: a child still warming up does not hold the
+parent back), writes the CSV and the JSON while the child draws, and
 :meth:`~FigureWorker.wait`\\ s: a failure in the child is raised in the parent as one
 :class:`RuntimeError` with the child's error line. The parent never imports matplotlib.
 
@@ -79,6 +80,8 @@ class FigureWorker:
         self._children: list[tuple[int, int, int]] = []     # (pid, job pipe write end, done pipe read end)
         self._args: Optional[tuple] = None
         self._inline = False
+        self._writer: Optional[threading.Thread] = None
+        self._lost = False
 
     @property
     def pid(self) -> Optional[int]:
@@ -115,18 +118,39 @@ class FigureWorker:
             self._inline = True
             return
         data = pickle.dumps(args, protocol=pickle.HIGHEST_PROTOCOL)
-        try:
-            for _, job_w, _ in self._children:
-                _write_all(job_w, data)
-                os.close(job_w)
-        except (BrokenPipeError, OSError):
-            self.cancel()                              # a child is gone: draw here instead
-            self._inline = True
-            return
+        pipes = [job_w for _, job_w, _ in self._children]
         self._children = [(pid, -1, done_r) for pid, _, done_r in self._children]
+        # a few MB through 64 kB pipes: written by a thread, so that the caller goes on (CSV,
+        # JSON) while a child still warming up has not started reading
+        self._writer = threading.Thread(target=self._send, args=(data, pipes), daemon=True)
+        self._writer.start()
+
+    def _send(self, data: bytes, pipes: list) -> None:
+        try:
+            for job_w in pipes:
+                _write_all(job_w, data)
+        except OSError:                                # BrokenPipeError: a child is gone
+            self._lost = True
+        finally:
+            for job_w in pipes:
+                try:
+                    os.close(job_w)
+                except OSError:
+                    pass
+
+    def _join_writer(self) -> bool:
+        """Wait for :meth:`submit`'s writer; whether every child got the job."""
+        writer, self._writer = self._writer, None
+        if writer is not None:
+            writer.join()
+        lost, self._lost = self._lost, False
+        return not lost
 
     def wait(self) -> None:
         """Wait for the children's figures (or draw them here); raise a child's error."""
+        if not self._join_writer():
+            self.cancel()                              # a child is gone: draw here instead
+            self._inline = True
         if self._inline:
             self._inline = False
             for part in range(self.parts):
@@ -158,6 +182,7 @@ class FigureWorker:
             except OSError:
                 pass
         self._children = []
+        self._join_writer()                            # its writes fail now that the children are gone
 
     def __enter__(self) -> "FigureWorker":
         return self.start()
