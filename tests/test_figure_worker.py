@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import os
 import sys
+import time
 
 import pytest
 
@@ -106,3 +107,51 @@ def test_switched_off_the_parent_draws_in_wait(tmp_path, monkeypatch):
     assert not (tmp_path / "drawn0").exists()               # nothing before wait()
     worker.wait()
     assert int((tmp_path / "drawn0").read_text()) == int((tmp_path / "drawn1").read_text()) == os.getpid()
+
+
+def test_split_shares_are_drawn_by_the_child_and_a_grandchild(tmp_path, forking):
+    def draw(where, part, parts):
+        (where / f"share{part}of{parts}").write_text(str(os.getpid()))
+
+    with FigureWorker(draw, split=2) as worker:
+        child = worker.pid
+        worker.submit(tmp_path)
+    a, b = (int((tmp_path / f"share{k}of2").read_text()) for k in (0, 1))
+    assert a == child and b not in (child, os.getpid())
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["share0of2", "share1of2"]
+
+
+def _fail_in_share_1(where, part, parts):
+    if part == 1:
+        raise ValueError("rudder.png: bad axis")
+    (where / "share0").write_text("x")
+
+
+def test_a_failing_grandchild_is_raised_in_the_parent_with_its_message(tmp_path, forking):
+    with pytest.raises(RuntimeError, match=r"failed: ValueError: rudder.png: bad axis$"):
+        with FigureWorker(_fail_in_share_1, split=2) as worker:
+            worker.submit(tmp_path)
+
+
+def test_submit_returns_while_the_child_is_still_warming_up(tmp_path, forking):
+    """The job (larger than a pipe's buffer) is written by a thread: the child waits in its warm-up
+    for a flag the parent sets after submit() returned (a blocking submit would leave the flag
+    unset until the child gave up waiting)."""
+    flag = tmp_path / "flag"
+
+    def warm():
+        for _ in range(3000):
+            if flag.exists():
+                (tmp_path / "saw").write_text("flag")
+                return
+            time.sleep(0.01)
+        (tmp_path / "saw").write_text("gave up")
+
+    def draw(where, blob, part, parts):
+        (where / "drawn").write_text(str(len(blob)))
+
+    with FigureWorker(draw, warm=warm) as worker:
+        worker.submit(tmp_path, b"x" * (4 << 20))
+        flag.write_text("set")
+    assert (tmp_path / "saw").read_text() == "flag"
+    assert (tmp_path / "drawn").read_text() == str(4 << 20)
