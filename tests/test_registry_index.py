@@ -40,8 +40,8 @@ def _probe(scenario: dict, cache: Path, **env) -> dict:
     return json.loads(r.stdout.strip().splitlines()[-1])
 
 
-def _index_file(cache: Path, kind: str) -> Path:
-    (path,) = cache.glob(f"drivers/*/registry-{kind}.json")
+def _index_file(cache: Path, package: str) -> Path:
+    (path,) = cache.glob(f"drivers/*/registry-{package}.json")
     return path
 
 
@@ -51,10 +51,10 @@ PID_ON_ESSO = {"ship": {"model": "esso"}, "controller": {"type": "pid", "Kp": 2.
 def test_with_the_index_only_the_chosen_modules_are_imported(tmp_path):
     first = _probe(PID_ON_ESSO, tmp_path)                        # no index yet: full discovery, writes it
     assert "steerlab.control.adrc" in first["modules"] and "steerlab.control.sliding_mode" in first["modules"]
-    index = json.loads(_index_file(tmp_path, "controller").read_text())["names"]
+    index = json.loads(_index_file(tmp_path, "steerlab.control").read_text())["names"]
     assert index["pid"] == ["steerlab.control.pid", None]
     assert index["adrc+wf"] == ["steerlab.control.adrc", "adrc"]
-    assert json.loads(_index_file(tmp_path, "ship").read_text())["names"]["esso"][0].startswith("steerlab.ships.")
+    assert json.loads(_index_file(tmp_path, "steerlab.ships").read_text())["names"]["esso"][0].startswith("steerlab.ships.")
     second = _probe(PID_ON_ESSO, tmp_path)
     assert second["controller"] == first["controller"] == "PIDConfig" and second["ship"] == "esso"
     others = {"steerlab.control.adrc", "steerlab.control.sliding_mode", "steerlab.control.backstepping_a",
@@ -68,7 +68,7 @@ def test_with_the_index_only_the_chosen_modules_are_imported(tmp_path):
 @pytest.mark.parametrize("damage", ["wrong module", "not json", "unknown name"])
 def test_a_stale_or_corrupt_index_is_rebuilt(tmp_path, damage):
     _probe(PID_ON_ESSO, tmp_path)
-    path = _index_file(tmp_path, "controller")
+    path = _index_file(tmp_path, "steerlab.control")
     good = json.loads(path.read_text())
     bad = json.loads(path.read_text())
     if damage == "wrong module":

@@ -55,7 +55,13 @@ def disk_memo(name: str, key: tuple, compute: Callable[[], Sequence[np.ndarray]]
     except (OSError, ValueError, KeyError, TypeError, AttributeError):
         pass
     arrays = [np.asarray(a, dtype=np.float64).ravel() for a in compute()]
-    text = json.dumps({"ident": ident, "arrays": [[float(v).hex() for v in a] for a in arrays]})
+    store_text(path, json.dumps({"ident": ident, "arrays": [[float(v).hex() for v in a] for a in arrays]}))
+    return arrays
+
+
+def store_text(path: Path, text: str) -> None:
+    """Write a cache file atomically (a temporary file, then a rename); an unwritable cache is
+    ignored (the entry is computed again next time)."""
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
         tmp = path.with_name(f".{path.name}.{os.getpid()}.{threading.get_ident()}.tmp")
@@ -63,4 +69,3 @@ def disk_memo(name: str, key: tuple, compute: Callable[[], Sequence[np.ndarray]]
         os.replace(tmp, path)
     except OSError:
         pass
-    return arrays

@@ -195,21 +195,14 @@ class FigureWorker:
 
     # ------------------------------------------------------------------ child side
     def _child(self, job_r: int, done_w: int, part: int) -> None:
-        code = 0
-        try:
+        def work():
             if self.warm is not None:
                 self.warm()
             data = _read_all(job_r)
             if data:                                   # empty: the parent cancelled or died
                 self._draw_shares(pickle.loads(data), part)
-        except BaseException as err:                   # noqa: BLE001 - reported to the parent
-            try:
-                os.write(done_w, _error_line(err))
-            except OSError:
-                pass
-            code = 1
-        finally:
-            os._exit(code)
+
+        _run_then_exit(work, done_w)
 
     def _draw_shares(self, args: tuple, part: int) -> None:
         """Draw part ``part`` in :attr:`split` shares: share 0 here, the others in grandchildren."""
@@ -224,18 +217,12 @@ class FigureWorker:
                 break
             if pid == 0:                               # grandchild: never returns
                 os.close(err_r)
-                code = 0
-                try:
+
+                def share(j=j):
                     _die_with_parent(me)
                     self.draw(*args, part=part * m + j, parts=n)
-                except BaseException as err:           # noqa: BLE001 - reported to the child
-                    try:
-                        os.write(err_w, _error_line(err))
-                    except OSError:
-                        pass
-                    code = 1
-                finally:
-                    os._exit(code)
+
+                _run_then_exit(share, err_w)
             os.close(err_w)
             grandchildren.append((pid, err_r))
         for j in [0, *range(1 + len(grandchildren), m)]:
@@ -249,6 +236,21 @@ class FigureWorker:
                 errors.append(message or f"exit status {status}")
         if errors:
             raise _ChildError(errors[0])
+
+
+def _run_then_exit(work: Callable[[], Any], err_fd: int) -> None:
+    """In a forked process: run ``work``, write its error line (if any) to ``err_fd``, exit."""
+    code = 0
+    try:
+        work()
+    except BaseException as err:                       # noqa: BLE001 - reported to the parent
+        try:
+            os.write(err_fd, _error_line(err))
+        except OSError:
+            pass
+        code = 1
+    finally:
+        os._exit(code)
 
 
 class _ChildError(Exception):

@@ -228,8 +228,8 @@ class Registry(Mapping[str, S]):
     def _save_index(self, index: dict) -> None:
         from steerlab import registry_index
 
-        if registry_index.enabled() and registry_index.read_index(self.kind) != index:
-            registry_index.write_index(self.kind, index)
+        if registry_index.enabled() and registry_index.read_index(self.package) != index:
+            registry_index.write_index(self.package, index)
 
     def _has_plugins(self) -> bool:
         """Whether plug-ins may declare specs (then only the full discovery is right)."""
@@ -248,7 +248,7 @@ class Registry(Mapping[str, S]):
         if not registry_index.enabled() or self._has_plugins():
             return None
         if self._index is None:
-            self._index = registry_index.read_index(self.kind) or {}
+            self._index = registry_index.read_index(self.package) or {}
         entry = self._index.get(name)
         if entry is None:
             return None

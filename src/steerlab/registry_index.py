@@ -5,7 +5,7 @@ Finding every controller (or ship) imports every module of :mod:`steerlab.contro
 a run of one controller on one ship does not need. After a full discovery
 (:meth:`steerlab.plugins.Registry._discover`), the registry writes ``name -> [module, base]``
 of the specs the package's own modules declare (``base``: the spec a derived one, such as
-``"adrc+wf"``, is made from; ``None`` otherwise) to ``<driver cache>/registry-<kind>.json``;
+``"adrc+wf"``, is made from; ``None`` otherwise) to ``<driver cache>/registry-<package>.json``;
 the driver directory is named after steerlab's package fingerprint
 (:func:`steerlab.sim.drivers.drivers_dir`), so an edited steerlab never reads another
 version's index, and ``steerlab cache clear`` removes it with the drivers.
@@ -21,7 +21,6 @@ from __future__ import annotations
 
 import json
 import os
-import threading
 from pathlib import Path
 from typing import Optional
 
@@ -32,30 +31,25 @@ def enabled() -> bool:
     return os.environ.get(ENV, "1") != "0"
 
 
-def index_path(kind: str) -> Path:
-    """The index file of one registry kind (``"ship"``, ``"controller"``)."""
+def index_path(package: str) -> Path:
+    """The index file of the registry that scans ``package`` (``"steerlab.control"``)."""
     from steerlab.sim.drivers import drivers_dir
 
-    return drivers_dir() / f"registry-{kind}.json"
+    return drivers_dir() / f"registry-{package}.json"
 
 
-def read_index(kind: str) -> Optional[dict]:
+def read_index(package: str) -> Optional[dict]:
     """``name -> (module, base or None)``; None if missing or unreadable."""
     try:
-        data = json.loads(index_path(kind).read_text(encoding="utf-8"))
+        data = json.loads(index_path(package).read_text(encoding="utf-8"))
         return {str(k): (str(v[0]), None if v[1] is None else str(v[1])) for k, v in data["names"].items()}
     except (OSError, ValueError, KeyError, TypeError, IndexError, AttributeError):
         return None
 
 
-def write_index(kind: str, names: dict) -> None:
+def write_index(package: str, names: dict) -> None:
     """Store ``name -> (module, base or None)`` atomically (an unwritable cache is ignored)."""
-    path = index_path(kind)
-    text = json.dumps({"kind": kind, "names": {k: list(v) for k, v in sorted(names.items())}}, indent=0)
-    try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        tmp = path.with_name(f".{path.name}.{os.getpid()}.{threading.get_ident()}.tmp")
-        tmp.write_text(text, encoding="utf-8")
-        os.replace(tmp, path)
-    except OSError:
-        pass
+    from steerlab.disk_memo import store_text
+
+    store_text(index_path(package),
+               json.dumps({"package": package, "names": {k: list(v) for k, v in sorted(names.items())}}, indent=0))
