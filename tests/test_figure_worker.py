@@ -155,3 +155,15 @@ def test_submit_returns_while_the_child_is_still_warming_up(tmp_path, forking):
         flag.write_text("set")
     assert (tmp_path / "saw").read_text() == "flag"
     assert (tmp_path / "drawn").read_text() == str(4 << 20)
+
+
+def test_the_parent_gets_its_objects_back_from_the_permanent_generation(tmp_path, forking):
+    """start() freezes the collector's objects for the fork (fewer page copies in the child) and
+    unfreezes them in the parent: the parent's garbage collection is as before."""
+    import gc
+
+    before = gc.get_freeze_count()
+    with FigureWorker(lambda where, part, parts: (where / "drawn").write_text(str(gc.get_freeze_count()))) as w:
+        assert gc.get_freeze_count() == before
+        w.submit(tmp_path)
+    assert int((tmp_path / "drawn").read_text()) > 0          # the child kept them frozen
