@@ -104,7 +104,8 @@ def test_plugins_are_found_and_still_clash_with_the_index_present(tmp_path):
     clash.write_text("from dataclasses import replace\nfrom steerlab.control import pid\n"
                      "CONTROLLER = replace(pid.CONTROLLER)\n")          # a second 'pid'
     out = _probe(PID_ON_ESSO, tmp_path, STEERLAB_PLUGINS=str(clash))
-    assert "declared twice" in out.get("error", ""), out
+    assert out.get("error", "").startswith("controller.type: controller 'pid' declared twice (steerlab.control.pid "
+                                           "and STEERLAB_PLUGINS "), out
 
 
 def test_a_spec_found_by_index_is_the_one_the_full_discovery_returns():

@@ -319,21 +319,26 @@ class Registry(Mapping[str, S]):
     def __len__(self):
         return len(self._discover())
 
-    def get_spec(self, name: str) -> S:
-        """The spec called ``name``; an unknown name is an :class:`InputError` on :attr:`field`.
+    def find(self, name: str) -> S | None:
+        """The spec called ``name``, or None if no such name is declared.
 
         Before the first full discovery, a built-in name is looked up in the index of
-        :mod:`steerlab.registry_index` and only its module is imported.
+        :mod:`steerlab.registry_index` and only its module is imported. (A broken plug-in or a
+        name declared twice is an :class:`InputError`, as for every access.)
         """
         if self._found is None and isinstance(name, str):
             spec = self._indexed_spec(name)
             if spec is not None:
                 return spec
-        found = self._discover()
-        try:
-            return found[name]
-        except KeyError:
-            raise InputError(self.field, f"unknown {self.kind} {name!r}; known {self.kind}s: {sorted(found)}") from None
+        return self._discover().get(name)
+
+    def get_spec(self, name: str) -> S:
+        """The spec called ``name`` (:meth:`find`); an unknown name is an :class:`InputError` on
+        :attr:`field` that lists the known names."""
+        spec = self.find(name)
+        if spec is None:
+            raise InputError(self.field, f"unknown {self.kind} {name!r}; known {self.kind}s: {sorted(self)}")
+        return spec
 
 
 def register_module(ref: str, replace: bool = False) -> list:

@@ -90,15 +90,20 @@ def _controller_config(value: Any, _handler: Any) -> Any:
                                   "Unable to extract tag using discriminator {discriminator}",
                                   {"discriminator": "'type'"})
     try:
-        spec = CONTROLLERS.get_spec(tag) if isinstance(tag, str) else None
-    except InputError:
-        spec = None
+        spec = CONTROLLERS.find(tag) if isinstance(tag, str) else None
+        expected = _expected_tags() if spec is None else ""
+    except InputError as err:          # the registry itself: a broken plug-in, a name declared twice
+        raise PydanticCustomError(_REGISTRY_ERROR, "{field}: {message}",
+                                  {"field": err.field, "message": err.message}) from None
     if spec is None:
         raise PydanticCustomError("union_tag_invalid",
                                   "Input tag {tag} found using {discriminator} does not match any of the "
                                   "expected tags: {expected_tags}",
-                                  {"discriminator": "'type'", "tag": str(tag), "expected_tags": _expected_tags()})
+                                  {"discriminator": "'type'", "tag": str(tag), "expected_tags": expected})
     return spec.config.model_validate(value)
+
+
+_REGISTRY_ERROR = "steerlab_registry"   #: error type carrying a registry's InputError through pydantic
 
 
 _MISSING = object()
@@ -220,6 +225,8 @@ def _tag_message(error: Mapping[str, Any]) -> str:
 
 def _format_validation_error(err: ValidationError) -> InputError:
     first = err.errors()[0]
+    if first["type"] == _REGISTRY_ERROR:                     # raised as it was, with its own field
+        return InputError(first["ctx"]["field"], first["ctx"]["message"])
     loc = ".".join(str(p) for p in first["loc"] if not _is_union_member_tag(p))
     msg = first["msg"]
     ctx = first.get("ctx") or {}
