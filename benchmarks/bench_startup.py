@@ -6,6 +6,7 @@ Usage::
     python benchmarks/bench_startup.py                  # 5 repeats of each, medians
     python benchmarks/bench_startup.py --repeats 9 --json > startup.json
     python benchmarks/bench_startup.py --skip-cold      # without the cold-cache run
+    python benchmarks/bench_startup.py --warm-run-only  # only the reference and the warm default run
 
 Measured (wall time of whole processes, medians of ``--repeats``; these machines are noisy,
 so the figures that matter are the ratios to the reference measured in the same session,
@@ -13,7 +14,9 @@ interleaved with the runs):
 
 * ``reference``: ``python -c "import numpy, numba, matplotlib.pyplot"``;
 * ``run_default_warm``: ``python -m steerlab run --out DIR --quiet`` on the bundled default
-  scenario with a warm driver cache (target: <= 1.5x the reference);
+  scenario with a warm driver cache (target: <= 1.5x the reference); with the CPU time (user +
+  system of the process and its children) of both, which a loaded machine moves less than the
+  wall time;
 * ``first_sim_and_batch_beyond_import``: in a fresh process with a warm cache, the time of
   the first ``simulate`` plus the first ``simulate_batch`` (of 32 runs) after
   ``import steerlab`` (target: <= 0.8 s);
@@ -30,6 +33,7 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import resource
 import statistics
 import subprocess
 import sys
@@ -66,17 +70,30 @@ def _env(cache: Path) -> dict:
     return env
 
 
+def _cpu_of_children() -> float:
+    r = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return r.ru_utime + r.ru_stime
+
+
 def _timed(cmd, env) -> tuple[float, subprocess.CompletedProcess]:
+    dt, _, p = _timed_cpu(cmd, env)
+    return dt, p
+
+
+def _timed_cpu(cmd, env) -> tuple[float, float, subprocess.CompletedProcess]:
+    """Wall time [s], CPU time (user + system, the process and the children it waited for) [s]."""
+    c0 = _cpu_of_children()
     t0 = time.perf_counter()
     p = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=900)
     dt = time.perf_counter() - t0
     if p.returncode != 0:
         raise RuntimeError(f"{' '.join(cmd)} failed: {p.stderr.strip()[-400:]}")
-    return dt, p
+    return dt, _cpu_of_children() - c0, p
 
 
-def measure(repeats: int, cold: bool, progress=print) -> dict:
-    """The medians and ratios of the module docstring."""
+def measure(repeats: int, cold: bool, progress=print, first_calls: bool = True) -> dict:
+    """The medians and ratios of the module docstring (``first_calls=False``: without the
+    first-calls measurement; the CPU times are user + system of the whole process tree)."""
     py = sys.executable
     tmp = Path(tempfile.mkdtemp(prefix="steerlab-startup-"))
     warm = tmp / "warm"
@@ -89,23 +106,34 @@ def measure(repeats: int, cold: bool, progress=print) -> dict:
     progress("warming the cache (default run, first calls) ...")
     _timed(run_cmd, _env(warm))
     _timed([py, "-c", FIRST_CALLS], _env(warm))
-    ref, run, imports, first = [], [], [], []
+    ref, run, ref_cpu, run_cpu, imports, first = [], [], [], [], [], []
     for i in range(repeats):
         progress(f"repeat {i + 1}/{repeats}")
-        ref.append(_timed(reference_cmd, _env(warm))[0])
-        run.append(_timed(run_cmd, _env(warm))[0])
-        _, p = _timed([py, "-c", FIRST_CALLS], _env(warm))
-        a, b = (float(v) for v in p.stdout.split())
-        imports.append(a)
-        first.append(b)
+        dt, cpu, _ = _timed_cpu(reference_cmd, _env(warm))
+        ref.append(dt)
+        ref_cpu.append(cpu)
+        dt, cpu, _ = _timed_cpu(run_cmd, _env(warm))
+        run.append(dt)
+        run_cpu.append(cpu)
+        if first_calls:
+            _, p = _timed([py, "-c", FIRST_CALLS], _env(warm))
+            a, b = (float(v) for v in p.stdout.split())
+            imports.append(a)
+            first.append(b)
     res = {
         "repeats": repeats,
         "reference_s": statistics.median(ref),
         "run_default_warm_s": statistics.median(run),
-        "import_steerlab_s": statistics.median(imports),
-        "first_sim_and_batch_beyond_import_s": statistics.median(first),
+        "reference_cpu_s": statistics.median(ref_cpu),
+        "run_default_warm_cpu_s": statistics.median(run_cpu),
     }
+    if first_calls:
+        res["import_steerlab_s"] = statistics.median(imports)
+        res["first_sim_and_batch_beyond_import_s"] = statistics.median(first)
     res["run_default_warm_vs_reference"] = res["run_default_warm_s"] / res["reference_s"]
+    res["run_default_warm_vs_reference_cpu"] = res["run_default_warm_cpu_s"] / res["reference_cpu_s"]
+    load = os.getloadavg() if hasattr(os, "getloadavg") else None
+    res["load_average_1min_at_end"] = load[0] if load else None
     if cold:
         colds = []
         said = []
@@ -125,13 +153,15 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--repeats", type=int, default=5)
     ap.add_argument("--skip-cold", action="store_true")
+    ap.add_argument("--warm-run-only", action="store_true",
+                    help="only the reference and the warm default run (no first calls, no cold run)")
     ap.add_argument("--json", action="store_true")
     args = ap.parse_args(argv)
     if args.repeats < 1:
         print("bench_startup: error: --repeats: must be >= 1", file=sys.stderr)
         return 2
-    res = measure(args.repeats, not args.skip_cold,
-                  progress=lambda m: print(m, file=sys.stderr, flush=True))
+    res = measure(args.repeats, not (args.skip_cold or args.warm_run_only),
+                  progress=lambda m: print(m, file=sys.stderr, flush=True), first_calls=not args.warm_run_only)
     if args.json:
         print(json.dumps(res, indent=2))
     else:

@@ -100,7 +100,8 @@ def _controller_config(value: Any, _handler: Any) -> Any:
                                   "Input tag {tag} found using {discriminator} does not match any of the "
                                   "expected tags: {expected_tags}",
                                   {"discriminator": "'type'", "tag": str(tag), "expected_tags": expected})
-    return spec.config.model_validate(value)
+    config: type[BaseModel] = spec.config
+    return config.model_validate(value)
 
 
 _REGISTRY_ERROR = "steerlab_registry"   #: error type carrying a registry's InputError through pydantic
