@@ -1,7 +1,5 @@
 """``python -m steerlab`` = the ``steerlab`` command."""
 
-import sys
+from steerlab.cli import console_main
 
-from steerlab.cli import main
-
-sys.exit(main())
+console_main()

@@ -297,6 +297,18 @@ def main(argv=None) -> int:
             restore()
 
 
+def console_main() -> None:
+    """The ``steerlab`` command and ``python -m steerlab``: :func:`main`, then the exit (a
+    finished ``run`` skips the interpreter's teardown: :mod:`steerlab.fast_exit`)."""
+    argv = sys.argv[1:]
+    code = main(argv)
+    if argv[:1] == ["run"]:
+        from steerlab.fast_exit import exit_now
+
+        exit_now(code)
+    sys.exit(code)
+
+
 def _say_compiling(msg: str) -> None:
     """The compile notice on stderr, below an open progress bar, wrapped to 100 columns."""
     import textwrap
