@@ -20,14 +20,20 @@ KW = {"episode_s": 30.0}                      # 30 env steps per episode: the au
 N = 37                                        # 2 full groups of 16 and a partial one of 5
 
 
-def _vec(env_id, n=N, **kw):
-    return gym.make_vec(env_id, num_envs=n, vectorization_mode="vector_entry_point", **{**KW, **kw})
+def _vec(env_id, n=N, threads=None, **kw):
+    """A native vector env; ``threads`` (an int) spreads its every step over that many threads
+    whatever N (the split the env uses from ``THREADS_FROM`` ships on)."""
+    venv = gym.make_vec(env_id, num_envs=n, vectorization_mode="vector_entry_point", **{**KW, **kw})
+    if threads is not None:
+        venv.unwrapped.core.threads_from, venv.unwrapped.core.threads = 1, threads
+    return venv
 
 
+@pytest.mark.parametrize("threads", [None, 2, 3])     # 37 ships: one call; ranges [0, 16) [16, 37); 3 ranges
 @pytest.mark.parametrize("env_id", ["steerlab/CourseKeeping-v0", "steerlab/TrackFollowing-v0"])
-def test_vector_env_of_37_equals_37_single_envs_through_an_autoreset(env_id):
+def test_vector_env_of_37_equals_37_single_envs_through_an_autoreset(env_id, threads):
     assert N % LANES != 0
-    venv = _vec(env_id)
+    venv = _vec(env_id, threads=threads)
     singles = [gym.make(env_id, **KW) for _ in range(N)]
     acts = np.random.default_rng(1).uniform(-1, 1, size=(34, N, 1)).astype(np.float32)
     vo, _ = venv.reset(seed=100)
@@ -50,20 +56,59 @@ def test_vector_env_of_37_equals_37_single_envs_through_an_autoreset(env_id):
     assert len({tuple(o) for o in vo}) == N   # 37 different seas and starts
 
 
+def _episodes(venv, seed, acts):
+    """Observations, rewards and end flags of ``len(acts)`` steps from ``reset(seed=seed)``, flat."""
+    out = [venv.reset(seed=seed)[0]]
+    for a in acts:
+        o, r, te, tr, _ = venv.step(a)
+        out.append(np.concatenate([o.ravel(), r, te, tr]))
+    return np.concatenate([np.ravel(x) for x in out])
+
+
 def test_vector_env_same_seed_same_episodes_and_another_seed_another():
     venv = _vec("steerlab/CourseChange-v0", n=20)
-    acts = np.random.default_rng(2).uniform(-1, 1, size=(40, 20, 1)).astype(np.float32)
-
-    def episode(seed):
-        out = [venv.reset(seed=seed)[0]]
-        for k in range(40):                   # through the autoreset at step 31
-            o, r, te, tr, _ = venv.step(acts[k])
-            out.append(np.concatenate([o.ravel(), r, te, tr]))
-        return np.concatenate([np.ravel(x) for x in out])
-
-    a, b, c = episode(7), episode(7), episode(8)
+    acts = np.random.default_rng(2).uniform(-1, 1, size=(40, 20, 1)).astype(np.float32)   # autoreset at 31
+    a, b, c = _episodes(venv, 7, acts), _episodes(venv, 7, acts), _episodes(venv, 8, acts)
     assert np.array_equal(a, b)
     assert not np.array_equal(a, c)
+
+
+@pytest.mark.parametrize("environment", [None, {"waves": True, "wind_speed": 5.0, "gusts": {"speed_std": 1.0}}])
+def test_threaded_steps_give_the_one_call_numbers_whatever_the_thread_count(environment):
+    """The step spread over 1, 2 or 3 threads (ranges of whole groups) gives, bit for bit, the
+    episodes of the one-call step, through autoresets, and the same seed the same episodes; also
+    with a sea realised lane by lane (gusts: the caller resets those lanes)."""
+    n = 2 * LANES + 3
+    kw = {"environment": environment} if environment else {}
+    acts = np.random.default_rng(4).uniform(-1, 1, size=(65, n, 1)).astype(np.float32)   # 2 autoresets
+    one_call = _vec("steerlab/CourseChange-v0", n=n, **kw)
+    assert one_call.unwrapped.core.threads_from > n
+    ref = _episodes(one_call, 9, acts)
+    for threads in (1, 2, 3):
+        venv = _vec("steerlab/CourseChange-v0", n=n, threads=threads, **kw)
+        assert np.array_equal(_episodes(venv, 9, acts), ref), threads
+        assert np.array_equal(_episodes(venv, 9, acts), ref), threads
+    assert not np.array_equal(_episodes(venv, 10, acts), ref)
+
+
+def test_run_ranges_covers_the_lanes_once_in_whole_groups_and_waits_for_all():
+    from steerlab.sim.lanes import _run_ranges
+
+    for n, threads, want in ((37, 2, [(0, 16), (16, 37)]), (37, 3, [(0, 16), (16, 32), (32, 37)]),
+                             (1024, 2, [(0, 512), (512, 1024)]), (10, 4, [(0, 10)]), (40, 1, [(0, 40)]),
+                             (1024, 3, [(0, 336), (336, 672), (672, 1024)])):
+        assert _run_ranges(lambda lo, hi: (lo, hi), n, LANES, threads) == want
+
+    done = []
+
+    def fails_first(lo, hi):
+        if lo == 0:
+            raise ValueError("boom")
+        done.append((lo, hi))
+
+    with pytest.raises(ValueError, match="boom"):
+        _run_ranges(fails_first, 48, LANES, 3)
+    assert sorted(done) == [(16, 32), (32, 48)]            # the others had finished when it raised
 
 
 def test_plain_seas_are_the_scenario_wave_model_driven_by_each_lanes_philox_normals():
@@ -238,10 +283,11 @@ def test_a_diverged_ship_in_the_vector_env_ends_only_its_episode():
     assert not te.any() and np.all(r == 0.0) and np.all(np.abs(o[:, 1]) < 1e-9)
 
 
-def test_an_action_outside_the_space_is_refused_by_the_vector_env_and_changes_nothing():
+@pytest.mark.parametrize("threads", [None, 2])          # 2: ranges [0, 16) and [16, 18), the bad lane in the 2nd
+def test_an_action_outside_the_space_is_refused_by_the_vector_env_and_changes_nothing(threads):
     from steerlab.errors import InputError
 
-    venv = _vec("steerlab/CourseKeeping-v0", n=18)
+    venv = _vec("steerlab/CourseKeeping-v0", n=18, threads=threads)
     core = venv.unwrapped.core
     venv.reset(seed=3)
     venv.step(np.zeros((18, 1), dtype=np.float32))
@@ -252,8 +298,15 @@ def test_an_action_outside_the_space_is_refused_by_the_vector_env_and_changes_no
         with pytest.raises(InputError) as ei:
             venv.step(acts)
         assert ei.value.field == "action" and "[-1, 1]" in str(ei.value)
+        assert repr(float(np.float32(bad))) in str(ei.value)
         assert all(np.array_equal(a, b, equal_nan=True) for a, b in
                    zip(before, (core.X, core.K, core.J, core.W, core.obs, core.rew)))
+    acts = np.zeros((18, 1), dtype=np.float32)
+    acts[3, 0], acts[17, 0] = 1.5, -2.0                       # one bad action in each range: the first named
+    with pytest.raises(InputError) as ei:
+        venv.step(acts)
+    assert "1.5" in str(ei.value) and "-2" not in str(ei.value)
+    assert all(np.array_equal(a, b) for a, b in zip(before, (core.X, core.K, core.J, core.W, core.obs, core.rew)))
     o, *_ = venv.step(np.ones((18, 1), dtype=np.float32))     # the boundary itself is allowed
     assert np.all(np.isfinite(o))
 

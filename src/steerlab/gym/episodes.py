@@ -32,6 +32,7 @@ import math
 from dataclasses import replace
 from typing import Any, Iterable, Mapping, Optional, Sequence, Union
 
+import numba
 import numpy as np
 from numpy.typing import ArrayLike
 
@@ -40,6 +41,8 @@ from steerlab.environment.iir_filter import _padded
 from steerlab.environment.waves import _hold, band_pass_eq39
 
 from steerlab.errors import InputError, require_finite_range
+from steerlab.gym.plant_batch import first_refused
+from steerlab.sim.lanes import LANES, _run_ranges as run_ranges
 from steerlab.units import rad
 from steerlab.ships.state import IPSI
 from steerlab.steering_gear import G_DMAX
@@ -49,6 +52,9 @@ TASKS = ("course_keeping", "course_change", "track_following")
 #: the track-following task's default route: a straight line north, the ship starting 200 m to starboard
 TRACK_GUIDANCE = {"type": "los", "start": [0.0, 200.0], "route": [[0.0, 0.0], [100000.0, 0.0]],
                   "lookahead_L": 5.0}
+THREADS_FROM = 256
+"""Least number of lanes whose vectorised step is spread over the threads (below it one call
+in the calling thread: a thread's hand-over, some 10-30 us, costs more than it saves)."""
 N_OBS = 3
 OBS_NAMES = ("heading_error", "yaw_rate", "rudder")
 OBS_UNITS = ("rad", "rad/s", "rad")
@@ -137,6 +143,9 @@ class Episodes:
         self.w_index = np.arange(n, dtype=np.int64)
         self._work = np.empty((5, nx))
         self.vectorised = bool(vectorised)
+        # the vectorised step of at least threads_from lanes runs on `threads` threads (None: numba's
+        # number, numba.get_num_threads(), read at each step); the numbers do not depend on either
+        self.threads_from, self.threads = THREADS_FROM, None
         if self.vectorised:
             self._vstep = vector_stepper(s0.ship.rhs, self.guide, nx)
         else:
@@ -230,17 +239,27 @@ class Episodes:
         return self.obs, self.rew, self.bad.copy(), truncated & ~self.bad
 
     def step_autoreset(self, actions: ArrayLike, redo: np.ndarray, term: np.ndarray, trunc: np.ndarray) -> None:
-        """The vector environment's step (:func:`steerlab.gym.plant_batch.vector_stepper`, one
-        compiled call): the lanes not in ``redo`` (N,) bool advance with ``actions`` (N,) in
-        [-1, 1], the ``redo`` lanes reset to their next episode (action ignored, reward 0);
-        fills ``obs``, ``rew``, ``term``, ``trunc`` and sets ``redo = term | trunc``."""
+        """The vector environment's step (:func:`steerlab.gym.plant_batch.vector_stepper`): the
+        lanes not in ``redo`` (N,) bool advance with ``actions`` (N,) in [-1, 1], the ``redo``
+        lanes reset to their next episode (action ignored, reward 0); fills ``obs``, ``rew``,
+        ``term``, ``trunc`` and sets ``redo = term | trunc``. One compiled call for all lanes;
+        from ``threads_from`` lanes (:data:`THREADS_FROM`) on, all actions are checked first,
+        then ``threads`` calls on contiguous ranges of whole groups run at once, as the batch
+        engine spreads its groups (:func:`steerlab.sim.lanes._run_ranges`, the same pool of
+        threads). A lane's numbers do not depend on the split."""
         a = np.asarray(actions, dtype=np.float64).reshape(self.n)
         again = None if self.lazy else redo.copy()
-        i = self._vstep(a, redo, self.X, self.K, self.J, self.cmd, self.W, self.w_index, self.PS, self.PG, self.dt,
-                        self.nc, self.gd, self.GZ, self.REF, self.rpm_slot, self.lam, self.reward, self.obs,
-                        self.rew, self.bad, term, trunc, self.n_env_steps, self.delta_max, *self._sea_args(),
-                        self.KEY, self.EP, self._scale, self.offset_max, self._x0, self._ps0, self.gz0, self._ref0,
-                        self._fast_seas)
+        args = (a, redo, self.X, self.K, self.J, self.cmd, self.W, self.w_index, self.PS, self.PG, self.dt,
+                self.nc, self.gd, self.GZ, self.REF, self.rpm_slot, self.lam, self.reward, self.obs, self.rew,
+                self.bad, term, trunc, self.n_env_steps, self.delta_max, *self._sea_args(), self.KEY, self.EP,
+                self._scale, self.offset_max, self._x0, self._ps0, self.gz0, self._ref0, self._fast_seas)
+        threads = self.threads if self.threads is not None else numba.get_num_threads()
+        if self.n < self.threads_from or threads <= 1:
+            i = self._vstep(0, self.n, *args)
+        else:                                              # every action checked before any lane moves
+            i = first_refused(a, redo, 0, self.n)
+            if i < 0:
+                run_ranges(lambda lo, hi: self._vstep(lo, hi, *args), self.n, LANES, threads)
         if i >= 0:
             raise self._refused(a[i])
         if again is not None and again.any():              # seas realised lane by lane: reset here

@@ -29,7 +29,7 @@ from __future__ import annotations
 
 import os
 import time
-from concurrent.futures import ThreadPoolExecutor, as_completed
+from concurrent.futures import ThreadPoolExecutor, as_completed, wait
 from functools import lru_cache
 
 import numba
@@ -97,6 +97,30 @@ def _run_groups(run_group, n: int, lanes: int, progress=None) -> None:
             for fut in runs:         # on an error (or Ctrl-C) drop the groups not yet started
                 fut.cancel()
     report.done()
+
+
+def _run_ranges(call, n: int, lanes: int, threads: int) -> list:
+    """``[call(lo, hi), ...]`` over at most ``threads`` contiguous ranges covering ``0 .. n - 1``
+    at the same time: the first in this thread, the others on the pool (:func:`_pool`).
+
+    The ranges are as equal as whole groups of ``lanes`` allow (their bounds are multiples of
+    ``lanes``, so each range's groups stay full but the last); a single range (``threads`` 1,
+    or ``n <= lanes``) is one call in this thread. ``call`` should release the GIL (a nogil
+    kernel) for the ranges to overlap. Returns when every call has returned (an exception is
+    raised after the others finished, so nothing still writes the caller's arrays).
+    """
+    groups = -(-n // lanes)
+    k = max(1, min(int(threads), groups))
+    if k == 1:
+        return [call(0, n)]
+    cuts = [min(n, lanes * (groups * j // k)) for j in range(k + 1)]
+    pool = _pool(k, os.getpid())
+    futs = [pool.submit(call, cuts[j], cuts[j + 1]) for j in range(1, k)]
+    try:
+        first = call(cuts[0], cuts[1])
+    finally:
+        wait(futs)
+    return [first] + [f.result() for f in futs]
 
 
 class _Reporter:
