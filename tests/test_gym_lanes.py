@@ -89,6 +89,12 @@ def test_threaded_steps_give_the_one_call_numbers_whatever_the_thread_count(envi
         assert np.array_equal(_episodes(venv, 9, acts), ref), threads
         assert np.array_equal(_episodes(venv, 9, acts), ref), threads
     assert not np.array_equal(_episodes(venv, 10, acts), ref)
+    lanes = [3, 30] + list(range(5, 25)) + [3]               # a lane twice: reset twice, in order, one call
+    for env in (one_call, venv):
+        env.reset(seed=9)
+        env.unwrapped.core.reset_lanes(lanes)
+    a, b = one_call.unwrapped.core, venv.unwrapped.core
+    assert np.array_equal(a.X, b.X) and np.array_equal(a.EP, b.EP) and np.array_equal(a.obs, b.obs)
 
 
 def test_run_ranges_covers_the_lanes_once_in_whole_groups_and_waits_for_all():

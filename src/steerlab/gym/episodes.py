@@ -181,12 +181,21 @@ class Episodes:
     def _sea_args(self):
         return (self.lazy, self.S, self.Z, self._base, self._hold, self._fb, self._fa, W_RUDDER)
 
+    def _threads(self, m: int) -> int:
+        """Threads for a compiled call over ``m`` lanes: 1 below ``threads_from``, else
+        ``threads`` (None: ``numba.get_num_threads()``)."""
+        if m < self.threads_from:
+            return 1
+        return self.threads if self.threads is not None else numba.get_num_threads()
+
     # ----------------------------------------------------------------- reset
     def reset_lanes(self, lanes: Union[Iterable[int], np.ndarray],
                     seeds: Optional[Sequence[Optional[int]]] = None) -> list[dict[str, Any]]:
         """Reset ``lanes`` (indices) to their next episode; ``seeds[i]`` (int or None) first
         keys lane ``lanes[i]`` with that seed (episode 0). A lane never keyed is keyed from
-        the operating system's entropy. Returns one info dict per lane."""
+        the operating system's entropy. Returns one info dict per lane. From ``threads_from``
+        distinct lanes on, the compiled resets are spread over the threads as the step's
+        (:meth:`step_autoreset`), with the same numbers."""
         from steerlab.gym.philox import seed_key
 
         lanes = np.asarray(lanes, dtype=np.int64).reshape(-1)
@@ -200,10 +209,16 @@ class Episodes:
                 self.KEY[i] = key
                 self.EP[i] = 0
                 self.keyed[i] = True
-        sea_seeds = self._sea_seeds[: lanes.shape[0]]
-        self._reset(lanes, self.KEY, self.EP, self.S, self.Z, self._scale, self.offset_max, self.X, self.K, self.J,
-                    self.cmd, self.PS, self.GZ, self.REF, self._x0, self._ps0, self.gz0, self._ref0, self.gd,
-                    self.control_dt, self.rpm_slot, self.obs, self.rew, self.bad, sea_seeds)
+        m = lanes.shape[0]
+        sea_seeds = self._sea_seeds[:m]
+        args = (self.KEY, self.EP, self.S, self.Z, self._scale, self.offset_max, self.X, self.K, self.J, self.cmd,
+                self.PS, self.GZ, self.REF, self._x0, self._ps0, self.gz0, self._ref0, self.gd, self.control_dt,
+                self.rpm_slot, self.obs, self.rew, self.bad)
+        threads = self._threads(m)
+        if threads > 1 and np.unique(lanes).shape[0] == m:   # distinct lanes: disjoint rows, spread
+            run_ranges(lambda lo, hi: self._reset(lanes[lo:hi], *args, sea_seeds[lo:hi]), m, 1, threads)
+        else:
+            self._reset(lanes, *args, sea_seeds)
         infos = [{"episode": int(self.EP[i]) - 1, "initial_heading": float(self.X[i, IPSI])} for i in lanes.tolist()]
         if not self._fast_seas:
             for q, i in enumerate(lanes.tolist()):
@@ -253,8 +268,8 @@ class Episodes:
                 self.nc, self.gd, self.GZ, self.REF, self.rpm_slot, self.lam, self.reward, self.obs, self.rew,
                 self.bad, term, trunc, self.n_env_steps, self.delta_max, *self._sea_args(), self.KEY, self.EP,
                 self._scale, self.offset_max, self._x0, self._ps0, self.gz0, self._ref0, self._fast_seas)
-        threads = self.threads if self.threads is not None else numba.get_num_threads()
-        if self.n < self.threads_from or threads <= 1:
+        threads = self._threads(self.n)
+        if threads <= 1:
             i = self._vstep(0, self.n, *args)
         else:                                              # every action checked before any lane moves
             i = first_refused(a, redo, 0, self.n)

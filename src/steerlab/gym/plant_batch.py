@@ -255,10 +255,11 @@ def lane_resetter(guide):
 def resetter(guide):
     """``reset(idx, KEY, EP, S, Z, scale, offset_max, X, K, J, cmd, PS, GZ, REF, x0, ps, gz0, ref0, gd, h_env,
     rpm_slot, obs, rew, bad, sea_seeds)``: :func:`lane_resetter` for the lanes ``idx``, their
-    sea seeds into ``sea_seeds``; one compiled call for all of them."""
+    sea seeds into ``sea_seeds``; one compiled call for all of them. It releases the GIL:
+    calls on disjoint lanes may run in parallel threads (:meth:`steerlab.gym.episodes.Episodes.reset_lanes`)."""
     reset_one = lane_resetter(guide)
 
-    @numba.njit
+    @numba.njit(nogil=True)
     def reset(idx, KEY, EP, S, Z, scale, offset_max, X, K, J, cmd, PS, GZ, REF, x0, ps, gz0, ref0, gd, h_env,
               rpm_slot, obs, rew, bad, sea_seeds):
         for q in range(idx.shape[0]):
