@@ -330,6 +330,9 @@ def test_bench_env_script_reports_both_envs(capsys):
     assert mod.main(["--n", "3", "--steps", "4", "--repeats", "1", "--min-time", "0", "--json"]) == 0
     (row,) = json.loads(capsys.readouterr().out)["rows"]
     assert row["n"] == 3 and row["steps"] == 4 and row["control_dt"] == 1.0
+    assert row["threads"] == 1                                # 3 ships: below THREADS_FROM, one call
     for k in ("native_env_steps_per_s", "sync_env_steps_per_s", "native_env_steps_per_cpu_s", "ratio", "ratio_cpu"):
         assert row[k] > 0
     assert row["ratio"] == pytest.approx(row["native_env_steps_per_s"] / row["sync_env_steps_per_s"])
+    assert mod.main(["--threads", "0"]) == 2
+    assert "--threads must be in [1, " in capsys.readouterr().err
