@@ -22,8 +22,9 @@ is the sea ``steerlab run`` gives that seed.
 ``vectorised=True`` (the native vector environment) advances the ships with the batch
 engine's vectorised groups and does the whole step - actions checked, autoresets, plants,
 guidance, observations, rewards - in one compiled call
-(:func:`steerlab.gym.plant_batch.vector_stepper`, :meth:`Episodes.step_autoreset`); the
-single environment steps its ship with the scalar kernel; the numbers are the same.
+(:func:`steerlab.gym.plant_batch.vector_stepper`, :meth:`Episodes.step_autoreset`), spread
+over the threads from :data:`THREADS_FROM` ships on; the single environment steps its ship
+with the scalar kernel; the numbers are the same.
 """
 
 from __future__ import annotations
