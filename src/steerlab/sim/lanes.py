@@ -29,7 +29,7 @@ from __future__ import annotations
 
 import os
 import time
-from concurrent.futures import ThreadPoolExecutor, as_completed, wait
+from concurrent.futures import ThreadPoolExecutor, as_completed
 from functools import lru_cache
 
 import numba
@@ -119,8 +119,9 @@ def _run_ranges(call, n: int, lanes: int, threads: int) -> list:
     try:
         first = call(cuts[0], cuts[1])
     finally:
-        wait(futs)
-    return [first] + [f.result() for f in futs]
+        for fut in futs:
+            fut.exception()          # waits for it (its exception, if any, is raised just below)
+    return [first] + [fut.result() for fut in futs]
 
 
 class _Reporter:
