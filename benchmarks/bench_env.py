@@ -25,9 +25,9 @@ wall clock and by the process's CPU time (``time.process_time``, all the process
 an autoreset round costs).
 
 Threads: like the batch engine, the native env spreads a step (and a reset) of
-``THREADS_FROM`` = 256 ships or more over ``numba.get_num_threads()`` threads (the cores,
+``THREADS_FROM`` = 512 ships or more over ``numba.get_num_threads()`` threads (the cores,
 or ``--threads``; :meth:`steerlab.gym.episodes.Episodes.step_autoreset`); ``threads`` in the
-table is the number it used at that N (1 below 256). ``SyncVectorEnv`` steps its envs one
+table is the number it used at that N (1 below 512). ``SyncVectorEnv`` steps its envs one
 after the other in one thread. So the **wall** ratio is the user's figure (what this machine
 gives an RL loop), and the **CPU** ratio is the per-core one (what a step costs in core
 time; threads add a little hand-over, they do not make a step cheaper). On an idle machine
@@ -115,7 +115,7 @@ def main(argv=None) -> int:
     ap.add_argument("--min-time", type=float, default=0.2,
                     help="each timing repeats its block of steps until this many seconds (small N)")
     ap.add_argument("--threads", type=int, default=None,
-                    help="threads of the native env from 256 ships on (numba.set_num_threads; default: "
+                    help="threads of the native env from 512 ships on (numba.set_num_threads; default: "
                          "numba's number, the cores)")
     ap.add_argument("--json", action="store_true")
     a = ap.parse_args(argv)
