@@ -97,26 +97,43 @@ def test_threaded_steps_give_the_one_call_numbers_whatever_the_thread_count(envi
     assert np.array_equal(a.X, b.X) and np.array_equal(a.EP, b.EP) and np.array_equal(a.obs, b.obs)
 
 
-def test_run_ranges_covers_the_lanes_once_in_whole_groups_and_waits_for_all():
-    from steerlab.sim.lanes import _run_ranges
+def test_shared_ranges_cover_the_lanes_once_in_whole_groups_and_wait_for_all():
+    import threading
 
-    for n, threads, want in ((37, 2, [(0, 16), (16, 37)]), (37, 3, [(0, 16), (16, 32), (32, 37)]),
-                             (1024, 2, [(0, 512), (512, 1024)]), (10, 4, [(0, 10)]), (40, 1, [(0, 40)]),
-                             (1024, 3, [(0, 336), (336, 672), (672, 1024)])):
-        assert _run_ranges(lambda lo, hi: (lo, hi), n, LANES, threads) == want
+    from steerlab.sim.lanes import _share_ranges
 
-    done = []
+    for n, threads, per_thread, ranges in ((37, 2, 1, 2), (37, 3, 1, 3), (37, 2, 4, 3), (1024, 2, 2, 4),
+                                           (1024, 3, 4, 12), (10, 4, 2, 1), (40, 1, 2, 1)):
+        calls, who = [], set()
 
-    def fails_first(lo, hi):
-        if lo == 0:
+        def call(lo, hi):
+            calls.append((lo, hi))
+            who.add(threading.get_ident())
+
+        _share_ranges(call, n, LANES, threads, per_thread)
+        calls.sort()
+        assert len(calls) == ranges and calls[0][0] == 0 and calls[-1][1] == n
+        assert all(a[1] == b[0] for a, b in zip(calls, calls[1:]))            # contiguous, no lane twice
+        assert all(lo % LANES == 0 and hi > lo for lo, hi in calls)            # whole groups
+        assert len(who) <= min(threads, ranges)
+
+    import time
+
+    started, done, release = [], [], threading.Event()
+
+    def fails_in_this_thread(lo, hi):
+        if threading.current_thread() is threading.main_thread():
+            release.wait(10.0)        # the pool thread takes the other ranges meanwhile
             raise ValueError("boom")
+        started.append(lo)
+        if len(started) == 2:
+            release.set()             # this thread raises while the pool thread is still in its call
+            time.sleep(0.1)
         done.append((lo, hi))
 
     with pytest.raises(ValueError, match="boom"):
-        _run_ranges(fails_first, 48, LANES, 3)
-    assert sorted(done) == [(16, 32), (32, 48)]            # the others had finished when it raised
-
-
+        _share_ranges(fails_in_this_thread, 48, LANES, 2, per_thread=2)     # 3 ranges of one group (2 x 2 > 3)
+    assert len(done) == 2                                                   # it had finished when it raised
 def test_plain_seas_are_the_scenario_wave_model_driven_by_each_lanes_philox_normals():
     """A plain sea's rows, written lazily env step by env step, equal the scenario machinery's
     sea (seed-free channels of ``realise``, eq-39 filter of the held samples as

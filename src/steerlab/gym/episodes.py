@@ -43,7 +43,7 @@ from steerlab.environment.waves import _hold, band_pass_eq39
 
 from steerlab.errors import InputError, require_finite_range
 from steerlab.gym.plant_batch import first_refused
-from steerlab.sim.lanes import LANES, _run_ranges as run_ranges
+from steerlab.sim.lanes import LANES, _share_ranges as share_ranges
 from steerlab.units import rad
 from steerlab.ships.state import IPSI
 from steerlab.steering_gear import G_DMAX
@@ -221,7 +221,7 @@ class Episodes:
                 self.rpm_slot, self.obs, self.rew, self.bad)
         threads = self._threads(m)
         if threads > 1 and np.unique(lanes).shape[0] == m:   # distinct lanes: disjoint rows, spread
-            run_ranges(lambda lo, hi: self._reset(lanes[lo:hi], *args, sea_seeds[lo:hi]), m, 1, threads)
+            share_ranges(lambda lo, hi: self._reset(lanes[lo:hi], *args, sea_seeds[lo:hi]), m, 1, threads)
         else:
             self._reset(lanes, *args, sea_seeds)
         infos = [{"episode": int(self.EP[i]) - 1, "initial_heading": float(self.X[i, IPSI])} for i in lanes.tolist()]
@@ -264,8 +264,8 @@ class Episodes:
         lanes reset to their next episode (action ignored, reward 0); fills ``obs``, ``rew``,
         ``term``, ``trunc`` and sets ``redo = term | trunc``. One compiled call for all lanes;
         from ``threads_from`` lanes (:data:`THREADS_FROM`) on, all actions are checked first,
-        then ``threads`` calls on contiguous ranges of whole groups run at once, as the batch
-        engine spreads its groups (:func:`steerlab.sim.lanes._run_ranges`, the same pool of
+        then ``threads`` threads share calls on contiguous ranges of whole groups, as the batch
+        engine spreads its groups (:func:`steerlab.sim.lanes._share_ranges`, the same pool of
         threads). A lane's numbers do not depend on the split."""
         a = np.asarray(actions, dtype=np.float64).reshape(self.n)
         again = None if self.lazy else redo.copy()
@@ -279,7 +279,7 @@ class Episodes:
         else:                                              # every action checked before any lane moves
             i = first_refused(a, redo, 0, self.n)
             if i < 0:
-                run_ranges(lambda lo, hi: self._vstep(lo, hi, *args), self.n, LANES, threads)
+                share_ranges(lambda lo, hi: self._vstep(lo, hi, *args), self.n, LANES, threads)
         if i >= 0:
             raise self._refused(a[i])
         if again is not None and again.any():              # seas realised lane by lane: reset here
