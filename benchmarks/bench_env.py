@@ -133,7 +133,8 @@ def main(argv=None) -> int:
         r = measure(n, a.steps, a.repeats, a.control_dt, a.min_time)
         rows.append(r)
         if not a.json:
-            print(f"N={n:5d}  threads {r['threads']}  native {r['native_env_steps_per_s']:10.3g} env-steps/s   SyncVectorEnv "
+            print(f"N={n:5d}  threads {r['threads']}  native {r['native_env_steps_per_s']:10.3g} env-steps/s   "
+                  f"SyncVectorEnv "
                   f"{r['sync_env_steps_per_s']:10.3g}   ratio {r['ratio']:6.1f}x   (CPU time: "
                   f"{r['native_env_steps_per_cpu_s']:9.3g} / {r['sync_env_steps_per_cpu_s']:9.3g} = "
                   f"{r['ratio_cpu']:6.1f}x)   native reset of all N {r['native_reset_all_ms']:7.2f} ms", flush=True)

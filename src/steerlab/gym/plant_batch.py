@@ -152,8 +152,8 @@ def vector_stepper(ship_rhs, guide, nx: int):
     (gymnasium's ``NEXT_STEP`` autoreset: their action is ignored). First every other lane's
     action in the range is checked to be in [-1, 1] (:func:`first_refused`): the index of the
     first one that is not is returned (nothing changed; -1 if all are). Those lanes get the
-    order ``A[i] dmax`` [rad], their disturbance rows (with ``lazy``, as :func:`lane_stepper`) and ``nc`` plant steps through
-    the ship driver's ``step_lanes`` (groups of ``LANES`` ships, structure of arrays,
+    order ``A[i] dmax`` [rad], their disturbance rows (with ``lazy``, as :func:`lane_stepper`)
+    and ``nc`` plant steps through the ship driver's ``step_lanes`` (groups of ``LANES`` ships, structure of arrays,
     vectorised RK4 stages), then :func:`finisher`; ``term`` = diverged, ``trunc`` = the
     episode's ``n_env_steps`` done. With ``auto`` (seas that need no per-lane scenario
     machinery) the ``redo`` lanes are reset here (:func:`lane_resetter`: ``KEY``, ``EP``, ``scale``, ``offset_max``,
