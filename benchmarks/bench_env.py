@@ -30,10 +30,11 @@ or ``--threads``; :meth:`steerlab.gym.episodes.Episodes.step_autoreset`); ``thre
 table is the number it used at that N (1 below 512). ``SyncVectorEnv`` steps its envs one
 after the other in one thread. So the **wall** ratio is the user's figure (what this machine
 gives an RL loop), and the **CPU** ratio is the per-core one (what a step costs in core
-time; threads add a little hand-over, they do not make a step cheaper). On an idle machine
-with T cores the wall ratio at N = 1024 approaches T times the CPU ratio; when other
-programs hold the cores it drops towards it. Not a test: the numbers depend on the machine
-and its load; report ``uptime`` with them.
+time; threads do not make a step cheaper, they add the hand-over to a pool thread, 20-70 us
+of CPU per step on the 2-core development VM). Two threads cut the wall time of a
+1024-ship step only when a second core is free (1.2-1.3x there); with the cores held by
+other programs the wall ratio falls below the one-thread figure (compare ``--threads 1``).
+Not a test: the numbers depend on the machine and its load (printed with them).
 """
 
 from __future__ import annotations
