@@ -56,8 +56,9 @@ TRACK_GUIDANCE = {"type": "los", "start": [0.0, 200.0], "route": [[0.0, 0.0], [1
 THREADS_FROM = 512
 """Least number of lanes whose vectorised step (or reset) is spread over the threads; below
 it, one call in the calling thread. Handing a range to a pool thread and waiting for it costs
-some 20-40 us of CPU and wall time on the 2-core development VM, what the second thread saves
-on about 300 ships (0.25 us per ship and env step at the default ``control_dt``). Measured
+some 25-55 us of wall and 20-70 us of CPU time on the 2-core development VM, what a second
+thread saves on 200-450 ships (0.25 us per ship and env step at the default
+``control_dt``). Measured
 there at 1024 ships: 1.2-1.3x faster by wall clock with part of a core free, 0.8-0.9x when
 other programs held both cores; ``numba.set_num_threads(1)`` keeps the env on one thread."""
 N_OBS = 3
