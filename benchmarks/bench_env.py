@@ -6,6 +6,7 @@ Usage::
     python benchmarks/bench_env.py                       # N = 1, 64, 1024
     python benchmarks/bench_env.py --n 1,64 --steps 150 --repeats 5 --json
     python benchmarks/bench_env.py --control-dt 0.1     # one RK4 step per env step
+    python benchmarks/bench_env.py --threads 1          # the native env on one thread
 
 Workload: ``steerlab/CourseKeeping-v0`` with its defaults (Esso tanker at 16 kn, gear 35 deg /
 2.33 deg/s, eq-39 waves, dt 0.1 s, control_dt 1 s = 10 RK4 steps per env step) but episodes of
@@ -19,16 +20,28 @@ single environments made by ``gymnasium.make`` (its wrappers included), and thei
 The two are timed alternately, ``--repeats`` times each after one untimed warm-up (the first
 call compiles), each timing the ``--steps`` steps after ``reset(seed=0)`` (repeated until
 ``--min-time`` seconds, for small N, and averaged); the figures are the medians, by
-wall clock and by the process's CPU time (``time.process_time``: what the code costs when other
-programs share the cores). ``reset_ms`` is the median wall time of one reset of all N native
-ships without a seed (what an autoreset round costs). Not a test: the numbers depend on the
-machine and its load.
+wall clock and by the process's CPU time (``time.process_time``, all the process's threads).
+``reset_ms`` is the median wall time of one reset of all N native ships without a seed (what
+an autoreset round costs).
+
+Threads: like the batch engine, the native env spreads a step (and a reset) of
+``THREADS_FROM`` = 512 ships or more over ``numba.get_num_threads()`` threads (the cores,
+or ``--threads``; :meth:`steerlab.gym.episodes.Episodes.step_autoreset`); ``threads`` in the
+table is the number it used at that N (1 below 512). ``SyncVectorEnv`` steps its envs one
+after the other in one thread. So the **wall** ratio is the user's figure (what this machine
+gives an RL loop), and the **CPU** ratio is the per-core one (what a step costs in core
+time; threads do not make a step cheaper, they add the hand-over to a pool thread, 20-70 us
+of CPU per step on the 2-core development VM). Two threads cut the wall time of a
+1024-ship step only when a second core is free (1.2-1.3x there); with the cores held by
+other programs the wall ratio falls below the one-thread figure (compare ``--threads 1``).
+Not a test: the numbers depend on the machine and its load (printed with them).
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import os
 import sys
 import time
 
@@ -70,6 +83,7 @@ def measure(n, steps=150, repeats=5, control_dt=1.0, min_s=0.2):
 
     kw = {"episode_s": 120 * control_dt, "control_dt": control_dt}
     native = gym.make_vec("steerlab/CourseKeeping-v0", num_envs=n, vectorization_mode="vector_entry_point", **kw)
+    threads = native.unwrapped.core._threads(n)
     sync = gym.vector.SyncVectorEnv([lambda: gym.make("steerlab/CourseKeeping-v0", **kw) for _ in range(n)])
     acts = np.random.default_rng(0).uniform(-1, 1, size=(steps, n, 1)).astype(np.float32)
     for env in (native, sync):                           # warm-up: compiles, touches the memory
@@ -78,7 +92,7 @@ def measure(n, steps=150, repeats=5, control_dt=1.0, min_s=0.2):
     for _ in range(repeats):
         t["native"].append(_time(native, acts, min_s=min_s))
         t["sync"].append(_time(sync, acts, min_s=min_s))
-    row = {"n": n, "control_dt": control_dt, "steps": steps, "repeats": repeats}
+    row = {"n": n, "threads": threads, "control_dt": control_dt, "steps": steps, "repeats": repeats}
     for name, times in t.items():
         wall, cpu = np.median(np.array(times), axis=0)
         row[f"{name}_env_steps_per_s"] = n * steps / wall
@@ -101,20 +115,37 @@ def main(argv=None) -> int:
                          "episodes of 120 steps")
     ap.add_argument("--min-time", type=float, default=0.2,
                     help="each timing repeats its block of steps until this many seconds (small N)")
+    ap.add_argument("--threads", type=int, default=None,
+                    help="threads of the native env from 512 ships on (numba.set_num_threads; default: "
+                         "numba's number, the cores)")
     ap.add_argument("--json", action="store_true")
     a = ap.parse_args(argv)
+    if a.threads is not None:
+        import numba
+
+        if not 1 <= a.threads <= numba.config.NUMBA_NUM_THREADS:
+            print(f"bench_env.py: --threads must be in [1, {numba.config.NUMBA_NUM_THREADS}], got {a.threads}",
+                  file=sys.stderr)
+            return 2
+        numba.set_num_threads(a.threads)
     rows = []
+    load0 = os.getloadavg()
     for n in (int(v) for v in a.n.split(",")):
         r = measure(n, a.steps, a.repeats, a.control_dt, a.min_time)
         rows.append(r)
         if not a.json:
-            print(f"N={n:5d}  native {r['native_env_steps_per_s']:10.3g} env-steps/s   SyncVectorEnv "
+            print(f"N={n:5d}  threads {r['threads']}  native {r['native_env_steps_per_s']:10.3g} env-steps/s   "
+                  f"SyncVectorEnv "
                   f"{r['sync_env_steps_per_s']:10.3g}   ratio {r['ratio']:6.1f}x   (CPU time: "
                   f"{r['native_env_steps_per_cpu_s']:9.3g} / {r['sync_env_steps_per_cpu_s']:9.3g} = "
                   f"{r['ratio_cpu']:6.1f}x)   native reset of all N {r['native_reset_all_ms']:7.2f} ms", flush=True)
+    load = {"before": load0[0], "after": os.getloadavg()[0], "cores": os.cpu_count()}
     if a.json:
         print(json.dumps({"workload": f"steerlab/CourseKeeping-v0, esso 16 kn, waves, dt 0.1 s, control_dt "
-                                      f"{a.control_dt} s, episodes of 120 env steps", "rows": rows}, indent=2))
+                                      f"{a.control_dt} s, episodes of 120 env steps", "load_average_1min": load,
+                          "rows": rows}, indent=2))
+    else:
+        print(f"load average (1 min) {load['before']:.2f} before, {load['after']:.2f} after, {load['cores']} cores")
     return 0
 
 

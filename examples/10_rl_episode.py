@@ -1,6 +1,6 @@
 """A reinforcement-learning environment: one episode of ``steerlab/CourseKeeping-v0``.
 
-Teaches: the Gymnasium environment (``pip install 'steerlab[gym]'``; ``import steerlab.gym``
+Teaches: the Gymnasium environment (``pip install 'steerlab[rl]'``; ``import steerlab.gym``
 registers the ids): observation ``[heading error e [rad], yaw rate r [rad/s], rudder delta
 [rad]]``, action the rudder order as a fraction of the gear limit, reward the speed-loss
 criterion ``-(e^2 + lam delta^2) control_dt``. Two policies on the same seeded episode (Esso
@@ -21,7 +21,7 @@ try:
     import gymnasium as gym
 except ImportError:
     print("gymnasium is not installed: this example needs the optional extra "
-          "(pip install 'steerlab[gym]'); skipped")
+          "(pip install 'steerlab[rl]'); skipped")
     sys.exit(0)
 
 import steerlab as sl

@@ -101,6 +101,17 @@ def test_bad_settings():
     assert ei.value.field == "ship.model"
 
 
+def test_without_gymnasium_the_import_says_what_to_install():
+    import subprocess
+    import sys
+
+    code = "import sys; sys.modules['gymnasium'] = None; import steerlab.gym"   # None: as if not installed
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert out.returncode == 1
+    last = out.stderr.strip().splitlines()[-1]
+    assert last == "ImportError: steerlab.gym needs gymnasium: pip install 'steerlab[rl]'"
+
+
 def test_a_steerlab_pid_beats_a_random_policy_through_the_env():
     from steerlab.components.controller import controller
 

@@ -20,14 +20,20 @@ KW = {"episode_s": 30.0}                      # 30 env steps per episode: the au
 N = 37                                        # 2 full groups of 16 and a partial one of 5
 
 
-def _vec(env_id, n=N, **kw):
-    return gym.make_vec(env_id, num_envs=n, vectorization_mode="vector_entry_point", **{**KW, **kw})
+def _vec(env_id, n=N, threads=None, **kw):
+    """A native vector env; ``threads`` (an int) spreads its every step over that many threads
+    whatever N (the split the env uses from ``THREADS_FROM`` ships on)."""
+    venv = gym.make_vec(env_id, num_envs=n, vectorization_mode="vector_entry_point", **{**KW, **kw})
+    if threads is not None:
+        venv.unwrapped.core.threads_from, venv.unwrapped.core.threads = 1, threads
+    return venv
 
 
+@pytest.mark.parametrize("threads", [None, 2, 3])     # 37 ships: one call; ranges [0, 16) [16, 37); 3 ranges
 @pytest.mark.parametrize("env_id", ["steerlab/CourseKeeping-v0", "steerlab/TrackFollowing-v0"])
-def test_vector_env_of_37_equals_37_single_envs_through_an_autoreset(env_id):
+def test_vector_env_of_37_equals_37_single_envs_through_an_autoreset(env_id, threads):
     assert N % LANES != 0
-    venv = _vec(env_id)
+    venv = _vec(env_id, threads=threads)
     singles = [gym.make(env_id, **KW) for _ in range(N)]
     acts = np.random.default_rng(1).uniform(-1, 1, size=(34, N, 1)).astype(np.float32)
     vo, _ = venv.reset(seed=100)
@@ -50,22 +56,84 @@ def test_vector_env_of_37_equals_37_single_envs_through_an_autoreset(env_id):
     assert len({tuple(o) for o in vo}) == N   # 37 different seas and starts
 
 
+def _episodes(venv, seed, acts):
+    """Observations, rewards and end flags of ``len(acts)`` steps from ``reset(seed=seed)``, flat."""
+    out = [venv.reset(seed=seed)[0]]
+    for a in acts:
+        o, r, te, tr, _ = venv.step(a)
+        out.append(np.concatenate([o.ravel(), r, te, tr]))
+    return np.concatenate([np.ravel(x) for x in out])
+
+
 def test_vector_env_same_seed_same_episodes_and_another_seed_another():
     venv = _vec("steerlab/CourseChange-v0", n=20)
-    acts = np.random.default_rng(2).uniform(-1, 1, size=(40, 20, 1)).astype(np.float32)
-
-    def episode(seed):
-        out = [venv.reset(seed=seed)[0]]
-        for k in range(40):                   # through the autoreset at step 31
-            o, r, te, tr, _ = venv.step(acts[k])
-            out.append(np.concatenate([o.ravel(), r, te, tr]))
-        return np.concatenate([np.ravel(x) for x in out])
-
-    a, b, c = episode(7), episode(7), episode(8)
+    acts = np.random.default_rng(2).uniform(-1, 1, size=(40, 20, 1)).astype(np.float32)   # autoreset at 31
+    a, b, c = _episodes(venv, 7, acts), _episodes(venv, 7, acts), _episodes(venv, 8, acts)
     assert np.array_equal(a, b)
     assert not np.array_equal(a, c)
 
 
+@pytest.mark.parametrize("environment", [None, {"waves": True, "wind_speed": 5.0, "gusts": {"speed_std": 1.0}}])
+def test_threaded_steps_give_the_one_call_numbers_whatever_the_thread_count(environment):
+    """The step spread over 1, 2 or 3 threads (ranges of whole groups) gives, bit for bit, the
+    episodes of the one-call step, through autoresets, and the same seed the same episodes; also
+    with a sea realised lane by lane (gusts: the caller resets those lanes)."""
+    n = 2 * LANES + 3
+    kw = {"environment": environment} if environment else {}
+    acts = np.random.default_rng(4).uniform(-1, 1, size=(65, n, 1)).astype(np.float32)   # 2 autoresets
+    one_call = _vec("steerlab/CourseChange-v0", n=n, **kw)
+    assert one_call.unwrapped.core.threads_from > n
+    ref = _episodes(one_call, 9, acts)
+    for threads in (1, 2, 3):
+        venv = _vec("steerlab/CourseChange-v0", n=n, threads=threads, **kw)
+        assert np.array_equal(_episodes(venv, 9, acts), ref), threads
+        assert np.array_equal(_episodes(venv, 9, acts), ref), threads
+    assert not np.array_equal(_episodes(venv, 10, acts), ref)
+    lanes = [3, 30] + list(range(5, 25)) + [3]               # a lane twice: reset twice, in order, one call
+    for env in (one_call, venv):
+        env.reset(seed=9)
+        env.unwrapped.core.reset_lanes(lanes)
+    a, b = one_call.unwrapped.core, venv.unwrapped.core
+    assert np.array_equal(a.X, b.X) and np.array_equal(a.EP, b.EP) and np.array_equal(a.obs, b.obs)
+
+
+def test_shared_ranges_cover_the_lanes_once_in_whole_groups_and_wait_for_all():
+    import threading
+
+    from steerlab.sim.lanes import _share_ranges
+
+    for n, threads, per_thread, ranges in ((37, 2, 1, 2), (37, 3, 1, 3), (37, 2, 4, 3), (1024, 2, 2, 4),
+                                           (1024, 3, 4, 12), (10, 4, 2, 1), (40, 1, 2, 1)):
+        calls, who = [], set()
+
+        def call(lo, hi):
+            calls.append((lo, hi))
+            who.add(threading.get_ident())
+
+        _share_ranges(call, n, LANES, threads, per_thread)
+        calls.sort()
+        assert len(calls) == ranges and calls[0][0] == 0 and calls[-1][1] == n
+        assert all(a[1] == b[0] for a, b in zip(calls, calls[1:]))            # contiguous, no lane twice
+        assert all(lo % LANES == 0 and hi > lo for lo, hi in calls)            # whole groups
+        assert len(who) <= min(threads, ranges)
+
+    import time
+
+    started, done, release = [], [], threading.Event()
+
+    def fails_in_this_thread(lo, hi):
+        if threading.current_thread() is threading.main_thread():
+            release.wait(10.0)        # the pool thread takes the other ranges meanwhile
+            raise ValueError("boom")
+        started.append(lo)
+        if len(started) == 2:
+            release.set()             # this thread raises while the pool thread is still in its call
+            time.sleep(0.1)
+        done.append((lo, hi))
+
+    with pytest.raises(ValueError, match="boom"):
+        _share_ranges(fails_in_this_thread, 48, LANES, 2, per_thread=2)     # 3 ranges of one group (2 x 2 > 3)
+    assert len(done) == 2                                                   # it had finished when it raised
 def test_plain_seas_are_the_scenario_wave_model_driven_by_each_lanes_philox_normals():
     """A plain sea's rows, written lazily env step by env step, equal the scenario machinery's
     sea (seed-free channels of ``realise``, eq-39 filter of the held samples as
@@ -238,10 +306,11 @@ def test_a_diverged_ship_in_the_vector_env_ends_only_its_episode():
     assert not te.any() and np.all(r == 0.0) and np.all(np.abs(o[:, 1]) < 1e-9)
 
 
-def test_an_action_outside_the_space_is_refused_by_the_vector_env_and_changes_nothing():
+@pytest.mark.parametrize("threads", [None, 2])          # 2: ranges [0, 16) and [16, 18), the bad lane in the 2nd
+def test_an_action_outside_the_space_is_refused_by_the_vector_env_and_changes_nothing(threads):
     from steerlab.errors import InputError
 
-    venv = _vec("steerlab/CourseKeeping-v0", n=18)
+    venv = _vec("steerlab/CourseKeeping-v0", n=18, threads=threads)
     core = venv.unwrapped.core
     venv.reset(seed=3)
     venv.step(np.zeros((18, 1), dtype=np.float32))
@@ -252,8 +321,15 @@ def test_an_action_outside_the_space_is_refused_by_the_vector_env_and_changes_no
         with pytest.raises(InputError) as ei:
             venv.step(acts)
         assert ei.value.field == "action" and "[-1, 1]" in str(ei.value)
+        assert repr(float(np.float32(bad))) in str(ei.value)
         assert all(np.array_equal(a, b, equal_nan=True) for a, b in
                    zip(before, (core.X, core.K, core.J, core.W, core.obs, core.rew)))
+    acts = np.zeros((18, 1), dtype=np.float32)
+    acts[3, 0], acts[17, 0] = 1.5, -2.0                       # one bad action in each range: the first named
+    with pytest.raises(InputError) as ei:
+        venv.step(acts)
+    assert "1.5" in str(ei.value) and "-2" not in str(ei.value)
+    assert all(np.array_equal(a, b) for a, b in zip(before, (core.X, core.K, core.J, core.W, core.obs, core.rew)))
     o, *_ = venv.step(np.ones((18, 1), dtype=np.float32))     # the boundary itself is allowed
     assert np.all(np.isfinite(o))
 
@@ -271,6 +347,9 @@ def test_bench_env_script_reports_both_envs(capsys):
     assert mod.main(["--n", "3", "--steps", "4", "--repeats", "1", "--min-time", "0", "--json"]) == 0
     (row,) = json.loads(capsys.readouterr().out)["rows"]
     assert row["n"] == 3 and row["steps"] == 4 and row["control_dt"] == 1.0
+    assert row["threads"] == 1                                # 3 ships: below THREADS_FROM, one call
     for k in ("native_env_steps_per_s", "sync_env_steps_per_s", "native_env_steps_per_cpu_s", "ratio", "ratio_cpu"):
         assert row[k] > 0
     assert row["ratio"] == pytest.approx(row["native_env_steps_per_s"] / row["sync_env_steps_per_s"])
+    assert mod.main(["--threads", "0"]) == 2
+    assert "--threads must be in [1, " in capsys.readouterr().err

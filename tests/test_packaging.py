@@ -32,6 +32,12 @@ def test_changelog_covers_the_current_version():
     assert f"## [{version}]" in log
 
 
+def test_the_rl_extra_installs_gymnasium_and_gym_is_its_alias():
+    extras = PROJECT["project"]["optional-dependencies"]
+    assert extras["rl"] == ["gymnasium>=1.0"]               # what steerlab.gym's import error names
+    assert extras["gym"] == extras["rl"]
+
+
 def test_py_typed_marker_is_shipped():
     assert (REPO / "src" / "steerlab" / "py.typed").exists()
     assert "py.typed" in PROJECT["tool"]["setuptools"]["package-data"]["steerlab"]

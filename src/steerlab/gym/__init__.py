@@ -1,4 +1,5 @@
-r"""Gymnasium environments on steerlab ships (optional extra ``steerlab[gym]``).
+r"""Gymnasium environments on steerlab ships (optional extra ``steerlab[rl]``,
+``pip install 'steerlab[rl]'``; ``steerlab[gym]`` is the same).
 
 ``import steerlab.gym`` registers (all keyword arguments of
 :class:`steerlab.gym.episodes.Episodes` pass through ``gymnasium.make``)::
@@ -20,7 +21,10 @@ IDS = {"steerlab/CourseKeeping-v0": "course_keeping", "steerlab/CourseChange-v0"
 
 def register_envs() -> None:
     """Register the ids with gymnasium (idempotent)."""
-    import gymnasium
+    try:
+        import gymnasium
+    except ImportError as err:
+        raise ImportError("steerlab.gym needs gymnasium: pip install 'steerlab[rl]'") from err
 
     for env_id, task in IDS.items():
         if env_id in gymnasium.registry:

@@ -143,24 +143,26 @@ def lane_stepper(ship_rhs, guide):
 
 @lru_cache(maxsize=None)
 def vector_stepper(ship_rhs, guide, nx: int):
-    """The native vector environment's whole step, one compiled call:
-    ``step(A, redo, X, K, J, cmd, W, w_index, PS, PG, dt, nc, gd, GZ, REF, rpm_slot, lam, reward, obs, rew, bad,
-    term, trunc, n_env_steps, dmax, lazy, S, Z, base, hold, fb, fa, ch, KEY, EP, scale, offset_max, x0, ps0, gz0,
-    ref0, auto) -> int``.
+    """The native vector environment's whole step of lanes ``lo .. hi - 1``, one compiled call:
+    ``step(lo, hi, A, redo, X, K, J, cmd, W, w_index, PS, PG, dt, nc, gd, GZ, REF, rpm_slot, lam, reward, obs,
+    rew, bad, term, trunc, n_env_steps, dmax, lazy, S, Z, base, hold, fb, fa, ch, KEY, EP, scale, offset_max, x0,
+    ps0, gz0, ref0, auto) -> int``.
 
     ``A`` (N,) actions, ``redo`` (N,) the lanes whose episode ended at the previous step
     (gymnasium's ``NEXT_STEP`` autoreset: their action is ignored). First every other lane's
-    action is checked to be in [-1, 1]: the index of the first one that is not is returned
-    (nothing changed; -1 if all are). Those lanes get the order ``A[i] dmax`` [rad], their
-    disturbance rows (with ``lazy``, as :func:`lane_stepper`) and ``nc`` plant steps through
-    the ship driver's ``step_lanes`` (groups of ``LANES`` ships, structure of arrays,
+    action in the range is checked to be in [-1, 1] (:func:`first_refused`): the index of the
+    first one that is not is returned (nothing changed; -1 if all are). Those lanes get the
+    order ``A[i] dmax`` [rad], their disturbance rows (with ``lazy``, as :func:`lane_stepper`)
+    and ``nc`` plant steps through the ship driver's ``step_lanes`` (groups of ``LANES`` ships, structure of arrays,
     vectorised RK4 stages), then :func:`finisher`; ``term`` = diverged, ``trunc`` = the
     episode's ``n_env_steps`` done. With ``auto`` (seas that need no per-lane scenario
     machinery) the ``redo`` lanes are reset here (:func:`lane_resetter`: ``KEY``, ``EP``, ``scale``, ``offset_max``,
     the design's ``x0``, ``ps0``, ``gz0``, ``ref0``; reward 0, not ended); else the caller
     resets them. Finally ``redo = term | trunc``. Per ship the operations are those of
     :func:`lane_stepper` and :func:`resetter`, so ship i's numbers equal a single
-    environment's, bit for bit.
+    environment's, bit for bit, whatever the range. A call reads and writes only its lanes'
+    rows and releases the GIL: disjoint ranges may run in parallel threads
+    (:meth:`steerlab.gym.episodes.Episodes.step_autoreset` checks all the actions first).
     """
     from steerlab.sim.drivers import driver, entry
     from steerlab.sim.lanes import LANES
@@ -170,16 +172,15 @@ def vector_stepper(ship_rhs, guide, nx: int):
     reset_one = lane_resetter(guide)
 
     @numba.njit(nogil=True)
-    def step(A, redo, X, K, J, cmd, W, w_index, PS, PG, dt, nc, gd, GZ, REF, rpm_slot, lam, reward, obs, rew, bad,
-             term, trunc, n_env_steps, dmax, lazy, S, Z, base, hold, fb, fa, ch, KEY, EP, scale, offset_max, x0,
-             ps0, gz0, ref0, auto):
-        n = X.shape[0]
-        for i in range(n):
-            if not redo[i] and not abs(A[i]) <= 1.0:      # NaN fails the comparison too
-                return i
-        idx = np.empty(n, dtype=np.int64)
+    def step(lo, hi, A, redo, X, K, J, cmd, W, w_index, PS, PG, dt, nc, gd, GZ, REF, rpm_slot, lam, reward, obs,
+             rew, bad, term, trunc, n_env_steps, dmax, lazy, S, Z, base, hold, fb, fa, ch, KEY, EP, scale,
+             offset_max, x0, ps0, gz0, ref0, auto):
+        bad_lane = first_refused(A, redo, lo, hi)
+        if bad_lane >= 0:
+            return bad_lane
+        idx = np.empty(hi - lo, dtype=np.int64)
         m = 0
-        for i in range(n):
+        for i in range(lo, hi):
             if not redo[i]:
                 idx[m] = i
                 m += 1
@@ -193,7 +194,7 @@ def vector_stepper(ship_rhs, guide, nx: int):
             finish(i, X, K, J, dt, nc, gd, GZ, REF, PS, rpm_slot, lam, reward, obs, rew, bad)
             term[i] = bad[i]
             trunc[i] = J[i] >= n_env_steps and not bad[i]
-        for i in range(n):
+        for i in range(lo, hi):
             if redo[i]:
                 if auto:
                     reset_one(i, KEY, EP, S, Z, scale, offset_max, X, K, J, cmd, PS, GZ, REF, x0, ps0, gz0, ref0,
@@ -205,6 +206,16 @@ def vector_stepper(ship_rhs, guide, nx: int):
         return -1
 
     return step
+
+
+@numba.njit(nogil=True)
+def first_refused(A, redo, lo, hi):
+    """The first lane ``i`` of ``lo .. hi - 1`` not in ``redo`` whose action ``A[i]`` is not in
+    [-1, 1] (NaN included); -1 if there is none."""
+    for i in range(lo, hi):
+        if not redo[i] and not abs(A[i]) <= 1.0:      # NaN fails the comparison too
+            return i
+    return -1
 
 
 @lru_cache(maxsize=None)
@@ -244,10 +255,11 @@ def lane_resetter(guide):
 def resetter(guide):
     """``reset(idx, KEY, EP, S, Z, scale, offset_max, X, K, J, cmd, PS, GZ, REF, x0, ps, gz0, ref0, gd, h_env,
     rpm_slot, obs, rew, bad, sea_seeds)``: :func:`lane_resetter` for the lanes ``idx``, their
-    sea seeds into ``sea_seeds``; one compiled call for all of them."""
+    sea seeds into ``sea_seeds``; one compiled call for all of them. It releases the GIL:
+    calls on disjoint lanes may run in parallel threads (:meth:`steerlab.gym.episodes.Episodes.reset_lanes`)."""
     reset_one = lane_resetter(guide)
 
-    @numba.njit
+    @numba.njit(nogil=True)
     def reset(idx, KEY, EP, S, Z, scale, offset_max, X, K, J, cmd, PS, GZ, REF, x0, ps, gz0, ref0, gd, h_env,
               rpm_slot, obs, rew, bad, sea_seeds):
         for q in range(idx.shape[0]):
