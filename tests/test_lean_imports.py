@@ -67,3 +67,13 @@ def test_numbas_blas_probe_skips_the_scipy_linalg_import_and_blas_still_works():
     out = subprocess.run([sys.executable, "-c", BLAS_SCRIPT], capture_output=True, text=True, timeout=300)
     assert out.returncode == 0, out.stderr
     assert out.stdout.strip() == "ok"
+
+
+def test_dir_of_steerlab_offers_the_api_and_not_its_typing_helpers():
+    """Tab completion on ``sl.`` shows the lazy API names (not yet imported) and no helper the
+    package module imports for itself."""
+    import steerlab
+
+    names = dir(steerlab)
+    assert set(steerlab.__all__) <= set(names)
+    assert not {"Any", "TYPE_CHECKING", "annotations", "importlib"} & set(names)

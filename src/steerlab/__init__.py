@@ -73,8 +73,12 @@ def __getattr__(name: str) -> Any:
     return value
 
 
+_NOT_API = {"Any", "TYPE_CHECKING", "annotations", "importlib"}
+"""Names this module needs but does not offer (left out of ``dir(steerlab)``, i.e. tab completion)."""
+
+
 def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(_LAZY))
+    return sorted((set(globals()) | set(_LAZY)) - _NOT_API)
 
 
 __all__ = ["InputError", "wrap_to_pi", *_LAZY]
