@@ -90,15 +90,6 @@ def scenario():
     return make_scenario
 
 
-# ---------------------------------------------------------------- long files first
-def pytest_collection_modifyitems(config, items):
-    """The files with a ``slow`` test first, each file's tests in their order (a stable sort):
-    pytest-xdist then starts the long files at once, instead of one worker finishing a long
-    file alone at the end of the run while the other waits."""
-    slow_files = {item.path for item in items if item.get_closest_marker("slow")}
-    items.sort(key=lambda item: item.path not in slow_files)
-
-
 # ---------------------------------------------------------------- real parts must run in CI
 REAL_PART_FILES = ("test_runtime_browser.py", "test_runtime_browser_rebinding.py", "test_signalk_plugin.py")
 """Tests of real parts (Debian's chromium, a real signalk-server, its NMEA 0183 parser, node).
