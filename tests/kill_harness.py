@@ -169,11 +169,13 @@ class Case:
         shutil.copytree(self.template, self.out)
         proc = subprocess.Popen(argv(self.command, self.scen[2], self.out), env=_env(),
                                 stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-        time.sleep(delay)
-        finished = proc.poll() is not None
-        if not finished:
+        try:                                      # kill at ``delay`` unless it finished before
+            proc.wait(timeout=delay)
+            finished = True
+        except subprocess.TimeoutExpired:
+            finished = False
             os.kill(proc.pid, signal.SIGKILL)
-        proc.wait()
+            proc.wait()
         left = self.leftovers()
         before = self.state()
         prepare_out(self.out)                     # what the next command writing here does first

@@ -55,10 +55,23 @@ def _result(p):
     return json.loads(out.strip().splitlines()[-1])
 
 
-def test_a_fresh_process_loads_the_compiled_loop_instead_of_compiling(tmp_path):
-    first = _run(tmp_path)
+@pytest.fixture(scope="module")
+def compiled_once(tmp_path_factory):
+    """``(cache, result)``: the first process's run on an empty cache (it compiles and saves the
+    loop), shared by the tests that start from that cache (each on its own copy of it)."""
+    cache = tmp_path_factory.mktemp("compiled-once")
+    return cache, _run(cache)
+
+
+def _copy(cache: Path, to: Path) -> Path:
+    shutil.copytree(cache, to)
+    return to
+
+
+def test_a_fresh_process_loads_the_compiled_loop_instead_of_compiling(compiled_once, tmp_path):
+    cache, first = compiled_once
     assert first["cached"] and first["misses"] == 1 and first["hits"] == 0      # compiled, saved
-    second = _run(tmp_path)
+    second = _run(_copy(cache, tmp_path / "cache"))
     assert second["misses"] == 0 and second["hits"] == 1                         # loaded
     assert second["last"] == first["last"]                                        # same bits
 
@@ -71,16 +84,17 @@ def test_two_processes_compiling_the_same_combination_at_once_both_succeed(tmp_p
     assert third["hits"] == 1 and third["last"] == a["last"]
 
 
-def test_truncated_cache_files_are_detected_and_rebuilt(tmp_path):
-    ref = _run(tmp_path)
-    files = [f for f in tmp_path.rglob("*") if f.suffix in (".nbi", ".nbc", ".py")]
+def test_truncated_cache_files_are_detected_and_rebuilt(compiled_once, tmp_path):
+    cache, ref = compiled_once
+    cache = _copy(cache, tmp_path / "cache")
+    files = [f for f in cache.rglob("*") if f.suffix in (".nbi", ".nbc", ".py")]
     assert any(f.suffix == ".nbc" for f in files)
     for f in files:                                   # truncate every entry, the module too
         data = f.read_bytes()
         f.write_bytes(data[: len(data) // 3])
-    again = _run(tmp_path)
+    again = _run(cache)
     assert again["last"] == ref["last"] and again["misses"] == 1                 # rebuilt, no crash
-    assert _run(tmp_path)["hits"] == 1                                           # and cached again
+    assert _run(cache)["hits"] == 1                                              # and cached again
 
 
 @pytest.mark.slow
