@@ -11,6 +11,8 @@ loopback ports; an autopilot gets a ship server of its own). It must exit with 0
 
 from __future__ import annotations
 
+import contextlib
+import io
 import re
 import shlex
 import shutil
@@ -255,11 +257,20 @@ def workdir(tmp_path_factory):
 
 
 def _same_run(argv) -> tuple:
-    """What a command runs, as tested: its smaller form (:func:`_smaller`), any ``--out`` folder."""
+    """What a command runs, as tested: its smaller form (:func:`_smaller`) with any ``--out``
+    folder, as steerlab's own parser reads it (so the order of the options does not matter);
+    the words themselves where the parser refuses them (that refusal is then what is tested)."""
+    from steerlab.cli import build_parser
+
     run = _smaller(argv)
     if "--out" in run:
         run = _set(run, "--out", "OUT")
-    return tuple(run)
+    try:
+        with contextlib.redirect_stderr(io.StringIO()):
+            parsed = vars(build_parser().parse_args([str(a) for a in run]))
+    except SystemExit:
+        return tuple(run)
+    return tuple(sorted((k, repr(v)) for k, v in parsed.items()))
 
 
 def all_examples():
