@@ -100,3 +100,13 @@ def test_kernels_that_cannot_be_named_step_and_reset_from_an_in_memory_module(tm
         np.testing.assert_array_equal(a.rew, b.rew)
         assert (flags[0][0] == flags[1][0]).all()
         assert flags[0][0].all() == (k == 3)          # all episodes end at the 4th step, reset at the 5th
+
+
+def test_cache_warm_gym_leaves_the_default_envs_step_and_reset_on_disk(tmp_path):
+    env = {**os.environ, "STEERLAB_CACHE_DIR": str(tmp_path), "PYTHONPATH": str(SRC)}
+    env.pop("STEERLAB_DRIVER_CACHE", None)
+    p = subprocess.run([sys.executable, "-m", "steerlab", "cache", "warm", "--ships", "esso", "--controllers",
+                        "pid", "--gym", "--quiet"], env=env, capture_output=True, text=True, timeout=900)
+    assert p.returncode == 0, p.stderr
+    after = _run(tmp_path)
+    assert after["stats"] == {"step": [1, 0], "step_serial": [1, 0], "reset": [1, 0]} and after["compiles"] == 0
