@@ -64,7 +64,7 @@ def test_a_fresh_process_loads_the_env_step_and_reset_and_compiles_nothing(tmp_p
 def test_kernels_that_cannot_be_named_step_and_reset_from_an_in_memory_module(tmp_path, monkeypatch):
     """A ship kernel made in a closure (no importable name) gets the environment's step and reset
     compiled in the process, with the same numbers as the named kernel's cached module."""
-    import numba
+    from conftest import unnamed_ship
 
     from steerlab import kernel_refs
     from steerlab.gym.episodes import Episodes
@@ -73,16 +73,7 @@ def test_kernels_that_cannot_be_named_step_and_reset_from_an_in_memory_module(tm
     monkeypatch.setenv("STEERLAB_CACHE_DIR", str(tmp_path))
     a = Episodes(20, episode_s=4.0, vectorised=True)
     b = Episodes(20, episode_s=4.0, vectorised=True)
-
-    def make():
-        inner = a.ship_spec.rhs
-
-        @numba.njit
-        def closure_rhs(t, x, delta, w, ps, dx):
-            inner(t, x, delta, w, ps, dx)
-        return closure_rhs
-
-    rhs = make()
+    rhs = unnamed_ship(a.ship_spec.rhs)
     assert kernel_refs.kernel_ref(rhs) is None
     named = env_kernels(a.ship_spec.rhs, a.guide, a.X.shape[1])
     mem = env_kernels(rhs, b.guide, b.X.shape[1])

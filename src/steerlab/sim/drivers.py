@@ -240,6 +240,17 @@ def _cache_files(dispatcher) -> tuple[Optional[str], list[str]]:
         return None, []
 
 
+def cached_signatures(dispatcher) -> list:
+    """The signatures whose machine code numba's disk cache holds for ``dispatcher`` (numba
+    internals, guarded: [] if unreadable). A caller loaded from the cache (e.g. the Gymnasium
+    environment's step, :mod:`steerlab.gym.env_template`) links the code of the entry points it
+    calls without loading them, so their ``signatures`` stay empty in that process."""
+    try:
+        return [key[0] for key in dispatcher._cache._cache_file._load_index()]
+    except Exception:  # noqa: BLE001 - numba internals or an unreadable index: none known
+        return []
+
+
 def _check_cache_files(dispatcher) -> bool:
     """Read back the dispatcher's cache files; delete them all if one is unreadable.
 
