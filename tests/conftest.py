@@ -75,6 +75,17 @@ def batch_parity_and_vectorisation(setup):
     return single, batch.final_states, vectorisation_report(setup.ship.rhs, setup.controller.update, setup.x0.size)
 
 
+def unnamed_ship(rhs):
+    """A ship kernel that calls ``rhs`` from a closure: the same numbers, but no importable name
+    (:func:`steerlab.kernel_refs.kernel_ref` gives None), so drivers are built in memory."""
+    import numba
+
+    @numba.njit
+    def closure_rhs(t, x, delta, w, ps, dx):
+        rhs(t, x, delta, w, ps, dx)
+    return closure_rhs
+
+
 def make_scenario_dict(**over) -> dict:
     """The base dict with top-level / nested overrides (``controller`` is replaced whole)."""
     return _merge(BASE, over)

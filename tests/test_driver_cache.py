@@ -129,9 +129,7 @@ def test_wrapped_kernels_have_references_that_resolve_to_themselves():
 def test_kernels_that_cannot_be_named_run_from_an_in_memory_driver(tmp_path, monkeypatch):
     """A ship kernel made in a closure (no importable name) still runs, compiled in the process,
     and gives the same numbers as the named kernel through the cached driver."""
-    import numba
-
-    from conftest import make_scenario
+    from conftest import make_scenario, unnamed_ship
 
     from steerlab.sim import drivers
     from steerlab.sim.engine import simulate
@@ -139,16 +137,7 @@ def test_kernels_that_cannot_be_named_run_from_an_in_memory_driver(tmp_path, mon
 
     monkeypatch.setenv("STEERLAB_CACHE_DIR", str(tmp_path))
     setup = build(make_scenario(duration=30.0, ship={"model": "nomoto1", "speed_kn": 10.0}))
-
-    def make():
-        inner = setup.ship.rhs
-
-        @numba.njit
-        def closure_rhs(t, x, delta, w, ps, dx):
-            inner(t, x, delta, w, ps, dx)
-        return closure_rhs
-
-    rhs = make()
+    rhs = unnamed_ship(setup.ship.rhs)
     assert kernel_refs.kernel_ref(rhs) is None
     d = drivers.driver(rhs, setup.controller.update, None, setup.x0.shape[0])
     assert d._steerlab_cached is False

@@ -16,6 +16,7 @@ EXAMPLES = """examples:
   steerlab cache warm                 # compile the common catalogue pairs (progress bar)
   steerlab cache warm --ships esso --controllers pid adrc --batch
   steerlab cache warm --ships nomoto1 --controllers all   # every controller on one ship
+  steerlab cache warm --gym           # also the Gymnasium environments' step and reset
   steerlab cache clear --stale        # drop the entries of other steerlab versions
   STEERLAB_CACHE_DIR=/tmp/slc steerlab cache info"""
 
@@ -34,6 +35,8 @@ def register(sub, formatter_class):
     p.add_argument("--controllers", nargs="+", default=list(COMMON_CONTROLLERS), metavar="TYPE",
                    help=f"warm: controller types, or 'all' (default: {' '.join(COMMON_CONTROLLERS)})")
     p.add_argument("--batch", action="store_true", help="warm: also the batch engine's loop")
+    p.add_argument("--gym", action="store_true",
+                   help="warm: also the Gymnasium environments' step and reset (Esso, every task)")
     p.add_argument("--json", action="store_true", help="info: print JSON")
     p.add_argument("--quiet", action="store_true")
     p.set_defaults(func=run)
@@ -74,7 +77,7 @@ def _warm(args) -> int:
     from steerlab.control.registry import get_controller
     from steerlab.ships.registry import get_ship
     from steerlab.sim import drivers
-    from steerlab.sim.warm import warm_pair
+    from steerlab.sim.warm import warm_gym, warm_pair
 
     from steerlab.control.registry import CONTROLLERS
     from steerlab.ships.registry import SHIPS
@@ -95,6 +98,8 @@ def _warm(args) -> int:
         if status != "ok":
             say(f"{s} + {c}: {status}")
         report(i + 1, len(pairs))
+    if args.gym:
+        warm_gym()
     if not args.quiet:
         print(f"warm: {len(pairs)} combination(s) compiled or already cached in "
               f"{drivers.drivers_dir()}", file=sys.stderr)

@@ -22,7 +22,7 @@ is the sea ``steerlab run`` gives that seed.
 ``vectorised=True`` (the native vector environment) advances the ships with the batch
 engine's vectorised groups and does the whole step - actions checked, autoresets, plants,
 guidance, observations, rewards - in one compiled call
-(:func:`steerlab.gym.plant_batch.vector_stepper`, :meth:`Episodes.step_autoreset`), spread
+(``step`` of :func:`steerlab.gym.plant_batch.env_kernels`, :meth:`Episodes.step_autoreset`), spread
 over the threads from :data:`THREADS_FROM` ships on; the single environment steps its ship
 with the scalar kernel; the numbers are the same.
 """
@@ -42,7 +42,6 @@ from steerlab.environment.iir_filter import _padded
 from steerlab.environment.waves import _hold, band_pass_eq39
 
 from steerlab.errors import InputError, require_finite_range
-from steerlab.gym.plant_batch import first_refused
 from steerlab.sim.lanes import LANES, _share_ranges as share_ranges
 from steerlab.units import rad
 from steerlab.ships.state import IPSI
@@ -95,7 +94,7 @@ class Episodes:
                  change_deg: float = 20.0, change_t: float = 10.0, guidance: Optional[Mapping[str, Any]] = None,
                  reward: str = "speed_loss", vectorised: bool = False) -> None:
         from steerlab.environment.sea import uses_sea
-        from steerlab.gym.plant_batch import REWARDS, lane_stepper, resetter, vector_stepper
+        from steerlab.gym.plant_batch import REWARDS, env_kernels
         from steerlab.guidance.reference_models import course_guide
         from steerlab.guidance.reference_vector import initial_reference
         from steerlab.sim.setup import design, realise
@@ -152,11 +151,15 @@ class Episodes:
         # the vectorised step of at least threads_from lanes runs on `threads` threads (None: numba's
         # number, numba.get_num_threads(), read at each step); the numbers do not depend on either
         self.threads_from, self.threads = THREADS_FROM, None
+        from steerlab.sim.drivers import entry
+
+        kernels = env_kernels(s0.ship.rhs, self.guide, nx)      # compiled once ever (disk cache)
         if self.vectorised:
-            self._vstep = vector_stepper(s0.ship.rhs, self.guide, nx)
+            self._vstep = entry(kernels, "step")
+            self._first_refused = kernels.first_refused
         else:
-            self._step = lane_stepper(s0.ship.rhs, self.guide)
-        self._reset = resetter(self.guide)
+            self._step = entry(kernels, "step_serial")
+        self._reset = entry(kernels, "reset")
         self._x0, self._ps0, self._ref0 = s0.x0, s0.ps, initial_reference()
         # per lane: its key (the reset seed), its next episode number (steerlab.gym.lane_seas)
         self.KEY = np.zeros((n, 2), dtype=np.uint64)
@@ -260,7 +263,7 @@ class Episodes:
         return self.obs, self.rew, self.bad.copy(), truncated & ~self.bad
 
     def step_autoreset(self, actions: ArrayLike, redo: np.ndarray, term: np.ndarray, trunc: np.ndarray) -> None:
-        """The vector environment's step (:func:`steerlab.gym.plant_batch.vector_stepper`): the
+        """The vector environment's step (``step`` of :func:`steerlab.gym.plant_batch.env_kernels`): the
         lanes not in ``redo`` (N,) bool advance with ``actions`` (N,) in [-1, 1], the ``redo``
         lanes reset to their next episode (action ignored, reward 0); fills ``obs``, ``rew``,
         ``term``, ``trunc`` and sets ``redo = term | trunc``. One compiled call for all lanes;
@@ -278,7 +281,7 @@ class Episodes:
         if threads <= 1:
             i = self._vstep(0, self.n, *args)
         else:                                              # every action checked before any lane moves
-            i = first_refused(a, redo, 0, self.n)
+            i = self._first_refused(a, redo, 0, self.n)
             if i < 0:
                 share_ranges(lambda lo, hi: self._vstep(lo, hi, *args), self.n, LANES, threads)
         if i >= 0:

@@ -1,16 +1,19 @@
 r"""Compiled calls that advance N ships (same model) by one environment step each.
 
 Each plant takes ``nc`` classic RK4 steps of ship + steering gear with its rudder order held,
-at the engine's times ``t = k dt``; then (:func:`finisher`) the scenario's guidance kernel
+at the engine's times ``t = k dt``; then (``finish``) the scenario's guidance kernel
 gives the new reference and the observation and the reward of the lane are computed by
-scalar code. Two schedules of the same operations:
+scalar code. Two schedules of the same operations, the entry points of the combination's
+module (:func:`env_kernels`, from :mod:`steerlab.gym.env_template`, compiled once ever and
+cached on disk like the engines' drivers, :mod:`steerlab.sim.drivers`):
 
-* :func:`lane_stepper` (the single environment): one plant after the other through the
+* ``step_serial`` (the single environment): one plant after the other through the
   engines' scalar step (:func:`steerlab.sim.kernels.plant_step`);
-* :func:`vector_stepper` (the native vector environment): the ship driver's ``step_lanes``
+* ``step`` (the native vector environment): the ship driver's ``step_lanes``
   (:mod:`steerlab.sim.driver_template`), the batch engine's structure-of-arrays groups of
   ``LANES`` ships with every RK4 stage vectorised across the group, inside one compiled call
-  that also checks the actions and does the autoresets (:func:`lane_resetter`).
+  that also checks the actions and does the autoresets (``reset_one``; ``reset`` for lanes
+  reset from Python).
 
 Both write a plain sea's disturbance rows of the step first
 (:func:`steerlab.gym.lane_seas.fill_rows`).
@@ -32,16 +35,8 @@ rate ``r`` [rad/s], rudder angle ``delta`` [rad]. Rewards (after the step, e and
 from __future__ import annotations
 
 import math
-from functools import lru_cache
-
-import numba
-import numpy as np
-
-from steerlab.angles import wrap_to_pi
-from steerlab.guidance.reference_vector import REF_PSI, REF_RPM
-from steerlab.gym.lane_seas import draw_episode, fill_rows
-from steerlab.sim.kernels import plant_step
-from steerlab.ships.state import IPSI, IR
+import types
+from pathlib import Path
 
 
 REWARDS = ("speed_loss", "itae", "iae")
@@ -49,229 +44,16 @@ REWARD_SPEED_LOSS, REWARD_ITAE, REWARD_IAE = 0, 1, 2
 R_MAX = math.pi   #: |r| [rad/s] beyond which a ship counts as diverged (180 deg/s; the observation bound)
 
 
-@lru_cache(maxsize=None)
-def finisher(guide):
-    """``finish(i, X, K, J, dt, nc, gd, GZ, REF, PS, rpm_slot, lam, reward, obs, rew, bad)``:
-    the end of lane ``i``'s env step, after its plant steps (compiled like the engines' fused
-    kernels, :func:`steerlab.sim.kernels._fused`, and inlined into its callers).
-
-    Counts the env step (``J[i]``), flags a diverged ship (a non-finite state or
-    ``|r| > R_MAX``: ``bad[i]``, observation and reward 0), else runs the guidance kernel
-    ``guide(t, x, gd, gz, ref, h)`` at ``t = K[i] dt`` (the engines' one, e.g. the time-only
-    course schedule or LOS; as in the engines a propeller-rate order ``ref[REF_RPM] >= 0``
-    goes to ``PS[i, rpm_slot]`` when ``rpm_slot >= 0``) and writes the observation and the
-    reward (``reward`` selects the criterion, :data:`REWARDS`; ``lam`` its rudder weight).
-    """
-
-    from steerlab.sim.kernels import _fused, _jit_fused
-
-    g = _fused(guide)          # inlined, no reference counting: as the engines' loops call it
-    wrap = _fused(wrap_to_pi)
-
-    @_jit_fused
-    def finish(i, X, K, J, dt, nc, gd, GZ, REF, PS, rpm_slot, lam, reward, obs, rew, bad):
-        x = X[i]
-        nx = x.shape[0]
-        h_env = nc * dt
-        J[i] += 1
-        ok = True
-        for q in range(nx):
-            if not np.isfinite(x[q]):
-                ok = False
-        if not abs(x[IR]) <= R_MAX:
-            ok = False
-        bad[i] = not ok
-        if ok:
-            ref = REF[i]
-            g(K[i] * dt, x, gd, GZ[i], ref, h_env)
-            if rpm_slot >= 0 and ref[REF_RPM] >= 0.0:
-                PS[i, rpm_slot] = ref[REF_RPM]
-            e = wrap(ref[REF_PSI] - x[IPSI])
-            d = x[nx - 1]
-            obs[i, 0] = e
-            obs[i, 1] = x[IR]
-            obs[i, 2] = d
-            if reward == REWARD_SPEED_LOSS:
-                rew[i] = -(e * e + lam * d * d) * h_env
-            elif reward == REWARD_ITAE:
-                rew[i] = -(K[i] * dt) * abs(e) * h_env
-            else:
-                rew[i] = -abs(e) * h_env
-        else:
-            obs[i, 0] = 0.0
-            obs[i, 1] = 0.0
-            obs[i, 2] = 0.0
-            rew[i] = 0.0
-
-    return finish
+TEMPLATE = Path(__file__).with_name("env_template.py")
 
 
-@lru_cache(maxsize=None)
-def lane_stepper(ship_rhs, guide):
-    """``step_lanes(X, K, J, cmd, W, PS, PG, dt, nc, gd, GZ, REF, rpm_slot, lam, reward, active, obs, rew, bad,
-    work, lazy, S, Z, base, hold, fb, fa, ch)``, one plant after the other (the single environment).
-
-    ``X`` (N, nx) plant states, ``K`` (N,) plant-step counters, ``J`` (N,) env-step counters,
-    ``cmd`` (N,) rudder orders [rad], ``W`` (N, n_steps + 1, channels) disturbances, ``PS``,
-    ``PG`` packed ship and gear records, ``gd`` the guidance record, ``GZ`` (N, n_gz) guidance
-    states and ``REF`` (N, N_REF) reference vectors (advanced in place); ``active`` (N,) lanes
-    to step; writes ``obs`` (N, 3), ``rew`` (N,), ``bad`` (N,) (:func:`finisher`). ``work`` is
-    a (5, nx) scratch array. With ``lazy`` the env step's disturbance rows of channel ``ch``
-    are written first (:func:`steerlab.gym.lane_seas.fill_rows`: samples ``S``, filter
-    ``fb/fa`` state ``Z``, seed-free rows ``base``, ``hold`` rows per sample).
-    """
-    rk4_step = plant_step(ship_rhs)
-    finish = finisher(guide)
-
-    @numba.njit
-    def step_lanes(X, K, J, cmd, W, PS, PG, dt, nc, gd, GZ, REF, rpm_slot, lam, reward, active, obs, rew, bad,
-                   work, lazy, S, Z, base, hold, fb, fa, ch):
-        for i in range(X.shape[0]):
-            if not active[i]:
-                continue
-            if lazy:
-                fill_rows(i, K[i], nc, W, S, Z, base, hold, fb, fa, ch)
-            x = X[i]
-            for _ in range(nc):
-                k = K[i]
-                rk4_step(k * dt, x, cmd[i], W[i, k], PS[i], PG[i], dt, work)
-                K[i] = k + 1
-            finish(i, X, K, J, dt, nc, gd, GZ, REF, PS, rpm_slot, lam, reward, obs, rew, bad)
-
-    return step_lanes
-
-
-@lru_cache(maxsize=None)
-def vector_stepper(ship_rhs, guide, nx: int):
-    """The native vector environment's whole step of lanes ``lo .. hi - 1``, one compiled call:
-    ``step(lo, hi, A, redo, X, K, J, cmd, W, w_index, PS, PG, dt, nc, gd, GZ, REF, rpm_slot, lam, reward, obs,
-    rew, bad, term, trunc, n_env_steps, dmax, lazy, S, Z, base, hold, fb, fa, ch, KEY, EP, scale, offset_max, x0,
-    ps0, gz0, ref0, auto) -> int``.
-
-    ``A`` (N,) actions, ``redo`` (N,) the lanes whose episode ended at the previous step
-    (gymnasium's ``NEXT_STEP`` autoreset: their action is ignored). First every other lane's
-    action in the range is checked to be in [-1, 1] (:func:`first_refused`): the index of the
-    first one that is not is returned (nothing changed; -1 if all are). Those lanes get the
-    order ``A[i] dmax`` [rad], their disturbance rows (with ``lazy``, as :func:`lane_stepper`)
-    and ``nc`` plant steps through the ship driver's ``step_lanes`` (groups of ``LANES`` ships, structure of arrays,
-    vectorised RK4 stages), then :func:`finisher`; ``term`` = diverged, ``trunc`` = the
-    episode's ``n_env_steps`` done. With ``auto`` (seas that need no per-lane scenario
-    machinery) the ``redo`` lanes are reset here (:func:`lane_resetter`: ``KEY``, ``EP``, ``scale``, ``offset_max``,
-    the design's ``x0``, ``ps0``, ``gz0``, ``ref0``; reward 0, not ended); else the caller
-    resets them. Finally ``redo = term | trunc``. Per ship the operations are those of
-    :func:`lane_stepper` and :func:`resetter`, so ship i's numbers equal a single
-    environment's, bit for bit, whatever the range. A call reads and writes only its lanes'
-    rows and releases the GIL: disjoint ranges may run in parallel threads
-    (:meth:`steerlab.gym.episodes.Episodes.step_autoreset` checks all the actions first).
-    """
-    from steerlab.sim.drivers import driver, entry
+def env_kernels(ship_rhs, guide, nx: int) -> types.ModuleType:
+    """The compiled step and reset of a (ship, guidance kernel, plant size) combination: the
+    module of :mod:`steerlab.gym.env_template` bound to them (memoised; loaded from the
+    driver cache in a fresh process, generated and compiled once otherwise, built in memory
+    for kernels that cannot be named: :func:`steerlab.sim.drivers.driver`). Take its entry
+    points through :func:`steerlab.sim.drivers.entry`."""
+    from steerlab.sim.drivers import driver
     from steerlab.sim.lanes import LANES
 
-    plants = entry(driver(ship_rhs, None, None, int(nx), LANES), "step_lanes")   # disk-cached
-    finish = finisher(guide)
-    reset_one = lane_resetter(guide)
-
-    @numba.njit(nogil=True)
-    def step(lo, hi, A, redo, X, K, J, cmd, W, w_index, PS, PG, dt, nc, gd, GZ, REF, rpm_slot, lam, reward, obs,
-             rew, bad, term, trunc, n_env_steps, dmax, lazy, S, Z, base, hold, fb, fa, ch, KEY, EP, scale,
-             offset_max, x0, ps0, gz0, ref0, auto):
-        bad_lane = first_refused(A, redo, lo, hi)
-        if bad_lane >= 0:
-            return bad_lane
-        idx = np.empty(hi - lo, dtype=np.int64)
-        m = 0
-        for i in range(lo, hi):
-            if not redo[i]:
-                idx[m] = i
-                m += 1
-                cmd[i] = A[i] * dmax
-                if lazy:
-                    fill_rows(i, K[i], nc, W, S, Z, base, hold, fb, fa, ch)
-        idx = idx[:m]
-        plants(X, K, cmd, W, w_index, PS, PG, idx, dt, nc)
-        for q in range(m):
-            i = idx[q]
-            finish(i, X, K, J, dt, nc, gd, GZ, REF, PS, rpm_slot, lam, reward, obs, rew, bad)
-            term[i] = bad[i]
-            trunc[i] = J[i] >= n_env_steps and not bad[i]
-        for i in range(lo, hi):
-            if redo[i]:
-                if auto:
-                    reset_one(i, KEY, EP, S, Z, scale, offset_max, X, K, J, cmd, PS, GZ, REF, x0, ps0, gz0, ref0,
-                              gd, nc * dt, rpm_slot, obs, rew, bad)
-                rew[i] = 0.0
-                term[i] = False
-                trunc[i] = False
-            redo[i] = term[i] or trunc[i]
-        return -1
-
-    return step
-
-
-@numba.njit(nogil=True)
-def first_refused(A, redo, lo, hi):
-    """The first lane ``i`` of ``lo .. hi - 1`` not in ``redo`` whose action ``A[i]`` is not in
-    [-1, 1] (NaN included); -1 if there is none."""
-    for i in range(lo, hi):
-        if not redo[i] and not abs(A[i]) <= 1.0:      # NaN fails the comparison too
-            return i
-    return -1
-
-
-@lru_cache(maxsize=None)
-def lane_resetter(guide):
-    """``reset_one(i, KEY, EP, S, Z, scale, offset_max, X, K, J, cmd, PS, GZ, REF, x0, ps, gz0, ref0, gd, h_env,
-    rpm_slot, obs, rew, bad) -> sea_seed``: lane ``i``'s next episode
-    (:func:`steerlab.gym.lane_seas.draw_episode`: its samples, filter state, heading offset
-    and sea seed), its plant back to the design's start (``x0`` with the offset [rad] added
-    to the heading, ``ps``, ``gz0``, ``ref0``; counters, order, reward and flag zeroed), its
-    first reference from the guidance kernel at ``t = 0`` (a propeller order to
-    ``PS[i, rpm_slot]`` as in :func:`finisher`) and its observation (:func:`observe`)."""
-
-    @numba.njit(inline="always")
-    def reset_one(i, KEY, EP, S, Z, scale, offset_max, X, K, J, cmd, PS, GZ, REF, x0, ps, gz0, ref0, gd, h_env,
-                  rpm_slot, obs, rew, bad):
-        offset, sea_seed = draw_episode(i, KEY, EP, S, Z, scale, offset_max)
-        X[i, :] = x0
-        X[i, IPSI] += offset
-        K[i] = 0
-        J[i] = 0
-        cmd[i] = 0.0
-        rew[i] = 0.0
-        bad[i] = False
-        PS[i, :] = ps
-        GZ[i, :] = gz0
-        REF[i, :] = ref0
-        guide(0.0, X[i], gd, GZ[i], REF[i], h_env)
-        if rpm_slot >= 0 and REF[i, REF_RPM] >= 0.0:
-            PS[i, rpm_slot] = REF[i, REF_RPM]
-        observe(X[i], REF[i, REF_PSI], obs[i])
-        return sea_seed
-
-    return reset_one
-
-
-@lru_cache(maxsize=None)
-def resetter(guide):
-    """``reset(idx, KEY, EP, S, Z, scale, offset_max, X, K, J, cmd, PS, GZ, REF, x0, ps, gz0, ref0, gd, h_env,
-    rpm_slot, obs, rew, bad, sea_seeds)``: :func:`lane_resetter` for the lanes ``idx``, their
-    sea seeds into ``sea_seeds``; one compiled call for all of them. It releases the GIL:
-    calls on disjoint lanes may run in parallel threads (:meth:`steerlab.gym.episodes.Episodes.reset_lanes`)."""
-    reset_one = lane_resetter(guide)
-
-    @numba.njit(nogil=True)
-    def reset(idx, KEY, EP, S, Z, scale, offset_max, X, K, J, cmd, PS, GZ, REF, x0, ps, gz0, ref0, gd, h_env,
-              rpm_slot, obs, rew, bad, sea_seeds):
-        for q in range(idx.shape[0]):
-            sea_seeds[q] = reset_one(idx[q], KEY, EP, S, Z, scale, offset_max, X, K, J, cmd, PS, GZ, REF, x0, ps,
-                                     gz0, ref0, gd, h_env, rpm_slot, obs, rew, bad)
-
-    return reset
-
-
-@numba.njit
-def observe(x, psi_ref, out):
-    """The observation ``[wrap(psi_ref - psi), r, delta]`` of plant state ``x``."""
-    out[0] = wrap_to_pi(psi_ref - x[IPSI])
-    out[1] = x[IR]
-    out[2] = x[x.shape[0] - 1]
+    return driver(ship_rhs, None, guide, int(nx), LANES, template=TEMPLATE)

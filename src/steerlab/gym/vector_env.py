@@ -4,7 +4,7 @@ r"""The native vector environment: N ships stepped in one compiled call.
 gives a :class:`SteeringVectorEnv`: spaces, reward and episodes as the single
 :class:`~steerlab.gym.env.SteeringEnv` (observations (N, 3), actions (N, 1)), all N ships
 advanced by the batch engine's vectorised groups of ``LANES`` ships in one compiled call
-(:func:`steerlab.gym.plant_batch.vector_stepper`: actions checked, autoresets, plants,
+(``step`` of :func:`steerlab.gym.plant_batch.env_kernels`: actions checked, autoresets, plants,
 guidance, observations and rewards; the single environment steps its ship with the scalar
 kernel, with the same numbers); from 512 ships on (:data:`~steerlab.gym.episodes.THREADS_FROM`)
 the call is split into ranges of whole groups shared by ``numba.get_num_threads()``

@@ -54,6 +54,10 @@ LANES = 16            # runs per batch group
 CACHE = False         # numba disk cache for the entry points
 # ---- end of bindings ----
 
+ENTRY_POINTS = {"run": "closed loop", "group": "batch loop", "rk4_step": "plant step",
+                "replay_rudder": "rudder replay", "step_lanes": "vectorised plant step"}
+"""The compiled entry points and what they are (for :data:`steerlab.sim.drivers.on_compile`)."""
+
 ship = _fused(SHIP_RHS)
 rate = _fused(gear_rate)
 clamp = _fused(gear_clamp)

@@ -55,7 +55,6 @@ from steerlab.numba_cache import _fingerprint
 TEMPLATE = Path(__file__).with_name("driver_template.py")
 BEGIN = "# ---- bindings: replaced in every generated driver ----"
 END = "# ---- end of bindings ----"
-ENTRY_POINTS = ("run", "group", "rk4_step", "replay_rudder", "step_lanes")
 MODULE_PREFIX = "steerlab_driver_"
 
 _LOCK = threading.RLock()
@@ -91,15 +90,19 @@ class _Key:
     guide: object
     nx: int
     lanes: int
+    template: Path = TEMPLATE
 
 
-def driver(ship_rhs, ctrl_update=None, guide=None, nx: int = 0, lanes: int = 16) -> types.ModuleType:
+def driver(ship_rhs, ctrl_update=None, guide=None, nx: int = 0, lanes: int = 16,
+           template: Path = TEMPLATE) -> types.ModuleType:
     """The driver module of a combination (loaded, generated or built in memory; memoised).
 
     ``ctrl_update``/``guide`` may be None for a plant-only driver (``rk4_step``). The module
-    has the kernels of :mod:`steerlab.sim.driver_template` as attributes.
+    has the kernels of ``template`` as attributes: by default :mod:`steerlab.sim.driver_template`;
+    any template with the same bindings block and an ``ENTRY_POINTS`` dict (entry point name:
+    what it is) works the same way (:mod:`steerlab.gym.env_template`).
     """
-    key = _Key(ship_rhs, ctrl_update, guide, int(nx), int(lanes))
+    key = _Key(ship_rhs, ctrl_update, guide, int(nx), int(lanes), Path(template))
     mod = _LOADED.get(key)
     if mod is not None:
         return mod
@@ -119,12 +122,12 @@ def _bindings(refs: dict, nx: int, lanes: int, cache: bool) -> str:
     return "\n".join(lines)
 
 
-def _source(bindings: str) -> str:
-    text = TEMPLATE.read_text(encoding="utf-8")
+def _source(bindings: str, template: Path = TEMPLATE) -> str:
+    text = template.read_text(encoding="utf-8")
     head, _, rest = text.partition(BEGIN)
     _, _, tail = rest.partition(END)
     if not tail:
-        raise RuntimeError(f"{TEMPLATE}: bindings markers missing")
+        raise RuntimeError(f"{template}: bindings markers missing")
     return head + bindings + tail
 
 
@@ -144,7 +147,7 @@ def _make(key: _Key) -> types.ModuleType:
                    for n, k in (("SHIP_RHS", key.ship), ("CTRL_UPDATE", key.ctrl), ("GUIDE", key.guide)))
     if enabled() and nameable:
         try:
-            return _from_disk(key, _source(_bindings(refs, key.nx, key.lanes, True)))
+            return _from_disk(key, _source(_bindings(refs, key.nx, key.lanes, True), key.template))
         except (OSError, ImportError, AttributeError):
             # read-only or full disk, or a plug-in kernel whose module cannot be imported back
             # by name: the same driver, compiled in memory
@@ -171,12 +174,13 @@ def in_memory_twin(ship_rhs, ctrl_update=None, guide=None, nx: int = 0, lanes: i
 def _in_memory(key: _Key) -> types.ModuleType:
     """The driver built in this process only (kernels passed as objects, no disk cache)."""
     text = _source("\n".join([BEGIN, "SHIP_RHS = CTRL_UPDATE = GUIDE = None",
-                              f"NX = {key.nx}", f"LANES = {key.lanes}", "CACHE = False", END]))
+                              f"NX = {key.nx}", f"LANES = {key.lanes}", "CACHE = False", END]),
+                   key.template)
     # bind the kernels as objects: replace the placeholder line before executing
     mod = types.ModuleType(f"{MODULE_PREFIX}mem_{id(key):x}")
-    mod.__file__ = str(TEMPLATE)
+    mod.__file__ = str(key.template)
     code = compile(text.replace("SHIP_RHS = CTRL_UPDATE = GUIDE = None",
-                                "SHIP_RHS, CTRL_UPDATE, GUIDE = _KERNELS"), str(TEMPLATE), "exec")
+                                "SHIP_RHS, CTRL_UPDATE, GUIDE = _KERNELS"), str(key.template), "exec")
     mod.__dict__["_KERNELS"] = (key.ship, key.ctrl, key.guide)
     sys.modules[mod.__name__] = mod
     exec(code, mod.__dict__)
@@ -218,7 +222,7 @@ def _from_disk(key: _Key, text: str) -> types.ModuleType:
         except BaseException:
             sys.modules.pop(name, None)
             raise
-    for entry in ENTRY_POINTS:
+    for entry in mod.ENTRY_POINTS:
         _check_cache_files(getattr(mod, entry))
     mod._steerlab_cached = True
     mod._steerlab_label = describe_key(key.ship, key.ctrl, key.guide)
@@ -234,6 +238,17 @@ def _cache_files(dispatcher) -> tuple[Optional[str], list[str]]:
         return index, glob.glob(os.path.join(glob.escape(cf._cache_path), pattern))
     except AttributeError:
         return None, []
+
+
+def cached_signatures(dispatcher) -> list:
+    """The signatures whose machine code numba's disk cache holds for ``dispatcher`` (numba
+    internals, guarded: [] if unreadable). A caller loaded from the cache (e.g. the Gymnasium
+    environment's step, :mod:`steerlab.gym.env_template`) links the code of the entry points it
+    calls without loading them, so their ``signatures`` stay empty in that process."""
+    try:
+        return [key[0] for key in dispatcher._cache._cache_file._load_index()]
+    except Exception:  # noqa: BLE001 - numba internals or an unreadable index: none known
+        return []
 
 
 def _check_cache_files(dispatcher) -> bool:
@@ -275,10 +290,7 @@ def entry(mod: types.ModuleType, name: str):
     """``mod.name``, after telling :data:`on_compile` if calling it will compile."""
     disp = getattr(mod, name)
     if on_compile is not None and not disp.signatures and not is_compiled_on_disk(mod, name):
-        what = {"run": "closed loop", "group": "batch loop", "rk4_step": "plant step",
-                "replay_rudder": "rudder replay",
-                "step_lanes": "vectorised plant step"}[name]
-        on_compile(f"steerlab: compiling the {what} for {mod._steerlab_label} "
+        on_compile(f"steerlab: compiling the {mod.ENTRY_POINTS[name]} for {mod._steerlab_label} "
                    f"(first use{'; cached for next time' if mod._steerlab_cached else ''}) ...")
     return disp
 

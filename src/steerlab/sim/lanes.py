@@ -230,7 +230,9 @@ def plant_lanes_report(ship_rhs, nx: int, lanes: int = LANES) -> dict:
     """:func:`vectorisation_report` for the plant-only ``step_lanes`` entry point of a ship
     (the Gymnasium vector environment's N ships, :mod:`steerlab.gym.plant_batch`): 4
     vectorised stages when every RK4 stage runs across the group. Raises ``RuntimeError``
-    if ``step_lanes`` has not been called for this ship, plant size and group size."""
+    if ``step_lanes`` has not been called for this ship, plant size and group size (in this
+    process, or in an earlier one that left it in the driver cache: a vector environment whose
+    step is loaded from the cache runs ``step_lanes`` without loading it)."""
     return _report(ship_rhs, None, None, int(nx), int(lanes), "step_lanes",
                    "step_lanes has not been compiled yet: step a vector environment of this ship first")
 
@@ -240,14 +242,15 @@ def _report(ship_rhs, ctrl_update, guide, nx: int, lanes: int, name: str, not_co
     import struct
 
     from steerlab import sincos as sincos_module
-    from steerlab.sim.drivers import driver, in_memory_twin
+    from steerlab.sim.drivers import cached_signatures, driver, in_memory_twin
 
     disp = getattr(driver(ship_rhs, ctrl_update, guide, nx, lanes), name)
-    if not disp.signatures:
+    sigs = list(disp.signatures) or cached_signatures(disp)
+    if not sigs:
         raise RuntimeError(not_compiled)
-    if any(disp.stats.cache_hits.values()):        # loaded from numba's cache: no IR; compile a twin
-        twin = getattr(in_memory_twin(ship_rhs, ctrl_update, guide, nx, lanes), name)
-        for sig in disp.signatures:
+    if not disp.signatures or any(disp.stats.cache_hits.values()):   # machine code from numba's cache
+        twin = getattr(in_memory_twin(ship_rhs, ctrl_update, guide, nx, lanes), name)   # has no IR: a twin
+        for sig in sigs:
             twin.compile(sig)
         disp = twin
     ir = "\n".join(disp.inspect_llvm().values())

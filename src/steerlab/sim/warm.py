@@ -1,4 +1,5 @@
-"""Compile (or load) the drivers of a (ship, controller) pair ahead of use: ``steerlab cache warm``."""
+"""Compile (or load) the drivers of a (ship, controller) pair, or of the Gymnasium environments,
+ahead of use: ``steerlab cache warm``."""
 
 from __future__ import annotations
 
@@ -42,3 +43,21 @@ def warm_pair(ship_id: str, controller: str, batch: bool = False) -> str:
     if batch:
         simulate_batch([setup, setup])
     return "ok"
+
+
+def warm_gym() -> None:
+    """Step and reset the default Gymnasium environments (the Esso, every task), single and
+    vector, once: their compiled step and reset (:func:`steerlab.gym.plant_batch.env_kernels`)
+    go to the driver cache."""
+    import numpy as np
+
+    from steerlab.gym.episodes import TASKS, Episodes
+
+    for task in TASKS:
+        for vectorised in (False, True):
+            env = Episodes(1, task=task, episode_s=2.0, vectorised=vectorised)
+            env.reset_lanes([0], seeds=[0])
+            if vectorised:
+                env.step_autoreset(np.zeros(1), *(np.zeros(1, dtype=np.bool_) for _ in range(3)))
+            else:
+                env.step(np.zeros(1))

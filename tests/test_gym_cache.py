@@ -1,0 +1,103 @@
+"""The Gymnasium environments' compiled step and reset are compiled once ever (issues 13/14):
+generated from :mod:`steerlab.gym.env_template` into the driver cache like the engines'
+drivers (:mod:`steerlab.sim.drivers`), loaded by a fresh process instead of compiled, with the
+same numbers; kernels that cannot be named get the same module built in memory."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+import textwrap
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+pytest.importorskip("gymnasium")
+
+SRC = Path(__file__).resolve().parent.parent / "src"
+
+SCRIPT = textwrap.dedent("""
+    import json
+    import numpy as np
+    from numba.core import event
+    with event.install_recorder("numba:compile") as rec:     # every numba compile in the process
+        import gymnasium as gym
+        import steerlab.gym
+        from steerlab.gym.plant_batch import env_kernels
+        venv = gym.make_vec("steerlab/CourseKeeping-v0", num_envs=37, vectorization_mode="vector_entry_point",
+                            episode_s=5.0)
+        single = gym.make("steerlab/CourseKeeping-v0", episode_s=5.0)
+        acts = np.random.default_rng(1).uniform(-1, 1, size=(7, 37, 1))
+        vec = [venv.reset(seed=3)[0].tolist()] + [venv.step(a)[0].tolist() for a in acts]   # through an autoreset
+        one = [single.reset(seed=3)[0].tolist()] + [single.step(a[0])[0].tolist() for a in acts[:5]]
+    core = venv.unwrapped.core
+    m = env_kernels(core.ship_spec.rhs, core.guide, core.X.shape[1])
+    stats = {n: [sum(getattr(m, n).stats.cache_hits.values()), sum(getattr(m, n).stats.cache_misses.values())]
+             for n in ("step", "step_serial", "reset")}
+    print(json.dumps({"cached": m._steerlab_cached, "stats": stats, "compiles": len(rec.buffer),
+                      "vec": vec, "one": one}))
+""")
+
+
+def _run(cache: Path) -> dict:
+    env = {**os.environ, "STEERLAB_CACHE_DIR": str(cache), "PYTHONPATH": str(SRC)}
+    env.pop("STEERLAB_DRIVER_CACHE", None)
+    p = subprocess.run([sys.executable, "-c", SCRIPT], env=env, capture_output=True, text=True, timeout=900)
+    assert p.returncode == 0, p.stderr
+    return json.loads(p.stdout.strip().splitlines()[-1])
+
+
+def test_a_fresh_process_loads_the_env_step_and_reset_and_compiles_nothing(tmp_path):
+    first = _run(tmp_path)
+    assert first["cached"] and first["compiles"] > 0
+    assert first["stats"] == {"step": [0, 1], "step_serial": [0, 1], "reset": [0, 1]}     # compiled, saved
+    second = _run(tmp_path)
+    assert second["stats"] == {"step": [1, 0], "step_serial": [1, 0], "reset": [1, 0]}    # loaded
+    assert second["compiles"] == 0                    # nothing else compiled either (plants, guidance, seas)
+    assert second["vec"] == first["vec"] and second["one"] == first["one"]               # same bits
+    assert [v[0] for v in first["vec"][:6]] == first["one"]                              # ship 0 = single env
+
+
+def test_kernels_that_cannot_be_named_step_and_reset_from_an_in_memory_module(tmp_path, monkeypatch):
+    """A ship kernel made in a closure (no importable name) gets the environment's step and reset
+    compiled in the process, with the same numbers as the named kernel's cached module."""
+    from conftest import unnamed_ship
+
+    from steerlab import kernel_refs
+    from steerlab.gym.episodes import Episodes
+    from steerlab.gym.plant_batch import env_kernels
+
+    monkeypatch.setenv("STEERLAB_CACHE_DIR", str(tmp_path))
+    a = Episodes(20, episode_s=4.0, vectorised=True)
+    b = Episodes(20, episode_s=4.0, vectorised=True)
+    rhs = unnamed_ship(a.ship_spec.rhs)
+    assert kernel_refs.kernel_ref(rhs) is None
+    named = env_kernels(a.ship_spec.rhs, a.guide, a.X.shape[1])
+    mem = env_kernels(rhs, b.guide, b.X.shape[1])
+    assert named._steerlab_cached and mem._steerlab_cached is False
+    b._vstep, b._reset = mem.step, mem.reset
+    acts = np.random.default_rng(2).uniform(-1, 1, size=(6, 20))
+    for e in (a, b):
+        e.reset_lanes(np.arange(20), seeds=list(range(20)))
+    np.testing.assert_array_equal(a.obs, b.obs)
+    flags = [tuple(np.zeros(20, dtype=bool) for _ in range(3)) for _ in (a, b)]
+    for k in range(6):                                # through an autoreset (4 steps per episode)
+        for e, (redo, term, trunc) in zip((a, b), flags):
+            e.step_autoreset(acts[k], redo, term, trunc)
+        np.testing.assert_array_equal(a.obs, b.obs)
+        np.testing.assert_array_equal(a.rew, b.rew)
+        assert (flags[0][0] == flags[1][0]).all()
+        assert flags[0][0].all() == (k == 3)          # all episodes end at the 4th step, reset at the 5th
+
+
+def test_cache_warm_gym_leaves_the_default_envs_step_and_reset_on_disk(tmp_path):
+    env = {**os.environ, "STEERLAB_CACHE_DIR": str(tmp_path), "PYTHONPATH": str(SRC)}
+    env.pop("STEERLAB_DRIVER_CACHE", None)
+    p = subprocess.run([sys.executable, "-m", "steerlab", "cache", "warm", "--ships", "esso", "--controllers",
+                        "pid", "--gym", "--quiet"], env=env, capture_output=True, text=True, timeout=900)
+    assert p.returncode == 0, p.stderr
+    after = _run(tmp_path)
+    assert after["stats"] == {"step": [1, 0], "step_serial": [1, 0], "reset": [1, 0]} and after["compiles"] == 0
