@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import copy
 import os
+import time
 from pathlib import Path
 
 import pytest
@@ -149,3 +150,33 @@ def pytest_runtest_logreport(report):
     if path and report.duration >= 0.05 and not os.environ.get("PYTEST_XDIST_WORKER"):
         with open(path, "a", encoding="utf-8") as f:
             f.write(f"{report.duration:.2f} {report.when} {report.nodeid}\n")
+
+
+# ------------------------------------------------------------- compiles, test by test
+class _CompileLog:
+    """numba ``numba:compile`` listener for ``STEERLAB_TEST_COMPILES=FILE``: appends ``seconds
+    worker nodeid function`` for every function numba compiles (not a disk-cache load) while a
+    test runs, so that a suite's compile time can be traced to its tests and combinations
+    compiled by both workers can be found (``sort -k4 FILE``)."""
+
+    def __init__(self, path: str):
+        import numba.core.event as ev
+
+        class Listener(ev.Listener):
+            def on_start(inner, event):
+                inner.t0 = time.perf_counter()
+
+            def on_end(inner, event):
+                disp = event.data.get("dispatcher")
+                name = getattr(getattr(disp, "py_func", None), "__qualname__", "?")
+                module = getattr(getattr(disp, "py_func", None), "__module__", "?")
+                with open(path, "a", encoding="utf-8") as f:
+                    f.write(f"{time.perf_counter() - inner.t0:.2f} {os.environ.get('PYTEST_XDIST_WORKER', '-')} "
+                            f"{os.environ.get('PYTEST_CURRENT_TEST', '-').split(' ')[0]} {module}.{name}\n")
+
+        self.listener = Listener()
+        ev.register("numba:compile", self.listener)
+
+
+if os.environ.get("STEERLAB_TEST_COMPILES"):
+    _COMPILE_LOG = _CompileLog(os.environ["STEERLAB_TEST_COMPILES"])
