@@ -127,10 +127,13 @@ class Case:
         must not survive. ``find_volatile``: run the new command a second time and treat the files
         that differ as volatile (else :data:`VOLATILE`).
         """
-        t0 = time.perf_counter()
-        subprocess.run(argv(self.command, self.scen[2], self.reference), env=_env(), check=True,
-                       capture_output=True, timeout=600)
-        self.run_s = time.perf_counter() - t0
+        times = []
+        for _ in range(2):           # the shorter of two runs: the first may compile, the killed ones do not
+            t0 = time.perf_counter()
+            subprocess.run(argv(self.command, self.scen[2], self.reference), env=_env(), check=True,
+                           capture_output=True, timeout=600)
+            times.append(time.perf_counter() - t0)
+        self.run_s = min(times)
         if real_old:
             subprocess.run(argv(self.command, self.scen[1], self.template), env=_env(), check=True,
                            capture_output=True, timeout=600)
