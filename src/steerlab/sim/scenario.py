@@ -35,7 +35,7 @@ import os
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, Any, Literal, Mapping, Optional
 
-from pydantic import BaseModel, Field, ValidationError, WrapValidator
+from pydantic import BaseModel, Field, PlainValidator, ValidationError
 from pydantic_core import PydanticCustomError
 
 from steerlab.config_base import FrozenConfig
@@ -70,7 +70,7 @@ def _expected_tags() -> str:
     return ", ".join(repr(name) for name in CONTROLLERS)
 
 
-def _controller_config(value: Any, _handler: Any) -> Any:
+def _controller_config(value: Any) -> Any:
     """``[controller]``: validated against the config of the controller its ``type`` names.
 
     The same check as a discriminated union of every registered controller's config (the same
@@ -112,7 +112,7 @@ _MISSING = object()
 if TYPE_CHECKING:      # any registered controller's config (FrozenConfig subclasses)
     ControllerConfig = Any
 else:
-    ControllerConfig = Annotated[Any, WrapValidator(_controller_config)]
+    ControllerConfig = Annotated[Any, PlainValidator(_controller_config)]
 
 
 def _default_controller():
