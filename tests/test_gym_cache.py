@@ -19,7 +19,8 @@ pytest.importorskip("gymnasium")
 
 SRC = Path(__file__).resolve().parent.parent / "src"
 
-SCRIPT = textwrap.dedent("""
+ENTRIES = ("step", "step_serial", "reset", "step_parallel", "reset_parallel")
+SCRIPT = textwrap.dedent(f"""ENTRIES = {ENTRIES!r}""") + textwrap.dedent("""
     import json
     import numpy as np
     from numba.core import event
@@ -33,12 +34,16 @@ SCRIPT = textwrap.dedent("""
         acts = np.random.default_rng(1).uniform(-1, 1, size=(7, 37, 1))
         vec = [venv.reset(seed=3)[0].tolist()] + [venv.step(a)[0].tolist() for a in acts]   # through an autoreset
         one = [single.reset(seed=3)[0].tolist()] + [single.step(a[0])[0].tolist() for a in acts[:5]]
+        par = gym.make_vec("steerlab/CourseKeeping-v0", num_envs=37, vectorization_mode="vector_entry_point",
+                           episode_s=5.0)
+        par.unwrapped.core.threads_from, par.unwrapped.core.threads = 1, 2      # the threaded step and reset
+        pvec = [par.reset(seed=3)[0].tolist()] + [par.step(a)[0].tolist() for a in acts]
     core = venv.unwrapped.core
     m = env_kernels(core.ship_spec.rhs, core.guide, core.X.shape[1])
     stats = {n: [sum(getattr(m, n).stats.cache_hits.values()), sum(getattr(m, n).stats.cache_misses.values())]
-             for n in ("step", "step_serial", "reset")}
+             for n in ENTRIES}
     print(json.dumps({"cached": m._steerlab_cached, "stats": stats, "compiles": len(rec.buffer),
-                      "vec": vec, "one": one}))
+                      "vec": vec, "one": one, "pvec": pvec}))
 """)
 
 
@@ -53,12 +58,13 @@ def _run(cache: Path) -> dict:
 def test_a_fresh_process_loads_the_env_step_and_reset_and_compiles_nothing(tmp_path):
     first = _run(tmp_path)
     assert first["cached"] and first["compiles"] > 0
-    assert first["stats"] == {"step": [0, 1], "step_serial": [0, 1], "reset": [0, 1]}     # compiled, saved
+    assert first["stats"] == {n: [0, 1] for n in ENTRIES}                                # compiled, saved
     second = _run(tmp_path)
-    assert second["stats"] == {"step": [1, 0], "step_serial": [1, 0], "reset": [1, 0]}    # loaded
+    assert second["stats"] == {n: [1, 0] for n in ENTRIES}                               # loaded
     assert second["compiles"] == 0                    # nothing else compiled either (plants, guidance, seas)
     assert second["vec"] == first["vec"] and second["one"] == first["one"]               # same bits
     assert [v[0] for v in first["vec"][:6]] == first["one"]                              # ship 0 = single env
+    assert first["pvec"] == first["vec"]                                                 # threaded: same bits
 
 
 def test_kernels_that_cannot_be_named_step_and_reset_from_an_in_memory_module(tmp_path, monkeypatch):
@@ -100,4 +106,4 @@ def test_cache_warm_gym_leaves_the_default_envs_step_and_reset_on_disk(tmp_path)
                         "pid", "--gym", "--quiet"], env=env, capture_output=True, text=True, timeout=900)
     assert p.returncode == 0, p.stderr
     after = _run(tmp_path)
-    assert after["stats"] == {"step": [1, 0], "step_serial": [1, 0], "reset": [1, 0]} and after["compiles"] == 0
+    assert after["stats"] == {n: [1, 0] for n in ENTRIES} and after["compiles"] == 0

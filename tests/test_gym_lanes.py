@@ -75,8 +75,8 @@ def test_vector_env_same_seed_same_episodes_and_another_seed_another():
 
 @pytest.mark.parametrize("environment", [None, {"waves": True, "wind_speed": 5.0, "gusts": {"speed_std": 1.0}}])
 def test_threaded_steps_give_the_one_call_numbers_whatever_the_thread_count(environment):
-    """The step spread over 1, 2 or 3 threads (ranges of whole groups) gives, bit for bit, the
-    episodes of the one-call step, through autoresets, and the same seed the same episodes; also
+    """The step spread over 1, 2 or 3 ranges of whole groups (on numba's threads, or on one)
+    gives, bit for bit, the episodes of the one-call step, through autoresets, and the same seed the same episodes; also
     with a sea realised lane by lane (gusts: the caller resets those lanes)."""
     n = 2 * LANES + 3
     kw = {"environment": environment} if environment else {}
@@ -84,10 +84,16 @@ def test_threaded_steps_give_the_one_call_numbers_whatever_the_thread_count(envi
     one_call = _vec("steerlab/CourseChange-v0", n=n, **kw)
     assert one_call.unwrapped.core.threads_from > n
     ref = _episodes(one_call, 9, acts)
-    for threads in (1, 2, 3):
+    for threads in (1, 2, 3):             # 2, 3: ranges of the prange (step_parallel, reset_parallel)
         venv = _vec("steerlab/CourseChange-v0", n=n, threads=threads, **kw)
         assert np.array_equal(_episodes(venv, 9, acts), ref), threads
         assert np.array_equal(_episodes(venv, 9, acts), ref), threads
+    cores = numba.get_num_threads()
+    try:
+        numba.set_num_threads(1)          # 2 ranges on one of numba's threads
+        assert np.array_equal(_episodes(_vec("steerlab/CourseChange-v0", n=n, threads=2, **kw), 9, acts), ref)
+    finally:
+        numba.set_num_threads(cores)
     assert not np.array_equal(_episodes(venv, 10, acts), ref)
     lanes = [3, 30] + list(range(5, 25)) + [3]               # a lane twice: reset twice, in order, one call
     for env in (one_call, venv):
@@ -97,43 +103,19 @@ def test_threaded_steps_give_the_one_call_numbers_whatever_the_thread_count(envi
     assert np.array_equal(a.X, b.X) and np.array_equal(a.EP, b.EP) and np.array_equal(a.obs, b.obs)
 
 
-def test_shared_ranges_cover_the_lanes_once_in_whole_groups_and_wait_for_all():
-    import threading
+def test_range_cuts_cover_the_lanes_once_in_whole_groups():
+    from steerlab.sim.lanes import range_cuts
 
-    from steerlab.sim.lanes import _share_ranges
+    for n, lanes, ranges, expect in ((37, LANES, 2, 2), (37, LANES, 3, 3), (37, LANES, 4, 3), (1024, LANES, 2, 2),
+                                     (1024, LANES, 12, 12), (10, LANES, 4, 1), (40, LANES, 1, 1), (5, 1, 8, 5)):
+        cuts = range_cuts(n, lanes, ranges)
+        assert cuts.dtype == np.int64 and cuts.shape == (expect + 1,), (n, ranges)
+        assert cuts[0] == 0 and cuts[-1] == n and (np.diff(cuts) > 0).all()     # contiguous, none empty
+        assert (cuts[:-1] % lanes == 0).all()                                   # whole groups
+        sizes = np.diff(-(-cuts // lanes))                                      # groups per range
+        assert sizes.max() - sizes.min() <= 1                                   # as equal as groups allow
 
-    for n, threads, per_thread, ranges in ((37, 2, 1, 2), (37, 3, 1, 3), (37, 2, 4, 3), (1024, 2, 2, 4),
-                                           (1024, 3, 4, 12), (10, 4, 2, 1), (40, 1, 2, 1)):
-        calls, who = [], set()
 
-        def call(lo, hi):
-            calls.append((lo, hi))
-            who.add(threading.get_ident())
-
-        _share_ranges(call, n, LANES, threads, per_thread)
-        calls.sort()
-        assert len(calls) == ranges and calls[0][0] == 0 and calls[-1][1] == n
-        assert all(a[1] == b[0] for a, b in zip(calls, calls[1:]))            # contiguous, no lane twice
-        assert all(lo % LANES == 0 and hi > lo for lo, hi in calls)            # whole groups
-        assert len(who) <= min(threads, ranges)
-
-    import time
-
-    started, done, release = [], [], threading.Event()
-
-    def fails_in_this_thread(lo, hi):
-        if threading.current_thread() is threading.main_thread():
-            release.wait(10.0)        # the pool thread takes the other ranges meanwhile
-            raise ValueError("boom")
-        started.append(lo)
-        if len(started) == 2:
-            release.set()             # this thread raises while the pool thread is still in its call
-            time.sleep(0.1)
-        done.append((lo, hi))
-
-    with pytest.raises(ValueError, match="boom"):
-        _share_ranges(fails_in_this_thread, 48, LANES, 2, per_thread=2)     # 3 ranges of one group (2 x 2 > 3)
-    assert len(done) == 2                                                   # it had finished when it raised
 def test_plain_seas_are_the_scenario_wave_model_driven_by_each_lanes_philox_normals():
     """A plain sea's rows, written lazily env step by env step, equal the scenario machinery's
     sea (seed-free channels of ``realise``, eq-39 filter of the held samples as

@@ -27,6 +27,10 @@ from steerlab import numba_cache_load  # noqa: F401,E402  (isort: skip)
 from steerlab import numba_blas_probe  # noqa: E402  (isort: skip)
 
 numba_blas_probe.preload()
+# numba's fork-safe threading layer for the parallel entry points, unless the user chose one
+from steerlab import threading_layer  # noqa: E402  (isort: skip)
+
+threading_layer.prefer_fork_safe()
 from steerlab.angles import wrap_to_pi  # noqa: F401
 from steerlab.errors import InputError  # noqa: F401
 

@@ -18,7 +18,10 @@ Entry points:
 * ``step_serial``: the single environment's step, one plant after the other through the
   engines' scalar RK4 step;
 * ``reset``: lanes to their next episodes;
-* ``first_refused``: the first action out of [-1, 1].
+* ``first_refused``: the first action out of [-1, 1];
+* ``step_parallel``, ``reset_parallel``: ``step`` and ``reset`` on contiguous ranges of lanes
+  spread over numba's threads (``parallel=True``, one ``prange`` iteration per range; the
+  threading layer: :mod:`steerlab.threading_layer`).
 
 Per ship ``step`` and ``step_serial`` perform the same IEEE operations in the same order
 (``finish``, ``reset_one``), so ship i of the vector environment equals a single environment
@@ -50,7 +53,9 @@ CACHE = False         # numba disk cache for the entry points
 # ---- end of bindings ----
 
 ENTRY_POINTS = {"step": "vector environment's step", "step_serial": "environment's step",
-                "reset": "environment's reset", "first_refused": "action check"}
+                "reset": "environment's reset", "first_refused": "action check",
+                "step_parallel": "vector environment's threaded step",
+                "reset_parallel": "vector environment's threaded reset"}
 """The compiled entry points and what they are (for :data:`steerlab.sim.drivers.on_compile`)."""
 
 if SHIP_RHS is not None:
@@ -155,8 +160,8 @@ def step(lo, hi, A, redo, X, K, J, cmd, W, w_index, PS, PG, dt, nc, gd, GZ, REF,
     ended); else the caller resets them. Finally ``redo = term | trunc``. Per ship the
     operations are those of :func:`step_serial` and :func:`reset`, so ship i's numbers equal a
     single environment's, bit for bit, whatever the range. A call reads and writes only its
-    lanes' rows and releases the GIL: disjoint ranges may run in parallel threads
-    (:meth:`steerlab.gym.episodes.Episodes.step_autoreset` checks all the actions first).
+    lanes' rows: disjoint ranges may run in parallel threads (:func:`step_parallel`, which checks
+    all the actions first).
     """
     bad_lane = first_refused(A, redo, lo, hi)
     if bad_lane >= 0:
@@ -199,6 +204,42 @@ def first_refused(A, redo, lo, hi):
     return -1
 
 
+@numba.njit(parallel=True, cache=CACHE)
+def step_parallel(cuts, A, redo, X, K, J, cmd, W, w_index, PS, PG, dt, nc, gd, GZ, REF, rpm_slot, lam, reward, obs,
+                  rew, bad, term, trunc, n_env_steps, dmax, lazy, S, Z, base, hold, fb, fa, ch, KEY, EP, scale,
+                  offset_max, x0, ps0, gz0, ref0, auto):
+    """:func:`step` of lanes ``cuts[0] .. cuts[-1] - 1`` in the ranges ``cuts[j] .. cuts[j + 1] - 1``
+    (int64, increasing; multiples of ``LANES`` but the last, so every group stays whole), one
+    range per ``prange`` iteration, spread over numba's threads; returns -1, or the first refused
+    lane. Every action of all the ranges is checked first (:func:`first_refused`), so nothing
+    moves when one is refused. A range reads and writes only its lanes' rows and a lane's
+    numbers do not depend on the range it is in: the numbers are those of one ``step`` call,
+    bit for bit, whatever the ranges and the threads. Not ``nogil``: the caller keeps the GIL
+    for the whole call, so two Python threads never launch it (or ``reset_parallel``) at once
+    (the workqueue threading layer aborts on concurrent launches, :mod:`steerlab.threading_layer`).
+    """
+    bad_lane = first_refused(A, redo, cuts[0], cuts[cuts.shape[0] - 1])
+    if bad_lane >= 0:
+        return bad_lane
+    for j in numba.prange(cuts.shape[0] - 1):
+        step(cuts[j], cuts[j + 1], A, redo, X, K, J, cmd, W, w_index, PS, PG, dt, nc, gd, GZ, REF, rpm_slot, lam,
+             reward, obs, rew, bad, term, trunc, n_env_steps, dmax, lazy, S, Z, base, hold, fb, fa, ch, KEY, EP,
+             scale, offset_max, x0, ps0, gz0, ref0, auto)
+    return -1
+
+
+@numba.njit(parallel=True, cache=CACHE)
+def reset_parallel(cuts, idx, KEY, EP, S, Z, scale, offset_max, X, K, J, cmd, PS, GZ, REF, x0, ps, gz0, ref0, gd,
+                   h_env, rpm_slot, obs, rew, bad, sea_seeds):
+    """:func:`reset` of the lanes ``idx[cuts[j]:cuts[j + 1]]`` (distinct lanes), one range per
+    ``prange`` iteration, spread over numba's threads (as :func:`step_parallel`, GIL held); the
+    numbers of one ``reset`` call."""
+    for j in numba.prange(cuts.shape[0] - 1):
+        lo, hi = cuts[j], cuts[j + 1]
+        reset(idx[lo:hi], KEY, EP, S, Z, scale, offset_max, X, K, J, cmd, PS, GZ, REF, x0, ps, gz0, ref0, gd, h_env,
+              rpm_slot, obs, rew, bad, sea_seeds[lo:hi])
+
+
 @numba.njit(inline="always")
 def reset_one(i, KEY, EP, S, Z, scale, offset_max, X, K, J, cmd, PS, GZ, REF, x0, ps, gz0, ref0, gd, h_env,
               rpm_slot, obs, rew, bad):
@@ -231,8 +272,8 @@ def reset_one(i, KEY, EP, S, Z, scale, offset_max, X, K, J, cmd, PS, GZ, REF, x0
 def reset(idx, KEY, EP, S, Z, scale, offset_max, X, K, J, cmd, PS, GZ, REF, x0, ps, gz0, ref0, gd, h_env,
           rpm_slot, obs, rew, bad, sea_seeds):
     """:func:`reset_one` for the lanes ``idx``, their sea seeds into ``sea_seeds``; one compiled
-    call for all of them. It releases the GIL: calls on disjoint lanes may run in parallel
-    threads (:meth:`steerlab.gym.episodes.Episodes.reset_lanes`)."""
+    call for all of them. Calls on disjoint lanes may run in parallel threads
+    (:func:`reset_parallel`)."""
     for q in range(idx.shape[0]):
         sea_seeds[q] = reset_one(idx[q], KEY, EP, S, Z, scale, offset_max, X, K, J, cmd, PS, GZ, REF, x0, ps,
                                  gz0, ref0, gd, h_env, rpm_slot, obs, rew, bad)

@@ -42,7 +42,8 @@ from steerlab.environment.iir_filter import _padded
 from steerlab.environment.waves import _hold, band_pass_eq39
 
 from steerlab.errors import InputError, require_finite_range
-from steerlab.sim.lanes import LANES, _share_ranges as share_ranges
+from steerlab.sim.lanes import LANES, range_cuts
+from steerlab.threading_layer import launch
 from steerlab.units import rad
 from steerlab.ships.state import IPSI
 from steerlab.steering_gear import G_DMAX
@@ -53,13 +54,12 @@ TASKS = ("course_keeping", "course_change", "track_following")
 TRACK_GUIDANCE = {"type": "los", "start": [0.0, 200.0], "route": [[0.0, 0.0], [100000.0, 0.0]],
                   "lookahead_L": 5.0}
 THREADS_FROM = 512
-"""Least number of lanes whose vectorised step (or reset) is spread over the threads; below
-it, one call in the calling thread. Handing a range to a pool thread and waiting for it costs
-some 25-55 us of wall and 20-70 us of CPU time on the 2-core development VM, what a second
-thread saves on 200-450 ships (0.25 us per ship and env step at the default
-``control_dt``). Measured
-there at 1024 ships: 1.2-1.3x faster by wall clock with part of a core free, 0.8-0.9x when
-other programs held both cores; ``numba.set_num_threads(1)`` keeps the env on one thread."""
+"""Least number of lanes whose vectorised step (or reset) is spread over the threads (numba's
+``prange``, ``step_parallel`` / ``reset_parallel`` of :mod:`steerlab.gym.env_template`); below
+it, one call in the calling thread. A step of 1024 ships at the default ``control_dt`` takes
+some 260-285 us on one core of the 2-core development VM (0.25 us per ship); see
+``benchmarks/README.md`` for what the threads give there. ``numba.set_num_threads(1)`` keeps
+the env on one thread."""
 N_OBS = 3
 OBS_NAMES = ("heading_error", "yaw_rate", "rudder")
 OBS_UNITS = ("rad", "rad/s", "rad")
@@ -156,7 +156,7 @@ class Episodes:
         kernels = env_kernels(s0.ship.rhs, self.guide, nx)      # compiled once ever (disk cache)
         if self.vectorised:
             self._vstep = entry(kernels, "step")
-            self._first_refused = kernels.first_refused
+            self._kernels, self._par, self._cuts = kernels, {}, {}
         else:
             self._step = entry(kernels, "step_serial")
         self._reset = entry(kernels, "reset")
@@ -189,6 +189,16 @@ class Episodes:
 
     def _sea_args(self):
         return (self.lazy, self.S, self.Z, self._base, self._hold, self._fb, self._fa, W_RUDDER)
+
+    def _parallel(self, name: str):
+        """The compiled threaded entry point ``name`` (taken on first use, so that the compile
+        message of :func:`steerlab.sim.drivers.entry` comes only when it is compiled)."""
+        fn = self._par.get(name)
+        if fn is None:
+            from steerlab.sim.drivers import entry
+
+            fn = self._par[name] = entry(self._kernels, name)
+        return fn
 
     def _threads(self, m: int) -> int:
         """Threads for a compiled call over ``m`` lanes: 1 below ``threads_from``, else
@@ -225,7 +235,7 @@ class Episodes:
                 self.rpm_slot, self.obs, self.rew, self.bad)
         threads = self._threads(m)
         if threads > 1 and np.unique(lanes).shape[0] == m:   # distinct lanes: disjoint rows, spread
-            share_ranges(lambda lo, hi: self._reset(lanes[lo:hi], *args, sea_seeds[lo:hi]), m, 1, threads)
+            launch(self._parallel("reset_parallel"), range_cuts(m, 1, threads), lanes, *args, sea_seeds)
         else:
             self._reset(lanes, *args, sea_seeds)
         infos = [{"episode": int(self.EP[i]) - 1, "initial_heading": float(self.X[i, IPSI])} for i in lanes.tolist()]
@@ -267,10 +277,10 @@ class Episodes:
         lanes not in ``redo`` (N,) bool advance with ``actions`` (N,) in [-1, 1], the ``redo``
         lanes reset to their next episode (action ignored, reward 0); fills ``obs``, ``rew``,
         ``term``, ``trunc`` and sets ``redo = term | trunc``. One compiled call for all lanes;
-        from ``threads_from`` lanes (:data:`THREADS_FROM`) on, all actions are checked first,
-        then ``threads`` threads share calls on contiguous ranges of whole groups, as the batch
-        engine spreads its groups (:func:`steerlab.sim.lanes._share_ranges`, the same pool of
-        threads). A lane's numbers do not depend on the split."""
+        from ``threads_from`` lanes (:data:`THREADS_FROM`) on, ``step_parallel``: all actions
+        checked first, then ``threads`` contiguous ranges of whole groups
+        (:func:`steerlab.sim.lanes.range_cuts`) spread over numba's threads (a ``prange``,
+        :mod:`steerlab.threading_layer`). A lane's numbers do not depend on the split."""
         a = np.asarray(actions, dtype=np.float64).reshape(self.n)
         again = None if self.lazy else redo.copy()
         args = (a, redo, self.X, self.K, self.J, self.cmd, self.W, self.w_index, self.PS, self.PG, self.dt,
@@ -281,9 +291,10 @@ class Episodes:
         if threads <= 1:
             i = self._vstep(0, self.n, *args)
         else:                                              # every action checked before any lane moves
-            i = self._first_refused(a, redo, 0, self.n)
-            if i < 0:
-                share_ranges(lambda lo, hi: self._vstep(lo, hi, *args), self.n, LANES, threads)
+            cuts = self._cuts.get(threads)
+            if cuts is None:
+                cuts = self._cuts[threads] = range_cuts(self.n, LANES, threads)
+            i = launch(self._parallel("step_parallel"), cuts, *args)
         if i >= 0:
             raise self._refused(a[i])
         if again is not None and again.any():              # seas realised lane by lane: reset here

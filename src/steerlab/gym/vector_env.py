@@ -7,9 +7,9 @@ advanced by the batch engine's vectorised groups of ``LANES`` ships in one compi
 (``step`` of :func:`steerlab.gym.plant_batch.env_kernels`: actions checked, autoresets, plants,
 guidance, observations and rewards; the single environment steps its ship with the scalar
 kernel, with the same numbers); from 512 ships on (:data:`~steerlab.gym.episodes.THREADS_FROM`)
-the call is split into ranges of whole groups shared by ``numba.get_num_threads()``
-threads (the batch engine's pool), after every action has been checked (same numbers whatever
-the split). ``reset(seed=s)`` seeds ship i with ``s + i`` (as gymnasium's
+the call is split into ranges of whole groups spread over ``numba.get_num_threads()``
+threads by numba's ``prange`` (on a fork-safe threading layer, :mod:`steerlab.threading_layer`),
+after every action has been checked (same numbers whatever the split). ``reset(seed=s)`` seeds ship i with ``s + i`` (as gymnasium's
 ``SyncVectorEnv``; or ``seed=[s0, s1, ...]``, one per ship), so ship i's episodes equal a
 single environment's after ``reset(seed=s + i)``. Autoreset: gymnasium's ``NEXT_STEP`` mode
 (the step after an episode ends resets that ship to its next episode and ignores its action;

@@ -33,6 +33,7 @@ from concurrent.futures import ThreadPoolExecutor, as_completed
 from functools import lru_cache
 
 import numba
+import numpy as np
 
 from steerlab.guidance.reference_models import course_guide
 
@@ -99,51 +100,15 @@ def _run_groups(run_group, n: int, lanes: int, progress=None) -> None:
     report.done()
 
 
-RANGES_PER_THREAD = 2
-"""Ranges of lanes per thread in :func:`_share_ranges`: a range a late pool thread has not
-taken is done by another, but each range costs a call (3-4 us of CPU, holding the GIL).
-Measured on the 2-core VM with both cores busy, at 1024 ships: 1, 2, 4, 8 ranges per thread
-cost about 40, 45, 60, 90 us of CPU per step above one thread."""
-
-
-def _share_ranges(call, n: int, lanes: int, threads: int, per_thread: int = RANGES_PER_THREAD) -> None:
-    """``call(lo, hi)`` once for each of the contiguous ranges covering ``0 .. n - 1``, shared
-    by this thread and ``threads - 1`` threads of the pool (:func:`_pool`).
-
-    The range bounds are multiples of ``lanes`` (so every group of ``lanes`` stays whole), about
-    ``per_thread`` ranges per thread, as equal as whole groups allow; each thread takes the next
-    range not yet taken until none is left, so a pool thread that starts late (a busy machine)
-    leaves its share to this one instead of holding it up. ``threads`` 1 (or ``n <= lanes``)
-    is one call ``call(0, n)`` in this thread. ``call`` should release the GIL (a nogil kernel)
-    for the ranges to overlap. Returns when every range is done and no pool thread still runs
-    a call (an exception is raised after that, so nothing still writes the caller's arrays).
-    """
-    groups = -(-n // lanes)
-    k = max(1, min(int(threads), groups))
-    if k == 1:
-        call(0, n)
-        return
-    m = min(groups, k * max(1, int(per_thread)))
-    cuts = [min(n, lanes * (groups * j // m)) for j in range(m + 1)]
-    todo = iter(range(m))            # next() under the GIL: each range is taken by exactly one thread
-
-    def work():
-        for j in todo:
-            call(cuts[j], cuts[j + 1])
-
-    pool = _pool(k, os.getpid())
-    futs = [pool.submit(work) for _ in range(k - 1)]
-    try:
-        work()
-    finally:
-        for _ in todo:               # after an exception here: no thread takes another range
-            pass
-        for fut in futs:
-            if not fut.cancel():     # not started yet: it never will; else wait for its ranges
-                fut.exception()
-    for fut in futs:
-        if not fut.cancelled():
-            fut.result()             # a pool thread's exception
+def range_cuts(n: int, lanes: int, ranges: int) -> np.ndarray:
+    """Bounds ``cuts`` (int64, ``cuts[0] = 0``, ``cuts[-1] = n``) of at most ``ranges`` contiguous
+    ranges ``cuts[j] .. cuts[j + 1] - 1`` covering ``0 .. n - 1``: multiples of ``lanes`` (every
+    group of ``lanes`` stays whole), as equal as whole groups allow, none empty (fewer ranges
+    when there are fewer groups). The ranges of the Gymnasium vector environment's threaded
+    step (``step_parallel`` of :mod:`steerlab.gym.env_template`)."""
+    groups = -(-int(n) // int(lanes))
+    m = max(1, min(int(ranges), groups))
+    return np.array([min(n, lanes * (groups * j // m)) for j in range(m + 1)], dtype=np.int64)
 
 
 class _Reporter:

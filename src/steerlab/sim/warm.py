@@ -47,17 +47,18 @@ def warm_pair(ship_id: str, controller: str, batch: bool = False) -> str:
 
 def warm_gym() -> None:
     """Step and reset the default Gymnasium environments (the Esso, every task), single and
-    vector, once: their compiled step and reset (:func:`steerlab.gym.plant_batch.env_kernels`)
-    go to the driver cache."""
+    vector (one call and threaded), once: their compiled steps and resets
+    (:func:`steerlab.gym.plant_batch.env_kernels`) go to the driver cache."""
     import numpy as np
 
     from steerlab.gym.episodes import TASKS, Episodes
 
     for task in TASKS:
-        for vectorised in (False, True):
-            env = Episodes(1, task=task, episode_s=2.0, vectorised=vectorised)
-            env.reset_lanes([0], seeds=[0])
-            if vectorised:
-                env.step_autoreset(np.zeros(1), *(np.zeros(1, dtype=np.bool_) for _ in range(3)))
-            else:
-                env.step(np.zeros(1))
+        single = Episodes(1, task=task, episode_s=2.0)
+        single.reset_lanes([0], seeds=[0])
+        single.step(np.zeros(1))
+        vec = Episodes(2, task=task, episode_s=2.0, vectorised=True)
+        for threads_from in (vec.threads_from, 1):     # one call, then the threaded step and reset
+            vec.threads_from, vec.threads = threads_from, 2
+            vec.reset_lanes([0, 1], seeds=[0, 1])
+            vec.step_autoreset(np.zeros(2), *(np.zeros(2, dtype=np.bool_) for _ in range(3)))

@@ -1,0 +1,73 @@
+"""numba's threading layer for steerlab's ``parallel=True`` entry points: a fork-safe one.
+
+The native Gymnasium vector environment spreads a step (and a reset) of many ships over the
+cores with numba's ``prange`` (``step_parallel`` and ``reset_parallel`` of
+:mod:`steerlab.gym.env_template`), which runs on numba's *threading layer*: one per process,
+chosen by numba when its threads are first started (the first ``parallel=True`` call or the
+first ``numba.get_num_threads()``), from ``numba.config.THREADING_LAYER`` (the
+``NUMBA_THREADING_LAYER`` environment variable, default ``"default"``: TBB if it can be
+loaded, else OpenMP, else workqueue).
+
+On Linux numba's OpenMP layer is GNU OpenMP, which is **not fork-safe**: a process forked
+after a parallel call aborts at its own first parallel call ("fork() called from a process
+already using GNU OpenMP"); steerlab forks (the figure worker, multiprocessing, Dask
+workers), and so do RL libraries' subprocess vector envs. It also busy-waits: with the cores
+held by other programs, a 1024-ship step took 8 ms instead of 0.3 ms on the 2-core
+development VM. So :func:`prefer_fork_safe` (called by ``import steerlab``) asks numba for
+its ``"forksafe"`` layer - TBB when it can be loaded (conda's ``tbb``; pip's ``tbb`` puts
+``libtbb.so.12`` where numba does not look), else **workqueue**, numba's own pthreads pool,
+always available - **unless the user chose**: ``NUMBA_THREADING_LAYER`` set, or
+``numba.config.THREADING_LAYER`` changed before ``import steerlab``, or numba's threads
+already started; then steerlab runs on that layer (an explicit ``omp`` is the user's
+choice, fork-unsafe). It only sets ``numba.config.THREADING_LAYER`` (numba starts its
+threads later, on first use: starting them costs 13-20 ms, not paid by commands that never
+use them), so it also applies to any other ``parallel=True`` code of the process.
+
+workqueue is fork-safe but not thread-safe: two threads launching parallel calls at once
+make it abort the process. numba releases the GIL around a parallel call, so the GIL does
+not prevent that; steerlab's parallel calls are made under :data:`LAUNCH`, one process-wide
+lock (:func:`launch`), so environments stepped from several Python threads take turns
+(another library's concurrent ``parallel=True`` calls on workqueue are not covered: choose
+``NUMBA_THREADING_LAYER=tbb`` for those).
+"""
+
+from __future__ import annotations
+
+import os
+import threading
+
+FORK_SAFE = "forksafe"
+"""The value :func:`prefer_fork_safe` gives ``numba.config.THREADING_LAYER`` (numba's name for
+"TBB if it loads, else workqueue" on Linux)."""
+
+LAUNCH = threading.Lock()
+"""Held during each of steerlab's parallel calls (see the module docstring)."""
+
+
+def prefer_fork_safe() -> bool:
+    """Ask numba for its fork-safe threading layer unless the user chose one (module docstring);
+    returns whether it did."""
+    import numba
+    from numba.np.ufunc import parallel
+
+    if "NUMBA_THREADING_LAYER" in os.environ or getattr(parallel, "_is_initialized", False):
+        return False
+    if str(numba.config.THREADING_LAYER).lower() != "default":
+        return False
+    numba.config.THREADING_LAYER = FORK_SAFE
+    return True
+
+
+def launch(call, *args):
+    """``call(*args)`` under :data:`LAUNCH` (a compiled ``parallel=True`` entry point)."""
+    with LAUNCH:
+        return call(*args)
+
+
+def _new_lock_in_child() -> None:
+    """A forked child gets a free lock (the parent's may have been held by another thread)."""
+    global LAUNCH
+    LAUNCH = threading.Lock()
+
+
+os.register_at_fork(after_in_child=_new_lock_in_child)

@@ -1,0 +1,115 @@
+"""The vector environment's threaded step on numba's threads (``step_parallel``, ``prange``) and the
+process-wide threading layer steerlab asks for (:mod:`steerlab.threading_layer`): fork-safe, a
+forked child steps its own environments; steerlab's parallel calls from several Python threads
+take turns; a user's explicit layer is kept. Each case runs in a fresh interpreter (the layer is
+chosen once per process, and a wrong one aborts the process)."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+import textwrap
+
+import pytest
+
+pytest.importorskip("gymnasium")
+
+PRELUDE = textwrap.dedent("""
+    import json, sys
+    import numpy as np
+    import gymnasium as gym
+    import numba
+    import steerlab.gym
+
+    def vec(n=37, threads=2):
+        v = gym.make_vec("steerlab/CourseKeeping-v0", num_envs=n, vectorization_mode="vector_entry_point",
+                         episode_s=6.0)
+        v.unwrapped.core.threads_from, v.unwrapped.core.threads = 1, threads     # the threaded step at any N
+        return v
+
+    def episodes(v, steps=9, seed=5):                # through an autoreset (6 steps per episode)
+        acts = np.random.default_rng(3).uniform(-1, 1, size=(steps, v.num_envs, 1))
+        out = [v.reset(seed=seed)[0]] + [np.concatenate([v.step(a)[0].ravel(), v.unwrapped.core.rew]) for a in acts]
+        return np.concatenate([np.ravel(x) for x in out])
+""")
+
+FORK = PRELUDE + textwrap.dedent("""
+    import multiprocessing as mp
+
+    def child(conn):
+        conn.send(episodes(vec()).tolist())          # a new env in the child, its threaded step
+        conn.close()
+
+    ref = episodes(vec())                             # the parent's threaded step first: numba's threads run
+    one = episodes(vec(threads=1))                    # the one-call step
+    recv, send = mp.get_context("fork").Pipe(duplex=False)
+    p = mp.get_context("fork").Process(target=child, args=(send,))
+    p.start()
+    got = recv.recv() if recv.poll(240) else None
+    p.join(60)
+    if p.is_alive():
+        p.kill()
+    print(json.dumps({"layer": numba.threading_layer(), "exitcode": p.exitcode,
+                      "child_same": got == ref.tolist(), "one_call_same": bool(np.array_equal(one, ref))}))
+""")
+
+THREADS = PRELUDE + textwrap.dedent("""
+    import threading
+
+    envs = [vec(), vec()]
+    ref = episodes(vec(threads=1), steps=60)
+    out = [None, None]
+
+    def run(k):
+        out[k] = episodes(envs[k], steps=60)
+
+    ts = [threading.Thread(target=run, args=(k,)) for k in range(2)]
+    for t in ts:
+        t.start()
+    for t in ts:
+        t.join()
+    print(json.dumps({"layer": numba.threading_layer(), "same": [bool(np.array_equal(o, ref)) for o in out]}))
+""")
+
+LAYER = textwrap.dedent("""
+    import json, sys
+    import numba
+    if len(sys.argv) > 1:
+        numba.config.THREADING_LAYER = sys.argv[1]     # chosen in code before importing steerlab
+    import steerlab
+    numba.get_num_threads()                            # starts numba's threads
+    print(json.dumps({"layer": numba.threading_layer(), "config": numba.config.THREADING_LAYER}))
+""")
+
+
+def _run(script, *args, env_extra=None, timeout=600):
+    env = {k: v for k, v in os.environ.items() if k != "NUMBA_THREADING_LAYER"}
+    env.update(env_extra or {})
+    p = subprocess.run([sys.executable, "-c", script, *args], env=env, capture_output=True, text=True,
+                       timeout=timeout)
+    assert p.returncode == 0, p.stderr[-3000:]
+    return json.loads(p.stdout.strip().splitlines()[-1])
+
+
+def test_a_child_forked_after_a_threaded_step_steps_its_own_env_and_exits():
+    r = _run(FORK)
+    assert r["layer"] in ("workqueue", "tbb")         # numba's fork-safe layers (not GNU OpenMP)
+    assert r["exitcode"] == 0                         # no abort, no hang
+    assert r["child_same"] and r["one_call_same"]     # same numbers in the child, and as one call
+
+
+def test_threaded_steps_from_two_python_threads_take_turns_and_keep_their_numbers():
+    r = _run(THREADS)
+    assert r["layer"] in ("workqueue", "tbb")
+    assert r["same"] == [True, True]
+
+
+def test_steerlab_asks_for_the_fork_safe_layer_unless_the_user_chose_one():
+    assert _run(LAYER)["config"] == "forksafe"
+    assert _run(LAYER)["layer"] in ("workqueue", "tbb")
+    assert _run(LAYER, env_extra={"NUMBA_THREADING_LAYER": "workqueue"}) == {"layer": "workqueue",
+                                                                              "config": "workqueue"}
+    assert _run(LAYER, "omp") == {"layer": "omp", "config": "omp"}                     # set in code: kept
+    assert _run(LAYER, env_extra={"NUMBA_THREADING_LAYER": "omp"})["layer"] == "omp"   # set outside: kept
