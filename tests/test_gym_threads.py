@@ -79,8 +79,10 @@ LAYER = textwrap.dedent("""
     if len(sys.argv) > 1:
         numba.config.THREADING_LAYER = sys.argv[1]     # chosen in code before importing steerlab
     import steerlab
-    numba.get_num_threads()                            # starts numba's threads
-    print(json.dumps({"layer": numba.threading_layer(), "config": numba.config.THREADING_LAYER}))
+    from steerlab.threading_layer import num_threads, tbb_library
+    num_threads()                                      # starts numba's threads, as steerlab does
+    print(json.dumps({"layer": numba.threading_layer(), "config": numba.config.THREADING_LAYER,
+                      "tbb": tbb_library() is not None}))
 """)
 
 
@@ -107,9 +109,20 @@ def test_threaded_steps_from_two_python_threads_take_turns_and_keep_their_number
 
 
 def test_steerlab_asks_for_the_fork_safe_layer_unless_the_user_chose_one():
-    assert _run(LAYER)["config"] == "forksafe"
-    assert _run(LAYER)["layer"] in ("workqueue", "tbb")
-    assert _run(LAYER, env_extra={"NUMBA_THREADING_LAYER": "workqueue"}) == {"layer": "workqueue",
-                                                                              "config": "workqueue"}
-    assert _run(LAYER, "omp") == {"layer": "omp", "config": "omp"}                     # set in code: kept
+    r = _run(LAYER)
+    assert r["config"] == "forksafe"
+    assert r["layer"] == ("tbb" if r["tbb"] else "workqueue")          # pip's TBB found and loaded when installed
+    wq = _run(LAYER, env_extra={"NUMBA_THREADING_LAYER": "workqueue"})
+    assert (wq["layer"], wq["config"]) == ("workqueue", "workqueue")
+    omp = _run(LAYER, "omp")                                            # set in code before import: kept
+    assert (omp["layer"], omp["config"]) == ("omp", "omp")
     assert _run(LAYER, env_extra={"NUMBA_THREADING_LAYER": "omp"})["layer"] == "omp"   # set outside: kept
+
+
+def test_the_threaded_step_runs_on_workqueue_too():
+    """The fallback when TBB cannot be loaded: fork after a threaded step, two Python threads."""
+    env = {"NUMBA_THREADING_LAYER": "workqueue"}
+    r = _run(FORK, env_extra=env)
+    assert r["layer"] == "workqueue" and r["exitcode"] == 0 and r["child_same"] and r["one_call_same"]
+    r = _run(THREADS, env_extra=env)
+    assert r["layer"] == "workqueue" and r["same"] == [True, True]

@@ -14,14 +14,21 @@ already using GNU OpenMP"); steerlab forks (the figure worker, multiprocessing, 
 workers), and so do RL libraries' subprocess vector envs. It also busy-waits: with the cores
 held by other programs, a 1024-ship step took 8 ms instead of 0.3 ms on the 2-core
 development VM. So :func:`prefer_fork_safe` (called by ``import steerlab``) asks numba for
-its ``"forksafe"`` layer - TBB when it can be loaded (conda's ``tbb``; pip's ``tbb`` puts
-``libtbb.so.12`` where numba does not look), else **workqueue**, numba's own pthreads pool,
-always available - **unless the user chose**: ``NUMBA_THREADING_LAYER`` set, or
+its ``"forksafe"`` layer - **TBB** when it can be loaded, else **workqueue** (numba's own
+pthreads pool, always there) - **unless the user chose**: ``NUMBA_THREADING_LAYER`` set, or
 ``numba.config.THREADING_LAYER`` changed before ``import steerlab``, or numba's threads
-already started; then steerlab runs on that layer (an explicit ``omp`` is the user's
-choice, fork-unsafe). It only sets ``numba.config.THREADING_LAYER`` (numba starts its
-threads later, on first use: starting them costs 13-20 ms, not paid by commands that never
-use them), so it also applies to any other ``parallel=True`` code of the process.
+already started; then steerlab runs on that layer (an explicit ``omp`` is the user's choice,
+fork-unsafe). It only sets ``numba.config.THREADING_LAYER``, so it applies to any other
+``parallel=True`` code of the process too; numba starts its threads later, on first use
+(13-20 ms, not paid by commands that never use them).
+
+steerlab starts them through :func:`num_threads` (the vector environment's and the batch
+engine's thread counts), which first loads pip's TBB where numba would not find it
+(:func:`preload_pip_tbb`): the ``tbb`` wheel (in the ``rl`` extra, Linux x86-64) installs
+``libtbb.so.12`` in ``sys.prefix/lib``, on the library path of some Pythons (pyenv's) but not
+of a virtual environment's. TBB is fork-safe and thread-safe, and the faster of the two here
+(``benchmarks/README.md``): its threads wait a little before they sleep, where workqueue wakes
+sleeping threads at every call.
 
 workqueue is fork-safe but not thread-safe: two threads launching parallel calls at once
 make it abort the process. numba releases the GIL around a parallel call, so the GIL does
@@ -34,7 +41,9 @@ lock (:func:`launch`), so environments stepped from several Python threads take 
 from __future__ import annotations
 
 import os
+import sys
 import threading
+from typing import Optional
 
 FORK_SAFE = "forksafe"
 """The value :func:`prefer_fork_safe` gives ``numba.config.THREADING_LAYER`` (numba's name for
@@ -55,6 +64,59 @@ def prefer_fork_safe() -> bool:
     if str(numba.config.THREADING_LAYER).lower() != "default":
         return False
     numba.config.THREADING_LAYER = FORK_SAFE
+    return True
+
+
+_started = False
+
+
+def num_threads() -> int:
+    """``numba.get_num_threads()``, numba's threads started first (once) after pip's TBB is
+    loaded where a layer that may pick TBB is asked for (:func:`preload_pip_tbb`)."""
+    import numba
+
+    global _started
+    if not _started:
+        from numba.np.ufunc import parallel
+
+        if not getattr(parallel, "_is_initialized", False) and str(numba.config.THREADING_LAYER).lower() in (
+                "forksafe", "tbb", "safe", "threadsafe", "default"):
+            preload_pip_tbb()
+        _started = True
+    return numba.get_num_threads()
+
+
+def tbb_library() -> Optional[str]:
+    """The path of ``libtbb.so.12`` of the installed ``tbb`` distribution (pip's wheel), or None
+    (not installed, not Linux)."""
+    from importlib import metadata
+
+    if not sys.platform.startswith("linux"):
+        return None
+    try:
+        files = metadata.files("tbb") or ()
+    except metadata.PackageNotFoundError:
+        return None
+    for f in files:
+        if f.name == "libtbb.so.12":
+            path = os.path.realpath(str(f.locate()))
+            return path if os.path.exists(path) else None
+    return None
+
+
+def preload_pip_tbb() -> bool:
+    """Load pip's ``libtbb.so.12`` (:func:`tbb_library`) into the process (``RTLD_GLOBAL``), so
+    that numba's TBB layer, which asks the loader for that name, finds it; returns whether it
+    was loaded. Harmless when it is on the library path already."""
+    import ctypes
+
+    path = tbb_library()
+    if path is None:
+        return False
+    try:
+        ctypes.CDLL(path, mode=ctypes.RTLD_GLOBAL)
+    except OSError:
+        return False
     return True
 
 

@@ -43,7 +43,7 @@ from steerlab.environment.waves import _hold, band_pass_eq39
 
 from steerlab.errors import InputError, require_finite_range
 from steerlab.sim.lanes import LANES, range_cuts
-from steerlab.threading_layer import launch
+from steerlab.threading_layer import launch, num_threads
 from steerlab.units import rad
 from steerlab.ships.state import IPSI
 from steerlab.steering_gear import G_DMAX
@@ -202,10 +202,10 @@ class Episodes:
 
     def _threads(self, m: int) -> int:
         """Threads for a compiled call over ``m`` lanes: 1 below ``threads_from``, else
-        ``threads`` (None: ``numba.get_num_threads()``)."""
+        ``threads`` (None: ``numba.get_num_threads()``, :func:`steerlab.threading_layer.num_threads`)."""
         if m < self.threads_from:
             return 1
-        return self.threads if self.threads is not None else numba.get_num_threads()
+        return self.threads if self.threads is not None else num_threads()
 
     # ----------------------------------------------------------------- reset
     def reset_lanes(self, lanes: Union[Iterable[int], np.ndarray],

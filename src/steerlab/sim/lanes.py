@@ -36,6 +36,7 @@ import numba
 import numpy as np
 
 from steerlab.guidance.reference_models import course_guide
+from steerlab.threading_layer import num_threads
 
 LANES = 16
 """Runs advanced together by one thread of the batch engine (two AVX-512 vectors of float64;
@@ -79,7 +80,7 @@ def _run_groups(run_group, n: int, lanes: int, progress=None) -> None:
     at most every :data:`PROGRESS_PERIOD` seconds and once at the end.
     """
     starts = list(range(0, n, lanes))
-    threads = min(numba.get_num_threads(), len(starts))
+    threads = min(num_threads(), len(starts))
     report = _Reporter(progress, n)
     run_group(starts[0], min(lanes, n))       # the first group also compiles, in this thread
     report.add(min(lanes, n))
