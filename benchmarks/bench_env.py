@@ -24,16 +24,17 @@ wall clock and by the process's CPU time (``time.process_time``, all the process
 ``reset_ms`` is the median wall time of one reset of all N native ships without a seed (what
 an autoreset round costs).
 
-Threads: like the batch engine, the native env spreads a step (and a reset) of
-``THREADS_FROM`` = 512 ships or more over ``numba.get_num_threads()`` threads (the cores,
-or ``--threads``; :meth:`steerlab.gym.episodes.Episodes.step_autoreset`); ``threads`` in the
-table is the number it used at that N (1 below 512). ``SyncVectorEnv`` steps its envs one
-after the other in one thread. So the **wall** ratio is the user's figure (what this machine
-gives an RL loop), and the **CPU** ratio is the per-core one (what a step costs in core
-time; threads do not make a step cheaper, they add the hand-over to a pool thread, 20-70 us
-of CPU per step on the 2-core development VM). Two threads cut the wall time of a
-1024-ship step only when a second core is free (1.2-1.3x there); with the cores held by
-other programs the wall ratio falls below the one-thread figure (compare ``--threads 1``).
+Threads: the native env spreads a step (and a reset) of ``THREADS_FROM`` = 512 ships or more
+over ``numba.get_num_threads()`` threads (the cores, or ``--threads``) with numba's
+``prange`` (:meth:`steerlab.gym.episodes.Episodes.step_autoreset`) on the threading layer
+steerlab asks for (:mod:`steerlab.threading_layer`: TBB, else workqueue, unless
+``NUMBA_THREADING_LAYER`` says otherwise; ``layer`` in the output); ``threads`` in the table
+is the number it used at that N (1 below 512, and on workqueue, where threads do not pay). ``SyncVectorEnv`` steps its envs one after the
+other in one thread. So the **wall** ratio is the user's figure (what this machine gives an RL
+loop), and the **CPU** ratio is the per-core one (what a step costs in core time; threads do
+not make a step cheaper, they add the hand-over to numba's threads). Two threads cut the
+wall time of a 1024-ship step only when a second core is free; with the cores held by other
+programs the figure falls to about the one-thread one (compare ``--threads 1``).
 Not a test: the numbers depend on the machine and its load (printed with them).
 """
 
@@ -120,9 +121,12 @@ def main(argv=None) -> int:
                          "numba's number, the cores)")
     ap.add_argument("--json", action="store_true")
     a = ap.parse_args(argv)
-    if a.threads is not None:
-        import numba
+    import numba
 
+    from steerlab.threading_layer import num_threads
+
+    num_threads()                        # numba's threads on steerlab's layer, before set_num_threads
+    if a.threads is not None:
         if not 1 <= a.threads <= numba.config.NUMBA_NUM_THREADS:
             print(f"bench_env.py: --threads must be in [1, {numba.config.NUMBA_NUM_THREADS}], got {a.threads}",
                   file=sys.stderr)
@@ -143,9 +147,10 @@ def main(argv=None) -> int:
     if a.json:
         print(json.dumps({"workload": f"steerlab/CourseKeeping-v0, esso 16 kn, waves, dt 0.1 s, control_dt "
                                       f"{a.control_dt} s, episodes of 120 env steps", "load_average_1min": load,
-                          "rows": rows}, indent=2))
+                          "layer": numba.threading_layer(), "rows": rows}, indent=2))
     else:
-        print(f"load average (1 min) {load['before']:.2f} before, {load['after']:.2f} after, {load['cores']} cores")
+        print(f"load average (1 min) {load['before']:.2f} before, {load['after']:.2f} after, {load['cores']} cores; "
+              f"numba threading layer {numba.threading_layer()}")
     return 0
 
 

@@ -79,10 +79,10 @@ LAYER = textwrap.dedent("""
     if len(sys.argv) > 1:
         numba.config.THREADING_LAYER = sys.argv[1]     # chosen in code before importing steerlab
     import steerlab
-    from steerlab.threading_layer import num_threads, tbb_library
+    from steerlab.threading_layer import num_threads, tbb_library, threads_pay
     num_threads()                                      # starts numba's threads, as steerlab does
     print(json.dumps({"layer": numba.threading_layer(), "config": numba.config.THREADING_LAYER,
-                      "tbb": tbb_library() is not None}))
+                      "tbb": tbb_library() is not None, "pay": threads_pay()}))
 """)
 
 
@@ -112,10 +112,11 @@ def test_steerlab_asks_for_the_fork_safe_layer_unless_the_user_chose_one():
     r = _run(LAYER)
     assert r["config"] == "forksafe"
     assert r["layer"] == ("tbb" if r["tbb"] else "workqueue")          # pip's TBB found and loaded when installed
+    assert r["pay"] == r["tbb"]
     wq = _run(LAYER, env_extra={"NUMBA_THREADING_LAYER": "workqueue"})
-    assert (wq["layer"], wq["config"]) == ("workqueue", "workqueue")
+    assert (wq["layer"], wq["config"], wq["pay"]) == ("workqueue", "workqueue", False)
     omp = _run(LAYER, "omp")                                            # set in code before import: kept
-    assert (omp["layer"], omp["config"]) == ("omp", "omp")
+    assert (omp["layer"], omp["config"], omp["pay"]) == ("omp", "omp", True)
     assert _run(LAYER, env_extra={"NUMBA_THREADING_LAYER": "omp"})["layer"] == "omp"   # set outside: kept
 
 
@@ -126,3 +127,19 @@ def test_the_threaded_step_runs_on_workqueue_too():
     assert r["layer"] == "workqueue" and r["exitcode"] == 0 and r["child_same"] and r["one_call_same"]
     r = _run(THREADS, env_extra=env)
     assert r["layer"] == "workqueue" and r["same"] == [True, True]
+
+
+def test_the_vector_env_threads_only_where_threads_pay(monkeypatch):
+    """From THREADS_FROM ships numba's threads, unless the layer is one where a threaded step is
+    slower than one call (workqueue); an explicit ``threads`` is kept either way."""
+    from steerlab.gym import episodes
+    from steerlab.threading_layer import num_threads
+
+    core = episodes.Episodes(2, episode_s=4.0, vectorised=True)
+    big = episodes.THREADS_FROM
+    for pay, want in ((True, num_threads()), (False, 1)):
+        monkeypatch.setattr(episodes, "threads_pay", lambda pay=pay: pay)
+        assert core._threads(big - 1) == 1 and core._threads(big) == want
+        core.threads = 3
+        assert core._threads(big) == 3
+        core.threads = None

@@ -26,9 +26,9 @@ steerlab starts them through :func:`num_threads` (the vector environment's and t
 engine's thread counts), which first loads pip's TBB where numba would not find it
 (:func:`preload_pip_tbb`): the ``tbb`` wheel (in the ``rl`` extra, Linux x86-64) installs
 ``libtbb.so.12`` in ``sys.prefix/lib``, on the library path of some Pythons (pyenv's) but not
-of a virtual environment's. TBB is fork-safe and thread-safe, and the faster of the two here
-(``benchmarks/README.md``): its threads wait a little before they sleep, where workqueue wakes
-sleeping threads at every call.
+of a virtual environment's. TBB is fork-safe and thread-safe, and the faster of the two by far
+(``benchmarks/README.md``): on workqueue a threaded step is slower than one call, so there
+the vector environment steps on one thread (:func:`threads_pay`).
 
 workqueue is fork-safe but not thread-safe: two threads launching parallel calls at once
 make it abort the process. numba releases the GIL around a parallel call, so the GIL does
@@ -84,6 +84,24 @@ def num_threads() -> int:
             preload_pip_tbb()
         _started = True
     return numba.get_num_threads()
+
+
+PAYING = ("tbb", "omp")
+"""numba's threading layers on which a threaded step of the vector environment pays (see
+:func:`threads_pay`)."""
+
+
+def threads_pay() -> bool:
+    """Whether numba's threading layer (started by :func:`num_threads`) runs a short parallel
+    call faster than one thread: TBB and OpenMP do; workqueue, which wakes its sleeping
+    threads at every call and leaves the calling thread waiting, does not (a threaded step of
+    1024 ships took 330-390 us against 290 us in one call on the 2-core development VM with a
+    core free; TBB 155-160 us). The vector environment stays on one thread where it does not
+    (:meth:`steerlab.gym.episodes.Episodes._threads`)."""
+    import numba
+
+    num_threads()
+    return numba.threading_layer() in PAYING
 
 
 def tbb_library() -> Optional[str]:

@@ -43,7 +43,7 @@ from steerlab.environment.waves import _hold, band_pass_eq39
 
 from steerlab.errors import InputError, require_finite_range
 from steerlab.sim.lanes import LANES, range_cuts
-from steerlab.threading_layer import launch, num_threads
+from steerlab.threading_layer import launch, num_threads, threads_pay
 from steerlab.units import rad
 from steerlab.ships.state import IPSI
 from steerlab.steering_gear import G_DMAX
@@ -202,10 +202,13 @@ class Episodes:
 
     def _threads(self, m: int) -> int:
         """Threads for a compiled call over ``m`` lanes: 1 below ``threads_from``, else
-        ``threads`` (None: ``numba.get_num_threads()``, :func:`steerlab.threading_layer.num_threads`)."""
+        ``threads``; None: ``numba.get_num_threads()`` on a threading layer where threads pay,
+        else 1 (:func:`steerlab.threading_layer.threads_pay`: not on workqueue)."""
         if m < self.threads_from:
             return 1
-        return self.threads if self.threads is not None else num_threads()
+        if self.threads is not None:
+            return self.threads
+        return num_threads() if threads_pay() else 1
 
     # ----------------------------------------------------------------- reset
     def reset_lanes(self, lanes: Union[Iterable[int], np.ndarray],
