@@ -29,9 +29,9 @@ over ``numba.get_num_threads()`` threads (the cores, or ``--threads``) with numb
 ``prange`` (:meth:`steerlab.gym.episodes.Episodes.step_autoreset`) on the threading layer
 steerlab asks for (:mod:`steerlab.threading_layer`: TBB, else workqueue, unless
 ``NUMBA_THREADING_LAYER`` says otherwise; ``layer`` in the output); ``threads`` in the table
-is the number it used at that N (1 below 512, and on workqueue, where threads do not pay). ``SyncVectorEnv`` steps its envs one after the
-other in one thread. So the **wall** ratio is the user's figure (what this machine gives an RL
-loop), and the **CPU** ratio is the per-core one (what a step costs in core time; threads do
+is the number it used at that N (1 below 512, and on workqueue, where threads do not pay).
+``SyncVectorEnv`` steps its envs one after the other in one thread. So the **wall** ratio is
+the user's figure (what this machine gives an RL loop), and the **CPU** ratio is the per-core one (what a step costs in core time; threads do
 not make a step cheaper, they add the hand-over to numba's threads). Two threads cut the
 wall time of a 1024-ship step only when a second core is free; with the cores held by other
 programs the figure falls to about the one-thread one (compare ``--threads 1``).

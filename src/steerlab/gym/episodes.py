@@ -33,7 +33,6 @@ import math
 from dataclasses import replace
 from typing import Any, Iterable, Mapping, Optional, Sequence, Union
 
-import numba
 import numpy as np
 from numpy.typing import ArrayLike
 

@@ -32,7 +32,6 @@ import time
 from concurrent.futures import ThreadPoolExecutor, as_completed
 from functools import lru_cache
 
-import numba
 import numpy as np
 
 from steerlab.guidance.reference_models import course_guide
