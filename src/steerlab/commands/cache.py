@@ -19,7 +19,7 @@ EXAMPLES = """examples:
   steerlab cache warm --ships nomoto1 --controllers all   # every controller on one ship
   steerlab cache warm --gym           # also the Gymnasium environments' step and reset
   steerlab cache warm --ships all --controllers pid --plants --trials   # + plant steps, trials
-  steerlab cache warm --scenario examples/scenarios/*.toml --batch      # what these files use
+  steerlab cache warm --scenario examples/scenarios/los-route.toml --batch   # what a file uses
   steerlab cache clear --stale        # drop the entries of other steerlab versions
   STEERLAB_CACHE_DIR=/tmp/slc steerlab cache info"""
 
