@@ -19,25 +19,33 @@ import json, sys
 from steerlab.errors import InputError
 from steerlab.sim.scenario import scenario_from_dict
 from steerlab.ships.registry import get_ship
-out = {}
-try:
-    sc = scenario_from_dict(json.loads(sys.argv[1]))
-    out["controller"] = type(sc.controller).__name__
-    out["ship"] = get_ship(sc.ship.model).name
-except InputError as err:
-    out["error"] = str(err)
-out["modules"] = sorted(m for m in sys.modules if m.startswith(("steerlab.control.", "steerlab.ships.")))
-print(json.dumps(out))
+for arg in sys.argv[1:]:
+    out = {}
+    try:
+        sc = scenario_from_dict(json.loads(arg))
+        out["controller"] = type(sc.controller).__name__
+        out["ship"] = get_ship(sc.ship.model).name
+    except InputError as err:
+        out["error"] = str(err)
+    out["modules"] = sorted(m for m in sys.modules if m.startswith(("steerlab.control.", "steerlab.ships.")))
+    print(json.dumps(out))
 """
 
 
-def _probe(scenario: dict, cache: Path, **env) -> dict:
+def _probes(scenarios: list, cache: Path, **env) -> list:
+    """What one new process says of each scenario in turn: its controller's and ship's names,
+    or its error; and the controller and ship modules imported so far."""
     e = {k: v for k, v in os.environ.items() if k not in ("STEERLAB_PLUGINS", "STEERLAB_REGISTRY_INDEX")}
     e.update(STEERLAB_CACHE_DIR=str(cache), **env)
-    r = subprocess.run([sys.executable, "-c", PROBE, json.dumps(scenario)], env=e, capture_output=True,
+    r = subprocess.run([sys.executable, "-c", PROBE, *map(json.dumps, scenarios)], env=e, capture_output=True,
                        text=True, timeout=300)
     assert r.returncode == 0, r.stderr
-    return json.loads(r.stdout.strip().splitlines()[-1])
+    return [json.loads(line) for line in r.stdout.strip().splitlines()[-len(scenarios):]]
+
+
+def _probe(scenario: dict, cache: Path, **env) -> dict:
+    """What a new process says of ``scenario`` (:func:`_probes`)."""
+    return _probes([scenario], cache, **env)[0]
 
 
 def _index_file(cache: Path, package: str) -> Path:
@@ -83,12 +91,15 @@ def test_a_stale_or_corrupt_index_is_rebuilt(tmp_path, damage):
 
 def test_messages_for_unknown_names_are_those_of_the_full_discovery(tmp_path):
     _probe(PID_ON_ESSO, tmp_path)
-    for bad in ({"controller": {"type": "nope"}}, {"controller": {}}, {"controller": 5},
-                {"controller": {"type": "pid", "Kp": -1.0}}, {"controller": {"type": "adrc+wf", "bogus": 1}}):
-        indexed = _probe(bad, tmp_path)
-        full = _probe(bad, tmp_path, STEERLAB_REGISTRY_INDEX="0")
-        assert indexed["error"] == full["error"], bad
-    msg = _probe({"controller": {"type": "nope"}}, tmp_path)["error"]
+    bads = [{"controller": {"type": "nope"}}, {"controller": {}}, {"controller": 5},
+            {"controller": {"type": "pid", "Kp": -1.0}}, {"controller": {"type": "adrc+wf", "bogus": 1}}]
+    # without the index every name goes through the full discovery: one process for all of them;
+    # with it, a fresh process for each (the first unknown name would discover everything)
+    full = _probes(bads, tmp_path, STEERLAB_REGISTRY_INDEX="0")
+    indexed = [_probe(bad, tmp_path) for bad in bads]
+    for bad, i, f in zip(bads, indexed, full, strict=True):
+        assert i["error"] == f["error"], bad
+    msg = indexed[0]["error"]                                        # {"controller": {"type": "nope"}}
     assert msg.startswith("controller.type: unknown type 'nope'; known: adrc, ") and "pid" in msg
     msg = _probe({"ship": {"model": "nope"}, "controller": {"type": "pid"}}, tmp_path)["error"]
     assert msg.startswith("ship.model: unknown ship 'nope'; known ships: [") and "'esso'" in msg
