@@ -180,3 +180,30 @@ class _CompileLog:
 
 if os.environ.get("STEERLAB_TEST_COMPILES"):
     _COMPILE_LOG = _CompileLog(os.environ["STEERLAB_TEST_COMPILES"])
+
+
+# ------------------------------------------------- one expensive result for every worker
+def once_per_session(tmp_path_factory, name: str, make):
+    """``make(folder)``'s result (JSON-able), computed once per test session even when the
+    tests that need it run in different pytest-xdist workers: the first worker to ask computes
+    it in ``folder`` under the session's shared temporary root, holding a lock the others wait
+    on, and keeps it in ``folder/result.json``, which the others read. Without ``fcntl`` (not
+    POSIX), each worker computes it in a folder of its own."""
+    import json
+
+    try:
+        import fcntl
+    except ImportError:
+        fcntl = None
+    root = tmp_path_factory.getbasetemp()
+    if os.environ.get("PYTEST_XDIST_WORKER") and fcntl is not None:
+        root = root.parent                        # the folder every worker's basetemp is in
+    folder = root / name
+    with open(root / f"{name}.lock", "a") as lock:
+        if fcntl is not None:
+            fcntl.flock(lock, fcntl.LOCK_EX)     # released when the file closes
+        result = folder / "result.json"
+        if not result.exists():
+            folder.mkdir(exist_ok=True)
+            result.write_text(json.dumps(make(folder)))
+        return json.loads(result.read_text())

@@ -97,6 +97,9 @@ def test_mutated_scenarios_exit_0_or_one_line_2(tmp_path, monkeypatch):
     import steerlab.sim.engine as engine
 
     monkeypatch.setattr(engine, "simulate", _stub_simulate)
+    # no figure child (steerlab.figure_worker): with the engine stubbed it never draws, and
+    # forking then killing one per file was half of this test's CPU time
+    monkeypatch.setenv("STEERLAB_FORK_JOBS", "0")
     outcomes = {"accepted": 0, "rejected": 0}
     t0 = time.perf_counter()
     for i, path in enumerate(scenario_mutator.mutants(300, seed=15, folder=tmp_path / "in")):

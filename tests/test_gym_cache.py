@@ -21,10 +21,14 @@ SRC = Path(__file__).resolve().parent.parent / "src"
 
 ENTRIES = ("step", "step_serial", "reset", "step_parallel", "reset_parallel")
 SCRIPT = textwrap.dedent(f"""ENTRIES = {ENTRIES!r}""") + textwrap.dedent("""
-    import json
+    import json, sys
     import numpy as np
     from numba.core import event
-    with event.install_recorder("numba:compile") as rec:     # every numba compile in the process
+    with event.install_recorder("numba:compile") as before:  # a steerlab command first, if any
+        if sys.argv[1:]:
+            from steerlab.cli import main
+            assert main(sys.argv[1:]) == 0
+    with event.install_recorder("numba:compile") as rec:     # every numba compile from here on
         import gymnasium as gym
         import steerlab.gym
         from steerlab.gym.plant_batch import env_kernels
@@ -42,24 +46,42 @@ SCRIPT = textwrap.dedent(f"""ENTRIES = {ENTRIES!r}""") + textwrap.dedent("""
     m = env_kernels(core.ship_spec.rhs, core.guide, core.X.shape[1])
     stats = {n: [sum(getattr(m, n).stats.cache_hits.values()), sum(getattr(m, n).stats.cache_misses.values())]
              for n in ENTRIES}
-    print(json.dumps({"cached": m._steerlab_cached, "stats": stats, "compiles": len(rec.buffer),
-                      "vec": vec, "one": one, "pvec": pvec}))
+    print(json.dumps({"cached": m._steerlab_cached, "stats": stats, "compiles_before": len(before.buffer),
+                      "compiles": len(rec.buffer), "vec": vec, "one": one, "pvec": pvec}))
 """)
+#: ``steerlab cache warm`` of the fewest combinations, with the Gymnasium environments
+WARM_GYM = ["cache", "warm", "--ships", "esso", "--controllers", "pid", "--gym", "--quiet"]
 
 
-def _run(cache: Path) -> dict:
+def _run(cache: Path, *command: str) -> dict:
+    """SCRIPT in a new process on the driver cache ``cache``, after ``steerlab COMMAND`` (through
+    the entry point of ``python -m steerlab``, :func:`steerlab.cli.main`) in the same process."""
     env = {**os.environ, "STEERLAB_CACHE_DIR": str(cache), "PYTHONPATH": str(SRC)}
     env.pop("STEERLAB_DRIVER_CACHE", None)
-    p = subprocess.run([sys.executable, "-c", SCRIPT], env=env, capture_output=True, text=True, timeout=900)
+    p = subprocess.run([sys.executable, "-c", SCRIPT, *command], env=env, capture_output=True, text=True,
+                       timeout=900)
     assert p.returncode == 0, p.stderr
     return json.loads(p.stdout.strip().splitlines()[-1])
 
 
-def test_a_fresh_process_loads_the_env_step_and_reset_and_compiles_nothing(tmp_path):
-    first = _run(tmp_path)
-    assert first["cached"] and first["compiles"] > 0
+@pytest.fixture(scope="module")
+def warmed(tmp_path_factory) -> dict:
+    """One cold compile for the two tests that need one (issue 14: CI time): on an empty driver
+    cache, a process runs ``steerlab cache warm --gym`` and then the environments (``first``);
+    then a fresh process runs them on that cache (``fresh``). Made once per test session
+    (shared by the pytest-xdist workers)."""
+    from conftest import once_per_session
+
+    def make(cache: Path) -> dict:
+        return {"first": _run(cache, *WARM_GYM), "fresh": _run(cache)}
+
+    return once_per_session(tmp_path_factory, "gym-cache-warmed", make)
+
+
+def test_a_fresh_process_loads_the_env_step_and_reset_and_compiles_nothing(warmed):
+    first, second = warmed["first"], warmed["fresh"]
+    assert first["cached"] and first["compiles_before"] > 0
     assert first["stats"] == {n: [0, 1] for n in ENTRIES}                                # compiled, saved
-    second = _run(tmp_path)
     assert second["stats"] == {n: [1, 0] for n in ENTRIES}                               # loaded
     assert second["compiles"] == 0                    # nothing else compiled either (plants, guidance, seas)
     assert second["vec"] == first["vec"] and second["one"] == first["one"]               # same bits
@@ -67,16 +89,16 @@ def test_a_fresh_process_loads_the_env_step_and_reset_and_compiles_nothing(tmp_p
     assert first["pvec"] == first["vec"]                                                 # threaded: same bits
 
 
-def test_kernels_that_cannot_be_named_step_and_reset_from_an_in_memory_module(tmp_path, monkeypatch):
+def test_kernels_that_cannot_be_named_step_and_reset_from_an_in_memory_module():
     """A ship kernel made in a closure (no importable name) gets the environment's step and reset
-    compiled in the process, with the same numbers as the named kernel's cached module."""
+    compiled in the process, with the same numbers as the named kernel's cached module (from
+    the cache the rest of the suite uses, which ``.ci/warm-cache`` fills)."""
     from conftest import unnamed_ship
 
     from steerlab import kernel_refs
     from steerlab.gym.episodes import Episodes
     from steerlab.gym.plant_batch import env_kernels
 
-    monkeypatch.setenv("STEERLAB_CACHE_DIR", str(tmp_path))
     a = Episodes(20, episode_s=4.0, vectorised=True)
     b = Episodes(20, episode_s=4.0, vectorised=True)
     rhs = unnamed_ship(a.ship_spec.rhs)
@@ -99,11 +121,7 @@ def test_kernels_that_cannot_be_named_step_and_reset_from_an_in_memory_module(tm
         assert flags[0][0].all() == (k == 3)          # all episodes end at the 4th step, reset at the 5th
 
 
-def test_cache_warm_gym_leaves_the_default_envs_step_and_reset_on_disk(tmp_path):
-    env = {**os.environ, "STEERLAB_CACHE_DIR": str(tmp_path), "PYTHONPATH": str(SRC)}
-    env.pop("STEERLAB_DRIVER_CACHE", None)
-    p = subprocess.run([sys.executable, "-m", "steerlab", "cache", "warm", "--ships", "esso", "--controllers",
-                        "pid", "--gym", "--quiet"], env=env, capture_output=True, text=True, timeout=900)
-    assert p.returncode == 0, p.stderr
-    after = _run(tmp_path)
+def test_cache_warm_gym_leaves_the_default_envs_step_and_reset_on_disk(warmed):
+    first, after = warmed["first"], warmed["fresh"]
+    assert first["compiles"] == 0                     # after the warm: no compile, so the warm wrote all
     assert after["stats"] == {n: [1, 0] for n in ENTRIES} and after["compiles"] == 0

@@ -284,7 +284,7 @@ def test_signalk_rest_api_serves_the_latest_values_to_a_real_http_client():
                 with pytest.raises(urllib.error.HTTPError) as err:
                     await asyncio.to_thread(get, api + bad)
                 assert err.value.code == 404, bad
-                err.value.close()       # the client hangs up (else the server's close waits 10 s for it)
+                err.value.close()       # the client hangs up (else the server's close waits CLOSE_TIMEOUT for it)
         finally:
             await srv.close()
 

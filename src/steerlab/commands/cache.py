@@ -3,7 +3,8 @@
 Each (ship, controller, guidance) combination's closed loop is compiled once and kept in
 the cache (:mod:`steerlab.sim.drivers`), so later processes load it in milliseconds.
 ``warm`` compiles the common catalogue combinations ahead of time (e.g. once per CI run,
-or after installing steerlab); ``clear`` deletes the cache (``--stale`` only the entries of
+or after installing steerlab), and on request the ships' plant steps and trial loops, the
+combinations of scenario files and the Gymnasium environments; ``clear`` deletes the cache (``--stale`` only the entries of
 other steerlab versions).
 """
 
@@ -17,6 +18,8 @@ EXAMPLES = """examples:
   steerlab cache warm --ships esso --controllers pid adrc --batch
   steerlab cache warm --ships nomoto1 --controllers all   # every controller on one ship
   steerlab cache warm --gym           # also the Gymnasium environments' step and reset
+  steerlab cache warm --ships all --controllers pid --plants --trials   # + plant steps, trials
+  steerlab cache warm --scenario examples/scenarios/los-route.toml --batch   # what a file uses
   steerlab cache clear --stale        # drop the entries of other steerlab versions
   STEERLAB_CACHE_DIR=/tmp/slc steerlab cache info"""
 
@@ -30,13 +33,19 @@ def register(sub, formatter_class):
                        formatter_class=formatter_class)
     p.add_argument("action", choices=("info", "clear", "warm"))
     p.add_argument("--stale", action="store_true", help="clear: only other steerlab versions' entries")
-    p.add_argument("--ships", nargs="+", default=list(COMMON_SHIPS), metavar="ID",
+    p.add_argument("--ships", nargs="+", default=None, metavar="ID",
                    help=f"warm: ship ids, or 'all' (default: {' '.join(COMMON_SHIPS)})")
     p.add_argument("--controllers", nargs="+", default=list(COMMON_CONTROLLERS), metavar="TYPE",
                    help=f"warm: controller types, or 'all' (default: {' '.join(COMMON_CONTROLLERS)})")
     p.add_argument("--batch", action="store_true", help="warm: also the batch engine's loop")
     p.add_argument("--gym", action="store_true",
-                   help="warm: also the Gymnasium environments' step and reset (Esso, every task)")
+                   help="warm: also the Gymnasium environments' step and reset (every task) of the Esso "
+                        "and of the --ships")
+    p.add_argument("--plants", action="store_true",
+                   help="warm: also each ship's plant-only step (readable loop, runtime ship, identification)")
+    p.add_argument("--trials", action="store_true", help="warm: also each ship's manoeuvring-trial loop")
+    p.add_argument("--scenario", nargs="+", default=[], metavar="FILE",
+                   help="warm: also the combinations these scenario files use (with --batch: batch too)")
     p.add_argument("--json", action="store_true", help="info: print JSON")
     p.add_argument("--quiet", action="store_true")
     p.set_defaults(func=run)
@@ -77,30 +86,38 @@ def _warm(args) -> int:
     from steerlab.control.registry import get_controller
     from steerlab.ships.registry import get_ship
     from steerlab.sim import drivers
-    from steerlab.sim.warm import warm_gym, warm_pair
+    from steerlab.sim.scenario import load_scenario
+    from steerlab.sim.warm import warm_gym, warm_pair, warm_plant, warm_scenario_file, warm_trial
 
     from steerlab.control.registry import CONTROLLERS
     from steerlab.ships.registry import SHIPS
 
-    ships = sorted(SHIPS) if args.ships == ["all"] else args.ships
+    given = args.ships or []
+    ships = sorted(SHIPS) if given == ["all"] else (given or list(COMMON_SHIPS))
     controllers = sorted(CONTROLLERS) if args.controllers == ["all"] else args.controllers
     pairs = [(s, c) for s in ships for c in controllers]
-    for s, c in pairs:            # validate every name before compiling anything
+    for s, c in pairs:            # validate every name and file before compiling anything
         get_ship(s)
         get_controller(c)
+    for path in args.scenario:
+        load_scenario(path)
+    jobs = [(f"{s} + {c}", warm_pair, (s, c, args.batch)) for s, c in pairs]
+    jobs += [(f"{s} plant step", warm_plant, (s,)) for s in ships if args.plants]
+    jobs += [(f"{s} trial loop", warm_trial, (s,)) for s in ships if args.trials]
+    jobs += [(str(path), warm_scenario_file, (path, args.batch)) for path in args.scenario]
     from steerlab.cli import _progress
     from steerlab.progress import runs_progress
 
     say = _progress(args.quiet)
     report = runs_progress(say, "combinations", period=0.0)
-    for i, (s, c) in enumerate(pairs):
-        status = warm_pair(s, c, batch=args.batch)
+    for i, (what, warm, warm_args) in enumerate(jobs):
+        status = warm(*warm_args)
         if status != "ok":
-            say(f"{s} + {c}: {status}")
-        report(i + 1, len(pairs))
+            say(f"{what}: {status}")
+        report(i + 1, len(jobs))
     if args.gym:
-        warm_gym()
+        warm_gym(("esso", *(ships if given else ())))
     if not args.quiet:
-        print(f"warm: {len(pairs)} combination(s) compiled or already cached in "
+        print(f"warm: {len(jobs)} combination(s) compiled or already cached in "
               f"{drivers.drivers_dir()}", file=sys.stderr)
     return 0

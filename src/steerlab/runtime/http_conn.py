@@ -28,6 +28,11 @@ from websockets.protocol import CONNECTING, Protocol
 
 MAX_BODY = 65536          #: largest request body read (and discarded) before answering [bytes]
 ALLOW = "GET"             #: the only method served
+CLOSE_TIMEOUT = 2.0
+"""Longest wait [s] for a client to close its side (a WebSocket's closing handshake, or the TCP
+connection after an HTTP answer) when a connection or the server closes; then the connection
+is dropped. websockets' default, 10 s, let one client that keeps its socket open after a 404
+hold up the server's shutdown for 10 s."""
 
 
 def plain(status: HTTPStatus, text: str, extra=()) -> Response:

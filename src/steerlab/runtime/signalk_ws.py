@@ -50,7 +50,7 @@ from websockets.asyncio.server import broadcast, serve
 
 from steerlab.errors import InputError
 from steerlab.runtime.access import AccessPolicy, parse_json
-from steerlab.runtime.http_conn import HttpConnection
+from steerlab.runtime.http_conn import CLOSE_TIMEOUT, HttpConnection
 from steerlab.runtime.path_glob import PathPattern
 from steerlab.runtime.rate_limit import RateLimiter
 from steerlab.runtime.signalk import MAX_DELTA_BYTES, SELF_ID, delta, is_self_context, iso_time
@@ -279,7 +279,7 @@ class SignalKStreamServer:
         try:
             self.server = await serve(self._handler, self.host, self.port, process_request=self._process_request,
                                       max_size=MAX_DELTA_BYTES, compression=None, server_header=None,
-                                      create_connection=HttpConnection)
+                                      create_connection=HttpConnection, close_timeout=CLOSE_TIMEOUT)
         except OSError as err:
             raise InputError(self.field, f"cannot bind {self.host}:{self.port}: {err.strerror}") from None
         return self

@@ -32,7 +32,7 @@ from websockets.http11 import Response
 
 from steerlab.errors import InputError
 from steerlab.runtime.access import AccessPolicy, parse_json
-from steerlab.runtime.http_conn import HttpConnection
+from steerlab.runtime.http_conn import CLOSE_TIMEOUT, HttpConnection
 from steerlab.runtime.rate_limit import RateLimiter
 
 STATIC = {"/": ("bridge.html", "text/html; charset=utf-8"),
@@ -176,7 +176,7 @@ class BridgeServer:
         try:
             self.server = await serve(self._handler, self.host, self.port,
                                       process_request=self._process_request, max_size=4096,
-                                      compression=None, server_header=None, create_connection=HttpConnection)
+                                      compression=None, server_header=None, create_connection=HttpConnection, close_timeout=CLOSE_TIMEOUT)
         except OSError as err:
             raise InputError("--web", f"cannot bind {self.host}:{self.port}: {err.strerror}") from None
         return self

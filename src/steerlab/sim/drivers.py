@@ -224,6 +224,9 @@ def _from_disk(key: _Key, text: str) -> types.ModuleType:
             raise
     for entry in mod.ENTRY_POINTS:
         _check_cache_files(getattr(mod, entry))
+    from steerlab.sim import vector_reports
+
+    vector_reports.install()      # a vectorised entry compiled here leaves its report beside the module
     mod._steerlab_cached = True
     mod._steerlab_label = describe_key(key.ship, key.ctrl, key.guide)
     return mod

@@ -167,12 +167,6 @@ def batch_loop(ship_rhs, ctrl_update, nx: int, lanes: int = LANES, guide=None):
     return run_batch
 
 
-# library functions a vectorised loop may still call per lane element: cheap, exact intrinsics
-_CHEAP_VECTOR_INTRINSICS = frozenset({
-    "fabs", "floor", "ceil", "trunc", "rint", "round", "sqrt", "copysign", "minnum", "maxnum",
-    "minimum", "maximum", "smax", "smin", "umax", "umin", "masked"})
-
-
 def vectorisation_report(ship_rhs, ctrl_update, nx: int, guide=None, lanes: int = LANES) -> dict:
     """How the compiled group of a (ship, controller, guidance) combination was vectorised.
 
@@ -183,8 +177,10 @@ def vectorisation_report(ship_rhs, ctrl_update, nx: int, guide=None, lanes: int 
     arithmetic, 4 when all RK4 stages are vectorised; the list names library functions the
     vectoriser could only call once per run (``sin``, ``exp`` ...: such a kernel is vectorised
     in name only). A kernel with branches, loops or library calls gives 0 stages.
-    Machine code loaded from the disk cache has no IR to show: the same driver is then
-    compiled once in this process for the inspection (:func:`steerlab.sim.drivers.in_memory_twin`).
+    Machine code loaded from the disk cache has no IR to show: its report is the one read from
+    the IR when it was compiled and kept beside the driver (:mod:`steerlab.sim.vector_reports`);
+    without it, the same driver is compiled once in this process for the inspection
+    (:func:`steerlab.sim.drivers.in_memory_twin`).
     """
     g = course_guide if guide is None else guide
     return _report(ship_rhs, ctrl_update, g, int(nx), int(lanes), "group",
@@ -203,23 +199,19 @@ def plant_lanes_report(ship_rhs, nx: int, lanes: int = LANES) -> dict:
 
 
 def _report(ship_rhs, ctrl_update, guide, nx: int, lanes: int, name: str, not_compiled: str) -> dict:
-    import re
-    import struct
-
-    from steerlab import sincos as sincos_module
     from steerlab.sim.drivers import cached_signatures, driver, in_memory_twin
+    from steerlab.sim.vector_reports import report_from_ir, stored
 
     disp = getattr(driver(ship_rhs, ctrl_update, guide, nx, lanes), name)
     sigs = list(disp.signatures) or cached_signatures(disp)
     if not sigs:
         raise RuntimeError(not_compiled)
     if not disp.signatures or any(disp.stats.cache_hits.values()):   # machine code from numba's cache
+        report = stored(disp, sigs)               # read from the IR when it was compiled
+        if report is not None:
+            return report
         twin = getattr(in_memory_twin(ship_rhs, ctrl_update, guide, nx, lanes), name)   # has no IR: a twin
         for sig in sigs:
             twin.compile(sig)
         disp = twin
-    ir = "\n".join(disp.inspect_llvm().values())
-    s1 = "0x%016X" % struct.unpack("<Q", struct.pack("<d", sincos_module._S1))[0]
-    stages = sum(1 for line in ir.splitlines() if s1 in line and "x double>" in line)
-    calls = set(re.findall(r"@llvm\.(\w+)\.[\w.]*v\d+f64", ir)) - _CHEAP_VECTOR_INTRINSICS
-    return {"vectorised_stages": stages, "per_run_library_calls": sorted(calls)}
+    return report_from_ir("\n".join(disp.inspect_llvm().values()))

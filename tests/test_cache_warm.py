@@ -1,0 +1,93 @@
+"""``steerlab cache warm``'s plant steps, trial loops and scenario files (issue 14): each warms
+exactly what the real use then runs (no new driver, no new compiled signature afterwards),
+and bad input is one line, exit 2, before anything compiles."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from steerlab.cli import main
+
+REPO = Path(__file__).resolve().parent.parent
+LOS_ROUTE = REPO / "examples" / "scenarios" / "los-route.toml"
+
+
+def _compiled_signatures() -> dict:
+    """Every compiled (or loaded) signature of every entry point of the drivers in this process."""
+    out = {}
+    for name, mod in list(sys.modules.items()):
+        if name.startswith("steerlab_driver_") and hasattr(mod, "ENTRY_POINTS"):
+            for entry in mod.ENTRY_POINTS:
+                disp = getattr(mod, entry, None)
+                out[(name, entry)] = frozenset(getattr(disp, "signatures", ()))
+    return {k: v for k, v in out.items() if v}
+
+
+def _assert_warmed(warm, use):
+    warm()
+    before = _compiled_signatures()
+    use()
+    after = _compiled_signatures()
+    assert after == before, sorted(set(after.items()) - set(before.items()))
+
+
+def test_plant_warm_covers_the_readable_loop_and_identifications_replay():
+    from steerlab.identification.response import simulate_response
+    from steerlab.sim.engine import simulate
+    from steerlab.sim.setup import build
+    from steerlab.sim.warm import warm_plant, warm_scenario
+    from steerlab.ships.registry import get_ship
+
+    def use():
+        res = simulate(build(warm_scenario("nomoto2", "pid")), "readable")
+        assert np.isfinite(res.states).all()
+        spec = get_ship("nomoto2")
+        psi, r = simulate_response(spec.rhs, spec.n_states, build(warm_scenario("nomoto2", "pid")).ps,
+                                   np.full(50, 0.1), 0.5, speed=5.0)
+        assert r[-1] > 0.0                                  # starboard rudder, starboard turn
+
+    _assert_warmed(lambda: warm_plant("nomoto2"), use)
+
+
+def test_trial_warm_covers_a_zigzag_trial():
+    from steerlab.sim.warm import warm_trial
+    from steerlab.trials.api import run_trial
+    from steerlab.trials.runner import TrialConditions
+
+    def use():
+        _, metrics = run_trial("zigzag", TrialConditions("norrbin"), rudder_deg=10.0, heading_deg=10.0)
+        assert len(metrics["overshoot_angles_deg"]) >= 2
+
+    _assert_warmed(lambda: warm_trial("norrbin"), use)
+
+
+def test_scenario_warm_covers_its_single_run_and_batch():
+    import steerlab as sl
+    from steerlab.sim.batch import simulate_batch
+    from steerlab.sim.scenario import load_scenario
+    from steerlab.sim.setup import build
+    from steerlab.sim.warm import warm_scenario_file
+
+    def use():
+        setup = build(load_scenario(LOS_ROUTE))
+        single = sl.simulate(setup)
+        batch = simulate_batch([setup, setup])
+        np.testing.assert_array_equal(batch.final_states[1], single.states[-1])
+
+    _assert_warmed(lambda: warm_scenario_file(LOS_ROUTE, batch=True), use)
+
+
+@pytest.mark.parametrize("argv, field", [
+    (["--scenario", "no-such-file.toml"], "scenario"),
+    (["--ships", "no-such-ship", "--plants"], "ship"),
+])
+def test_bad_warm_input_is_one_line_and_exit_2(argv, field, capsys, monkeypatch, tmp_path):
+    monkeypatch.setenv("STEERLAB_CACHE_DIR", str(tmp_path))
+    assert main(["cache", "warm", "--quiet", *argv]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and field in err, err
+    assert not any(tmp_path.rglob("*.nbi"))                 # nothing compiled before the refusal
