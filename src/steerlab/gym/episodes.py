@@ -155,7 +155,9 @@ class Episodes:
         kernels = env_kernels(s0.ship.rhs, self.guide, nx)      # compiled once ever (disk cache)
         if self.vectorised:
             self._vstep = entry(kernels, "step")
-            self._kernels, self._par, self._cuts = kernels, {}, {}
+            self._kernels = kernels
+            self._par: dict[str, Any] = {}                   # threaded entry points, taken on first use
+            self._cuts: dict[int, np.ndarray] = {}           # range bounds per thread count
         else:
             self._step = entry(kernels, "step_serial")
         self._reset = entry(kernels, "reset")
