@@ -119,22 +119,6 @@ def _real_part_skips(terminalreporter) -> list:
     return out
 
 
-def pytest_xdist_auto_num_workers(config):
-    """``-n auto``: one worker per core plus one. Some tests spend seconds waiting on real parts
-    (sockets, subprocesses, a browser, real-time runs), which an extra worker fills: on the
-    2-core CI machine, with every driver cached, 3 workers ran the suite in 158 s against
-    172 s for 2 (same tests, 2026-11-26). ``-n N`` or ``PYTEST_XDIST_AUTO_NUM_WORKERS`` still
-    set the number. Cores as xdist counts them: those this process may run on."""
-    env = os.environ.get("PYTEST_XDIST_AUTO_NUM_WORKERS")
-    if env:
-        return int(env)
-    try:
-        cores = len(os.sched_getaffinity(0))
-    except AttributeError:                        # not Linux
-        cores = os.cpu_count() or 1
-    return cores + 1
-
-
 def pytest_terminal_summary(terminalreporter, exitstatus, config):
     if os.environ.get("STEERLAB_REQUIRE_REAL_PARTS") != "1":
         return
