@@ -39,7 +39,7 @@ import numpy as np
 from steerlab.angles import wrap_to_pi
 from steerlab.guidance.reference_vector import REF_PSI, REF_RPM
 from steerlab.gym.lane_seas import draw_episode, fill_rows
-from steerlab.gym.plant_batch import R_MAX, REWARD_ITAE, REWARD_SPEED_LOSS
+from steerlab.gym.plant_batch import OBS_DELTA, OBS_E, OBS_R, R_MAX, REWARD_ITAE, REWARD_SPEED_LOSS
 from steerlab.sim.kernels import _fused, _jit_fused, plant_step
 from steerlab.ships.state import IPSI, IR
 
@@ -64,7 +64,6 @@ if SHIP_RHS is not None:
     plants = _driver(SHIP_RHS, None, None, NX, LANES).step_lanes   # the vectorised plant step
     rk4_step = plant_step(SHIP_RHS)                                 # the engines' scalar step
 reference = _fused(GUIDE)       # inlined, no reference counting: as the engines' loops call it
-wrap = _fused(wrap_to_pi)
 
 
 @_jit_fused
@@ -95,11 +94,9 @@ def finish(i, X, K, J, dt, nc, gd, GZ, REF, PS, rpm_slot, lam, reward, obs, rew,
         reference(K[i] * dt, x, gd, GZ[i], ref, h_env)
         if rpm_slot >= 0 and ref[REF_RPM] >= 0.0:
             PS[i, rpm_slot] = ref[REF_RPM]
-        e = wrap(ref[REF_PSI] - x[IPSI])
-        d = x[nx - 1]
-        obs[i, 0] = e
-        obs[i, 1] = x[IR]
-        obs[i, 2] = d
+        observe(x, ref[REF_PSI], obs[i])
+        e = obs[i, OBS_E]
+        d = obs[i, OBS_DELTA]
         if reward == REWARD_SPEED_LOSS:
             rew[i] = -(e * e + lam * d * d) * h_env
         elif reward == REWARD_ITAE:
@@ -107,9 +104,7 @@ def finish(i, X, K, J, dt, nc, gd, GZ, REF, PS, rpm_slot, lam, reward, obs, rew,
         else:
             rew[i] = -abs(e) * h_env
     else:
-        obs[i, 0] = 0.0
-        obs[i, 1] = 0.0
-        obs[i, 2] = 0.0
+        obs[i, :] = 0.0
         rew[i] = 0.0
 
 
@@ -282,6 +277,6 @@ def reset(idx, KEY, EP, S, Z, scale, offset_max, X, K, J, cmd, PS, GZ, REF, x0, 
 @numba.njit
 def observe(x, psi_ref, out):
     """The observation ``[wrap(psi_ref - psi), r, delta]`` of plant state ``x``."""
-    out[0] = wrap_to_pi(psi_ref - x[IPSI])
-    out[1] = x[IR]
-    out[2] = x[x.shape[0] - 1]
+    out[OBS_E] = wrap_to_pi(psi_ref - x[IPSI])
+    out[OBS_R] = x[IR]
+    out[OBS_DELTA] = x[x.shape[0] - 1]

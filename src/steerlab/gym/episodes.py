@@ -59,9 +59,7 @@ it, one call in the calling thread. A step of 1024 ships at the default ``contro
 some 260-285 us on one core of the 2-core development VM (0.25 us per ship); see
 ``benchmarks/README.md`` for what the threads give there. ``numba.set_num_threads(1)`` keeps
 the env on one thread."""
-N_OBS = 3
-OBS_NAMES = ("heading_error", "yaw_rate", "rudder")
-OBS_UNITS = ("rad", "rad/s", "rad")
+from steerlab.gym.plant_batch import N_OBS, OBS_NAMES, OBS_UNITS  # noqa: E402,F401  (the layout, declared there)
 
 
 def _scenario(task, ship, speed_kn, gear, environment, ship_options, dt, episode_s, change_deg, change_t,

@@ -41,6 +41,11 @@ from pathlib import Path
 
 REWARDS = ("speed_loss", "itae", "iae")
 REWARD_SPEED_LOSS, REWARD_ITAE, REWARD_IAE = 0, 1, 2
+OBS_NAMES = ("heading_error", "yaw_rate", "rudder")
+"""The observation vector's fields, in order (:func:`steerlab.gym.env_template.observe`)."""
+OBS_UNITS = ("rad", "rad/s", "rad")
+N_OBS = len(OBS_NAMES)
+OBS_E, OBS_R, OBS_DELTA = range(N_OBS)   #: indices of heading error, yaw rate, rudder angle
 R_MAX = math.pi   #: |r| [rad/s] beyond which a ship counts as diverged (180 deg/s; the observation bound)
 
 
