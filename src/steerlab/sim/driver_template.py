@@ -39,6 +39,7 @@ import numba
 import numpy as np
 
 from steerlab.angles import wrap_to_pi
+from steerlab.environment.channels import N_CHANNELS
 from steerlab.guidance.reference_vector import N_REF, REF_LEG, REF_PSI, REF_RPM, REF_XTE
 from steerlab.metrics_online import accumulate
 from steerlab.sim.kernels import _fused, _jit_fused, rk4_stage, rk4_update
@@ -357,31 +358,34 @@ def store_plants(X, idx, i0, n_act, XL):
 
 
 @_jit_fused
-def rk4_plants(n_act, T, CMD, dt, h2, s6, XL, PL, PGL, WL, K1, K2, K3, K4, XT):
+def rk4_plants(n_act, T, CMD, dt, h2, s6, XL, PL, PGL, WL, K1, K2, K3, K4, XT, XLf, K1f, K2f, K3f, K4f, XTf):
     """One RK4 step of every plant of the group, each at its own time ``T[g]`` [s] with its own
     held order ``CMD[g]`` and disturbance column ``WL[:, g]``: :func:`rk4_lanes`' stages
-    (per plant the operations of :func:`rk4`), without the metrics accumulator."""
-    # the loops over g below are the vectorised ones: keep their bodies free of calls
+    (per plant the operations of :func:`rk4`), without the metrics accumulator.
+
+    ``XLf, K1f, ..., XTf`` are flat ``(NX * LANES,)`` views of ``XL, K1, ..., XT``: the
+    element-wise stage inputs and the update run over all of them in one loop of a constant
+    length (every column, those past ``n_act`` included, which no one reads), which the
+    compiler vectorises at full width; loops over ``g < n_act`` are too short for its
+    unrolled vector body and ran in its narrower remainder. Per plant the operations are the
+    same."""
+    # the loops below are the vectorised ones: keep their bodies free of calls
     for g in range(n_act):
         plant_rhs(T[g], XL[:, g], CMD[g], WL[:, g], PL[:, g], PGL[:, g], K1[:, g])
-    for q in range(NX):
-        for g in range(n_act):
-            XT[q, g] = rk4_stage(XL[q, g], h2, K1[q, g])
+    for j in range(NX * G):
+        XTf[j] = rk4_stage(XLf[j], h2, K1f[j])
     for g in range(n_act):
         plant_rhs(T[g] + h2, XT[:, g], CMD[g], WL[:, g], PL[:, g], PGL[:, g], K2[:, g])
-    for q in range(NX):
-        for g in range(n_act):
-            XT[q, g] = rk4_stage(XL[q, g], h2, K2[q, g])
+    for j in range(NX * G):
+        XTf[j] = rk4_stage(XLf[j], h2, K2f[j])
     for g in range(n_act):
         plant_rhs(T[g] + h2, XT[:, g], CMD[g], WL[:, g], PL[:, g], PGL[:, g], K3[:, g])
-    for q in range(NX):
-        for g in range(n_act):
-            XT[q, g] = rk4_stage(XL[q, g], dt, K3[q, g])
+    for j in range(NX * G):
+        XTf[j] = rk4_stage(XLf[j], dt, K3f[j])
     for g in range(n_act):
         plant_rhs(T[g] + dt, XT[:, g], CMD[g], WL[:, g], PL[:, g], PGL[:, g], K4[:, g])
-    for q in range(NX):
-        for g in range(n_act):
-            XL[q, g] = rk4_update(XL[q, g], s6, K1[q, g], K2[q, g], K3[q, g], K4[q, g])
+    for j in range(NX * G):
+        XLf[j] = rk4_update(XLf[j], s6, K1f[j], K2f[j], K3f[j], K4f[j])
     for g in range(n_act):
         XL[NX - 1, g] = clamp(XL[NX - 1, g], PGL[:, g])
 
@@ -393,7 +397,7 @@ def step_lanes(X, K, CMD, W, w_index, PS, PG, idx, dt, n_sub):
     ``X`` (N, NX) plant states ``[ship states..., delta]``; ``K`` (N,) int64 plant-step
     counters: plant ``i``'s step ``k = K[i]`` runs from ``t = k dt`` with disturbance row
     ``W[w_index[i], k]`` (``W``: a stack of disturbance sequences, ``(n_seas, n_rows,
-    channels)``, shared by index as in the batch engine), and ``K[i]`` advances by ``n_sub``;
+    N_CHANNELS)``, shared by index as in the batch engine), and ``K[i]`` advances by ``n_sub``;
     ``CMD`` (N,) rudder orders [rad], held; ``PS``, ``PG`` (N, .) packed ship and gear
     records; ``idx`` (M,) int64 the plants to advance (others untouched). The plants go
     through in groups of ``LANES``, structure of arrays, each RK4 stage vectorised across the
@@ -401,7 +405,15 @@ def step_lanes(X, K, CMD, W, w_index, PS, PG, idx, dt, n_sub):
     :func:`rk4_step` called ``n_sub`` times with ``t = k * dt``, so each plant's numbers are
     bit-identical to that scalar step's, whatever N, ``idx`` or the other plants.
     """
+    if W.shape[2] != N_CHANNELS:
+        raise ValueError("disturbance rows must have N_CHANNELS channels")
     XL, PL, PGL, WL, K1, K2, K3, K4, XT, CL, TL, _ = scratch(PS.shape[1], PG.shape[1], W.shape[2])
+    for a in (XL, K1, K2, K3, K4, XT):      # the columns past a short group's plants: finite
+        a[:, :] = 0.0
+    flat = (XL.reshape(NX * G), K1.reshape(NX * G), K2.reshape(NX * G), K3.reshape(NX * G),
+            K4.reshape(NX * G), XT.reshape(NX * G))
+    WI = np.empty(G, dtype=np.int64)        # the group's disturbance sequences and first rows
+    K0 = np.empty(G, dtype=np.int64)
     h2 = 0.5 * dt
     s6 = dt / 6.0
     m = idx.shape[0]
@@ -409,16 +421,18 @@ def step_lanes(X, K, CMD, W, w_index, PS, PG, idx, dt, n_sub):
         n_act = min(G, m - i0)
         load_plants(X, PS, PG, idx, i0, n_act, XL, PL, PGL)
         for g in range(n_act):
-            CL[g] = CMD[idx[i0 + g]]
+            i = idx[i0 + g]
+            CL[g] = CMD[i]
+            WI[g] = w_index[i]
+            K0[g] = K[i]
         for s in range(n_sub):
             for g in range(n_act):
-                i = idx[i0 + g]
-                k = K[i] + s
+                k = K0[g] + s
                 TL[g] = k * dt
-                row = W[w_index[i], k]
-                for c in range(row.shape[0]):
+                row = W[WI[g], k]
+                for c in range(N_CHANNELS):     # a constant count: the copy is unrolled
                     WL[c, g] = row[c]
-            rk4_plants(n_act, TL, CL, dt, h2, s6, XL, PL, PGL, WL, K1, K2, K3, K4, XT)
+            rk4_plants(n_act, TL, CL, dt, h2, s6, XL, PL, PGL, WL, K1, K2, K3, K4, XT, *flat)
         store_plants(X, idx, i0, n_act, XL)
         for g in range(n_act):
             K[idx[i0 + g]] += n_sub
