@@ -120,7 +120,7 @@ def test_plain_seas_are_the_scenario_wave_model_driven_by_each_lanes_philox_norm
     """A plain sea's rows, written lazily env step by env step, equal the scenario machinery's
     sea (seed-free channels of ``realise``, eq-39 filter of the held samples as
     ``build_disturbances`` does it in one pass) driven by the lane's own Philox normals."""
-    from steerlab.environment.disturbance import W_RUDDER, _fill
+    from steerlab.environment.disturbance import N_CHANNELS, W_RUDDER, _fill
     from steerlab.environment.iir_filter import _padded
     from steerlab.environment.waves import band_pass_eq39
     from steerlab.gym.philox import seed_key
@@ -135,11 +135,16 @@ def test_plain_seas_are_the_scenario_wave_model_driven_by_each_lanes_philox_norm
     venv.step(np.zeros((5, 1), dtype=np.float32))
     infos = core.reset_lanes([4, 1, 2], [11, 12, 11])   # lanes 4 and 2 keyed 11 again, episode 0; lane 1 12
     assert [d["episode"] for d in infos] == [0, 0, 0]
-    for _ in range(int(KW["episode_s"])):              # every row the plants read, in 30 env steps
-        venv.step(np.full((5, 1), 0.3, dtype=np.float32))
-    assert (core.J[[4, 1, 2]] == 30).all()
     sc = core.scenario
     n_read = sc.n_steps                               # rows 0 .. n_steps - 1 are read by the plant steps
+    assert core.W.shape == (5, core.nc, N_CHANNELS)   # a lane holds only its env step's rows
+    read = np.full((5, n_read, core.W.shape[2]), np.nan)
+    for _ in range(int(KW["episode_s"])):              # every row the plants read, in 30 env steps
+        k0 = core.K.copy()
+        venv.step(np.full((5, 1), 0.3, dtype=np.float32))
+        for i in (4, 1, 2):
+            read[i, k0[i]:k0[i] + core.nc] = core.W[i]
+    assert (core.J[[4, 1, 2]] == 30).all()
     ref = realise(core.design, 123).w
     b, a = _padded(*band_pass_eq39(sc.dt))
     dist = core.design.dist
@@ -150,11 +155,11 @@ def test_plain_seas_are_the_scenario_wave_model_driven_by_each_lanes_philox_norm
         np.testing.assert_array_equal(core.S[i], z * scale)
         one_pass = np.empty((1,) + ref.shape)
         _fill(one_pass, np.array([0]), core._base, core.S[i:i + 1], core._hold, b, a, W_RUDDER)
-        np.testing.assert_array_equal(core.W[i, :n_read], one_pass[0, :n_read])
+        np.testing.assert_array_equal(read[i], one_pass[0, :n_read])
         others = [c for c in range(ref.shape[1]) if c != W_RUDDER]
-        np.testing.assert_array_equal(core.W[i][:, others], ref[:, others])   # seed-free channels
-    np.testing.assert_array_equal(core.W[4, :n_read], core.W[2, :n_read])      # same seed, same sea
-    assert not np.array_equal(core.W[1, :n_read], core.W[2, :n_read])
+        np.testing.assert_array_equal(read[i][:, others], ref[:n_read, others])   # seed-free channels
+    np.testing.assert_array_equal(read[4], read[2])                              # same seed, same sea
+    assert not np.array_equal(read[1], read[2])
 
 
 def _ziggurat_normals(k0, k1, episode, n):

@@ -21,6 +21,36 @@ def test_first_order_bit_identical_to_scipy(pole):
     np.testing.assert_array_equal(lfilter([1.0], [1.0, -pole], x), scipy_lfilter([1.0], [1.0, -pole], x))
 
 
+@pytest.mark.parametrize("dt", [0.1, 0.5])
+def test_second_order_step_with_scalar_state_equals_the_array_step(dt):
+    """df2_step2 (state in two floats: the gym's lazily filtered seas) gives df2_step's bits, and
+    both scipy's, sample by sample; signed zeros and a non-zero start included."""
+    import numba
+
+    from steerlab.environment.iir_filter import _padded, df2_step, df2_step2
+
+    @numba.njit
+    def both(b, a, x, z_start, y1, y2):
+        z = z_start.copy()
+        z0, z1 = z_start[0], z_start[1]
+        for k in range(x.shape[0]):
+            y1[k] = df2_step(b, a, z, x[k])
+            y2[k], z0, z1 = df2_step2(b, a, z0, z1, x[k])
+        return z, z0, z1
+
+    b, a = _padded(*band_pass_eq39(dt))
+    assert b.shape == (3,)
+    x = np.random.default_rng(5).standard_normal(5_000) * 0.01
+    x[:4] = [0.0, -0.0, -0.0, 0.0]
+    for z_start in (np.zeros(2), np.array([-0.0, -0.0]), np.array([0.3, -0.2])):
+        y1, y2 = np.empty_like(x), np.empty_like(x)
+        z, z0, z1 = both(b, a, x, z_start, y1, y2)
+        assert y1.tobytes() == y2.tobytes() and z.tobytes() == np.array([z0, z1]).tobytes()
+    y1, y2 = np.empty_like(x), np.empty_like(x)
+    both(b, a, x, np.zeros(2), y1, y2)
+    assert y2.tobytes() == scipy_lfilter(b, a, x).tobytes()
+
+
 def test_fir_and_impulse_response():
     x = np.zeros(6)
     x[0] = 1.0

@@ -18,19 +18,47 @@ import numpy as np
 
 
 @numba.njit(inline="always")
+def df2_out(z0, b0, xk):
+    """The transposed direct form II's output ``y[k] = z[0] + b[0] x[k]``."""
+    return z0 + b0 * xk
+
+
+@numba.njit(inline="always")
+def df2_next(z_next, xk, bi, yk, ai):
+    """A state's next value ``z[i] = z[i + 1] + b[i + 1] x[k] - a[i + 1] y[k]`` (operands in
+    :func:`lfilter`'s order)."""
+    return z_next + xk * bi - yk * ai
+
+
+@numba.njit(inline="always")
+def df2_last(xk, bn, yk, an):
+    """The last state's next value ``z[n - 2] = b[n - 1] x[k] - a[n - 1] y[k]``."""
+    return xk * bn - yk * an
+
+
+@numba.njit(inline="always")
 def df2_step(b, a, z, xk):
     """One sample of the transposed direct form II: returns ``y[k]`` for input ``xk`` and
     advances the state ``z`` (``max(len(b) - 1, 1)`` floats, zeros at rest) in place. Filtering
     a sequence sample by sample with it gives the bits of :func:`lfilter` (the same loop)."""
     n = b.shape[0]
     if n > 1:
-        yk = z[0] + b[0] * xk
+        yk = df2_out(z[0], b[0], xk)
         for i in range(n - 2):
-            z[i] = z[i + 1] + xk * b[i + 1] - yk * a[i + 1]
-        z[n - 2] = xk * b[n - 1] - yk * a[n - 1]
+            z[i] = df2_next(z[i + 1], xk, b[i + 1], yk, a[i + 1])
+        z[n - 2] = df2_last(xk, b[n - 1], yk, a[n - 1])
     else:
         yk = xk * b[0]
     return yk
+
+
+@numba.njit(inline="always")
+def df2_step2(b, a, z0, z1, xk):
+    """:func:`df2_step` of a second-order section (``b``, ``a`` of 3 coefficients) whose state
+    is two floats instead of an array (so it stays in registers): returns ``(y[k], z0, z1)``,
+    the same bits."""
+    yk = df2_out(z0, b[0], xk)
+    return yk, df2_next(z1, xk, b[1], yk, a[1]), df2_last(xk, b[2], yk, a[2])
 
 
 @numba.njit(cache=True)

@@ -118,19 +118,21 @@ def step_serial(X, K, J, cmd, W, PS, PG, dt, nc, gd, GZ, REF, rpm_slot, lam, rew
     ``PG`` packed ship and gear records, ``gd`` the guidance record, ``GZ`` (N, n_gz) guidance
     states and ``REF`` (N, N_REF) reference vectors (advanced in place); ``active`` (N,) lanes
     to step; writes ``obs`` (N, 3), ``rew`` (N,), ``bad`` (N,) (:func:`finish`). ``work`` is
-    a (5, nx) scratch array. With ``lazy`` the env step's disturbance rows of channel ``ch``
-    are written first (:func:`steerlab.gym.lane_seas.fill_rows`: samples ``S``, filter
-    ``fb/fa`` state ``Z``, seed-free rows ``base``, ``hold`` rows per sample).
+    a (5, nx) scratch array. With ``lazy`` ``W`` (N, nc, channels) holds only the env step's
+    rows, written first (:func:`steerlab.gym.lane_seas.fill_rows`: samples ``S``, filter
+    ``fb/fa`` state ``Z`` of channel ``ch``, seed-free rows ``base``, ``hold`` rows per sample);
+    else ``W`` holds every lane's whole sequence.
     """
     for i in range(X.shape[0]):
         if not active[i]:
             continue
+        k0 = K[i]
         if lazy:
-            fill_rows(i, K[i], nc, W, S, Z, base, hold, fb, fa, ch)
+            fill_rows(i, k0, nc, W, S, Z, base, hold, fb, fa, ch)
         x = X[i]
-        for _ in range(nc):
-            k = K[i]
-            rk4_step(k * dt, x, cmd[i], W[i, k], PS[i], PG[i], dt, work)
+        for j in range(nc):
+            k = k0 + j
+            rk4_step(k * dt, x, cmd[i], W[i, j if lazy else k], PS[i], PG[i], dt, work)
             K[i] = k + 1
         finish(i, X, K, J, dt, nc, gd, GZ, REF, PS, rpm_slot, lam, reward, obs, rew, bad)
 
@@ -171,7 +173,7 @@ def step(lo, hi, A, redo, X, K, J, cmd, W, w_index, PS, PG, dt, nc, gd, GZ, REF,
             if lazy:
                 fill_rows(i, K[i], nc, W, S, Z, base, hold, fb, fa, ch)
     idx = idx[:m]
-    plants(X, K, cmd, W, w_index, PS, PG, idx, dt, nc)
+    plants(X, K, cmd, W, w_index, PS, PG, idx, dt, nc, lazy)
     for q in range(m):
         i = idx[q]
         finish(i, X, K, J, dt, nc, gd, GZ, REF, PS, rpm_slot, lam, reward, obs, rew, bad)

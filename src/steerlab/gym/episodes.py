@@ -132,7 +132,6 @@ class Episodes:
         self.X = np.zeros((n, nx))
         self.K = np.zeros(n, dtype=np.int64)
         self.J = np.zeros(n, dtype=np.int64)
-        self.W = np.zeros((n,) + s0.w.shape)
         self.PS = np.tile(s0.ps, (n, 1))
         self.PG = np.tile(s0.pg, (n, 1))
         self.GZ = np.tile(s0.gz0, (n, 1))
@@ -166,12 +165,16 @@ class Episodes:
         self.keyed = np.zeros(n, dtype=np.bool_)
         self._sea_seeds = np.zeros(n, dtype=np.int64)
         dist, sc = self.design.dist, self.scenario
-        # a plain sea's wave channel is filtered lazily from the lane's draws; its other channels
-        # are seed-free and written once
+        # a plain sea's wave channel is filtered lazily from the lane's draws, added to its
+        # seed-free channels (base); W holds every lane's disturbance rows: a lazy sea's lanes
+        # only their env step's nc rows (written by the step, lane_seas.fill_rows), the others
+        # their whole sequence
         self.lazy = self._fast_seas and bool(dist.waves)
+        self.W = np.zeros((n, nc if self.lazy else s0.w.shape[0], s0.w.shape[1]))
         if self._fast_seas:
             self._base = build_disturbance(replace(dist, waves=False), sc.n_steps, sc.dt, 0)
-            self.W[:] = self._base
+            if not self.lazy:
+                self.W[:] = self._base
         else:
             self._base = np.zeros((1, N_CHANNELS))
             self.W[:] = s0.w
@@ -179,6 +182,8 @@ class Episodes:
             hold, n_samples = _hold(sc.n_steps, sc.dt, dist.wave_sample_time, dist.wave_power)
             self._scale = math.sqrt(dist.wave_power / dist.wave_sample_time)
             self._fb, self._fa = _padded(*band_pass_eq39(sc.dt))
+            if self._fb.shape != (3,):      # lane_seas.fill_rows filters a second-order section
+                raise ValueError(f"the wave filter must be of second order, got {self._fb.shape[0] - 1}")
         else:
             hold, n_samples, self._scale = 1, 0, 0.0
             self._fb, self._fa = np.zeros(1), np.ones(1)

@@ -19,8 +19,9 @@ default ``{"waves": True}``) is the scenario's eq-39 wave disturbance
 ZOH filter and sum with the seed-free channels) driven by these normals instead of
 ``numpy.random.default_rng(seed)``'s. It is written lazily (:func:`fill_rows`), the rows of
 an env step just before its plant steps read them, one filter sample at a time
-(:func:`steerlab.environment.iir_filter.df2_step`), so a reset costs no pass over the
-episode's disturbance rows and builds no generator object: bit-identical to filtering the
+(:func:`steerlab.environment.iir_filter.df2_step2`), into a lane's few rows of the env step
+(not a whole episode's sequence: those rows stay in the cache), so a reset costs no pass over
+the episode's disturbance rows and builds no generator object: bit-identical to filtering the
 whole sequence at once (``tests/test_gym_lanes.py``).
 """
 
@@ -29,7 +30,8 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-from steerlab.environment.iir_filter import df2_step
+from steerlab.environment.channels import N_CHANNELS
+from steerlab.environment.iir_filter import df2_step2
 from steerlab.gym.philox import STREAM_HEADER, STREAM_NORMAL, normals, philox_block, uniform
 
 _S33 = np.uint64(33)
@@ -54,10 +56,19 @@ def draw_episode(i, KEY, EP, S, Z, scale, offset_max):
 
 @numba.njit(inline="always")
 def fill_rows(i, k0, n, W, S, Z, base, hold, b, a, ch):
-    """Rows ``k0 .. k0 + n - 1`` of lane ``i``'s disturbance ``W[i]``, channel ``ch``:
-    ``base[k, ch] + y[k]``, ``y`` the filter ``b/a`` of the held samples ``S[i, k // hold]``
-    (state ``Z[i]``, advanced; rows must come in order from 0)."""
-    z = Z[i]
+    """Rows ``k0 .. k0 + n - 1`` of lane ``i``'s disturbance into ``W[i, 0 .. n - 1]`` (the env
+    step's own rows, ``N_CHANNELS`` channels): ``base[k]``, and on channel ``ch``
+    ``base[k, ch] + y[k]``, ``y`` the filter ``b/a`` (a second-order section, eq 39's: 3
+    coefficients each) of the held samples ``S[i, k // hold]`` (state ``Z[i]``, two floats,
+    advanced; rows must come in order from 0)."""
     s = S[i]
-    for k in range(k0, k0 + n):
-        W[i, k, ch] = base[k, ch] + df2_step(b, a, z, s[k // hold])
+    z0 = Z[i, 0]
+    z1 = Z[i, 1]
+    for j in range(n):
+        k = k0 + j
+        for c in range(N_CHANNELS):         # a constant count: unrolled
+            W[i, j, c] = base[k, c]
+        y, z0, z1 = df2_step2(b, a, z0, z1, s[k // hold])
+        W[i, j, ch] = base[k, ch] + y
+    Z[i, 0] = z0
+    Z[i, 1] = z1

@@ -391,13 +391,16 @@ def rk4_plants(n_act, T, CMD, dt, h2, s6, XL, PL, PGL, WL, K1, K2, K3, K4, XT, X
 
 
 @numba.njit(nogil=True, cache=CACHE)
-def step_lanes(X, K, CMD, W, w_index, PS, PG, idx, dt, n_sub):
+def step_lanes(X, K, CMD, W, w_index, PS, PG, idx, dt, n_sub, step_rows):
     """Advance plants ``idx`` of ``X`` by ``n_sub`` RK4 steps of ``dt`` [s] each, in place.
 
     ``X`` (N, NX) plant states ``[ship states..., delta]``; ``K`` (N,) int64 plant-step
     counters: plant ``i``'s step ``k = K[i]`` runs from ``t = k dt`` with disturbance row
     ``W[w_index[i], k]`` (``W``: a stack of disturbance sequences, ``(n_seas, n_rows,
     N_CHANNELS)``, shared by index as in the batch engine), and ``K[i]`` advances by ``n_sub``;
+    with ``step_rows`` ``W[w_index[i]]`` holds only this call's ``n_sub`` rows instead (its
+    step ``K[i] + s`` reads row ``s``: a small array written just before, which stays in the
+    cache, where a whole sequence per plant is fresh memory at every step);
     ``CMD`` (N,) rudder orders [rad], held; ``PS``, ``PG`` (N, .) packed ship and gear
     records; ``idx`` (M,) int64 the plants to advance (others untouched). The plants go
     through in groups of ``LANES``, structure of arrays, each RK4 stage vectorised across the
@@ -429,7 +432,7 @@ def step_lanes(X, K, CMD, W, w_index, PS, PG, idx, dt, n_sub):
             for g in range(n_act):
                 k = K0[g] + s
                 TL[g] = k * dt
-                row = W[WI[g], k]
+                row = W[WI[g], s if step_rows else k]
                 for c in range(N_CHANNELS):     # a constant count: the copy is unrolled
                     WL[c, g] = row[c]
             rk4_plants(n_act, TL, CL, dt, h2, s6, XL, PL, PGL, WL, K1, K2, K3, K4, XT, *flat)
