@@ -97,11 +97,18 @@ def threads_pay() -> bool:
     threads at every call and leaves the calling thread waiting, does not (a threaded step of
     1024 ships took 330-390 us against 290 us in one call on the 2-core development VM with a
     core free; TBB 155-160 us). The vector environment stays on one thread where it does not
-    (:meth:`steerlab.gym.episodes.Episodes._threads`)."""
-    import numba
+    (:meth:`steerlab.gym.episodes.Episodes._threads`, at every step: the answer is kept, a
+    started layer does not change)."""
+    global _pays
+    if _pays is None:
+        import numba
 
-    num_threads()
-    return numba.threading_layer() in PAYING
+        num_threads()
+        _pays = numba.threading_layer() in PAYING
+    return _pays
+
+
+_pays: Optional[bool] = None
 
 
 def tbb_library() -> Optional[str]:
