@@ -56,7 +56,8 @@ THREADS_FROM = 512
 """Least number of lanes whose vectorised step (or reset) is spread over the threads (numba's
 ``prange``, ``step_parallel`` / ``reset_parallel`` of :mod:`steerlab.gym.env_template`); below
 it, one call in the calling thread. A step of 1024 ships at the default ``control_dt`` takes
-some 260-285 us on one core of the 2-core development VM (0.25 us per ship); see
+some 165-175 us on one core of the 2-core development VM (0.17 us per ship; 260-285 us before
+the step was made cheaper, 2026-11-26), about 100 us on two TBB threads with a core free; see
 ``benchmarks/README.md`` for what the threads give there. ``numba.set_num_threads(1)`` keeps
 the env on one thread."""
 from steerlab.gym.plant_batch import N_OBS, OBS_NAMES, OBS_UNITS  # noqa: E402,F401  (the layout, declared there)
