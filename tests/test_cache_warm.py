@@ -91,3 +91,21 @@ def test_bad_warm_input_is_one_line_and_exit_2(argv, field, capsys, monkeypatch,
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and field in err, err
     assert not any(tmp_path.rglob("*.nbi"))                 # nothing compiled before the refusal
+
+
+def test_scenario_warm_with_plants_covers_the_plant_step_of_its_ships_options():
+    """An rpm schedule in ``[ship.options]`` gives the ship another kernel than the catalogue's
+    (``mmg_rhs`` instead of ``mmg_rhs_constant_rate``): ``--plants`` with ``--scenario`` warms
+    that kernel's plant step, which the readable loop of the scenario then runs."""
+    from steerlab.sim.engine import simulate
+    from steerlab.sim.scenario import load_scenario
+    from steerlab.sim.setup import build
+    from steerlab.sim.warm import warm_scenario_file
+
+    path = REPO / ".ci" / "warm" / "kosoko-rpm-schedule.toml"
+
+    def use():
+        res = simulate(build(load_scenario(path)), "readable")
+        assert np.isfinite(res.states).all()
+
+    _assert_warmed(lambda: warm_scenario_file(path, plants=True), use)

@@ -146,3 +146,58 @@ def test_kernels_that_cannot_be_named_run_from_an_in_memory_driver(tmp_path, mon
     a = simulate(setup)
     b = simulate(replace(setup, ship=replace(setup.ship, rhs=rhs)))
     np.testing.assert_array_equal(a.states, b.states)
+
+
+UNPICKLE = textwrap.dedent("""
+    import json, pickle, sys
+    from steerlab.kernel_refs import kernel_ref
+    from steerlab.sim.drivers import driver
+    import kmod
+    rhs, upd = pickle.loads(open(sys.argv[1], "rb").read())
+    mod = driver(rhs, upd, None, 7)
+    print(json.dumps({"copy": rhs is not kmod.rhs, "ref": kernel_ref(rhs), "cached": mod._steerlab_cached}))
+""")
+KMOD = textwrap.dedent("""
+    import numba
+
+    @numba.njit
+    def rhs(t, x, delta, w, p, dx):
+        dx[:] = 0.0
+        dx[2] = x[5]
+        dx[5] = (p[1] * delta - x[5]) / p[0]{extra}
+""")
+
+
+def test_a_kernel_unpickled_in_another_process_keeps_its_name_unless_its_code_changed(tmp_path):
+    """numba pickles a dispatcher by its function's code, so another process (a spawned child, a
+    Dask worker) unpickles a new dispatcher, not the module's: still named (its driver from the
+    disk cache, not compiled in every such process) when its code is the module's, and not named
+    (compiled in memory) when the module's code has changed since it was pickled."""
+    import pickle
+
+    from steerlab.control.pid import pid_update
+
+    (tmp_path / "kmod.py").write_text(KMOD.format(extra=""))
+    sys.path.insert(0, str(tmp_path))
+    try:
+        import kmod
+
+        (tmp_path / "k.pkl").write_bytes(pickle.dumps((kmod.rhs, pid_update)))
+    finally:
+        sys.path.remove(str(tmp_path))
+        sys.modules.pop("kmod", None)
+    env = {**os.environ, "STEERLAB_CACHE_DIR": str(tmp_path / "cache"),
+           "PYTHONPATH": os.pathsep.join([str(tmp_path), str(SRC)])}
+    env.pop("STEERLAB_DRIVER_CACHE", None)
+
+    def child() -> dict:
+        p = subprocess.run([sys.executable, "-c", UNPICKLE, str(tmp_path / "k.pkl")], env=env,
+                           capture_output=True, text=True, timeout=300)
+        assert p.returncode == 0, p.stderr
+        return json.loads(p.stdout.strip().splitlines()[-1])
+
+    same = child()
+    assert same == {"copy": True, "ref": ["ref", "kmod:rhs"], "cached": True}
+    (tmp_path / "kmod.py").write_text(KMOD.format(extra=" + 0.0"))
+    changed = child()
+    assert changed == {"copy": True, "ref": None, "cached": False}

@@ -44,6 +44,23 @@ def test_montecarlo_ci_shrinks_with_n():
     assert np.all(large.error_bands_deg[50] <= large.error_bands_deg[95])
 
 
+def test_confidence_interval_is_scipys_student_t_interval_bit_for_bit():
+    """The interval's t quantile comes from scipy.special (the command stays clear of
+    scipy.stats' import time) and equals scipy.stats.t.ppf's, for every sample size."""
+    from scipy import stats
+
+    from steerlab.sweeps.montecarlo import confidence_interval
+
+    rng = np.random.default_rng(3)
+    for n in (2, 3, 5, 8, 30, 101, 1000, 5000):
+        v = rng.normal(2.0, 0.7, n)
+        for level in (0.9, 0.95, 0.99):
+            m, lo, hi = confidence_interval(v, level)
+            half = stats.t.ppf(0.5 + level / 2.0, n - 1) * np.std(v, ddof=1) / np.sqrt(n)
+            assert (m, lo, hi) == (np.mean(v), np.mean(v) - half, np.mean(v) + half)
+    assert np.isnan(confidence_interval([1.0, np.nan])[1])          # one finite value: no interval
+
+
 def test_montecarlo_in_chunks_gives_the_same_numbers(monkeypatch):
     """Chunks of 3 seeds (the last one short) against one chunk: every per-run metric, every
     statistic and every percentile band equal, and the progress runs to the end."""

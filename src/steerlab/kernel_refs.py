@@ -88,7 +88,23 @@ def kernel_ref(kernel) -> Optional[tuple]:
         found = _lookup(path)
     except Exception:  # noqa: BLE001 - any import problem means: not nameable
         return None
-    return ("ref", path) if found is kernel else None
+    return ("ref", path) if found is kernel or _unpickled_copy(kernel, found) else None
+
+
+def _unpickled_copy(kernel, found) -> bool:
+    """Whether ``kernel`` is a copy of the module-level kernel ``found`` made by pickling.
+
+    numba pickles a dispatcher by its function's code; another process (a ``spawn``
+    multiprocessing child, a Dask worker) unpickles a *new* dispatcher of a rebuilt function
+    instead of the module's own. It is the same kernel when the class, the code, the defaults and
+    the compile options are equal and neither has a closure: then it is named like the module's
+    kernel, so its driver comes from the disk cache instead of being compiled in every such
+    process (the module's kernel runs: the same code)."""
+    a, b = getattr(kernel, "py_func", None), getattr(found, "py_func", None)
+    if a is None or b is None or type(kernel) is not type(found):
+        return False
+    return (a.__code__ == b.__code__ and a.__closure__ is None and b.__closure__ is None
+            and a.__defaults__ == b.__defaults__ and kernel.targetoptions == found.targetoptions)
 
 
 def resolve(ref: Optional[tuple]):

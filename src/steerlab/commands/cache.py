@@ -42,7 +42,8 @@ def register(sub, formatter_class):
                    help="warm: also the Gymnasium environments' step and reset (every task) of the Esso "
                         "and of the --ships")
     p.add_argument("--plants", action="store_true",
-                   help="warm: also each ship's plant-only step (readable loop, runtime ship, identification)")
+                   help="warm: also each ship's plant-only step (readable loop, runtime ship, identification), "
+                        "and that of the --scenario files' ships")
     p.add_argument("--trials", action="store_true", help="warm: also each ship's manoeuvring-trial loop")
     p.add_argument("--scenario", nargs="+", default=[], metavar="FILE",
                    help="warm: also the combinations these scenario files use (with --batch: batch too)")
@@ -104,7 +105,7 @@ def _warm(args) -> int:
     jobs = [(f"{s} + {c}", warm_pair, (s, c, args.batch)) for s, c in pairs]
     jobs += [(f"{s} plant step", warm_plant, (s,)) for s in ships if args.plants]
     jobs += [(f"{s} trial loop", warm_trial, (s,)) for s in ships if args.trials]
-    jobs += [(str(path), warm_scenario_file, (path, args.batch)) for path in args.scenario]
+    jobs += [(str(path), warm_scenario_file, (path, args.batch, args.plants)) for path in args.scenario]
     from steerlab.cli import _progress
     from steerlab.progress import runs_progress
 

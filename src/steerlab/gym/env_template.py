@@ -21,7 +21,9 @@ Entry points:
 * ``first_refused``: the first action out of [-1, 1];
 * ``step_parallel``, ``reset_parallel``: ``step`` and ``reset`` on contiguous ranges of lanes
   spread over numba's threads (``parallel=True``, one ``prange`` iteration per range; the
-  threading layer: :mod:`steerlab.threading_layer`).
+  threading layer: :mod:`steerlab.threading_layer`), calling the compiled ``step`` and ``reset``
+  through their addresses (:mod:`steerlab.numba_call_at`), so they compile in a fraction of a
+  second instead of compiling the step again.
 
 Per ship ``step`` and ``step_serial`` perform the same IEEE operations in the same order
 (``finish``, ``reset_one``), so ship i of the vector environment equals a single environment
@@ -40,6 +42,7 @@ from steerlab.angles import wrap_to_pi
 from steerlab.guidance.reference_vector import REF_PSI, REF_RPM
 from steerlab.gym.lane_seas import draw_episode, fill_rows
 from steerlab.gym.plant_batch import OBS_DELTA, OBS_E, OBS_R, R_MAX, REWARD_ITAE, REWARD_SPEED_LOSS
+from steerlab.numba_call_at import call_at
 from steerlab.sim.kernels import _fused, _jit_fused, plant_step
 from steerlab.ships.state import IPSI, IR
 
@@ -202,39 +205,45 @@ def first_refused(A, redo, lo, hi):
 
 
 @numba.njit(parallel=True, cache=CACHE)
-def step_parallel(cuts, A, redo, X, K, J, cmd, W, w_index, PS, PG, dt, nc, gd, GZ, REF, rpm_slot, lam, reward, obs,
-                  rew, bad, term, trunc, n_env_steps, dmax, lazy, S, Z, base, hold, fb, fa, ch, KEY, EP, scale,
+def step_parallel(step_at, cuts, A, redo, X, K, J, cmd, W, w_index, PS, PG, dt, nc, gd, GZ, REF, rpm_slot, lam, reward,
+                  obs, rew, bad, term, trunc, n_env_steps, dmax, lazy, S, Z, base, hold, fb, fa, ch, KEY, EP, scale,
                   offset_max, x0, ps0, gz0, ref0, auto):
     """:func:`step` of lanes ``cuts[0] .. cuts[-1] - 1`` in the ranges ``cuts[j] .. cuts[j + 1] - 1``
     (int64, increasing; multiples of ``LANES`` but the last, so every group stays whole), one
     range per ``prange`` iteration, spread over numba's threads; returns -1, or the first refused
-    lane. Every action of all the ranges is checked first (:func:`first_refused`), so nothing
-    moves when one is refused. A range reads and writes only its lanes' rows and a lane's
-    numbers do not depend on the range it is in: the numbers are those of one ``step`` call,
-    bit for bit, whatever the ranges and the threads. Not ``nogil``: the caller keeps the GIL
-    for the whole call, so two Python threads never launch it (or ``reset_parallel``) at once
-    (the workqueue threading layer aborts on concurrent launches, :mod:`steerlab.threading_layer`).
+    lane. ``step_at`` is the address of :func:`step`'s machine code for these arguments
+    (:func:`steerlab.numba_call_at.address_of`), called through
+    :func:`steerlab.numba_call_at.call_at`: this entry point does not compile a second copy of the
+    step (seconds per ship), and its ranges run the very code of a one-call step. Every action of
+    all the ranges is checked first (:func:`first_refused`), so nothing moves when one is refused.
+    A range reads and writes only its lanes' rows and a lane's numbers do not depend on the range
+    it is in: the numbers are those of one ``step`` call, bit for bit, whatever the ranges and the
+    threads. Not ``nogil``: the caller keeps the GIL for the whole call, so two Python threads
+    never launch it (or ``reset_parallel``) at once (the workqueue threading layer aborts on
+    concurrent launches, :mod:`steerlab.threading_layer`).
     """
     bad_lane = first_refused(A, redo, cuts[0], cuts[cuts.shape[0] - 1])
     if bad_lane >= 0:
         return bad_lane
     for j in numba.prange(cuts.shape[0] - 1):
-        step(cuts[j], cuts[j + 1], A, redo, X, K, J, cmd, W, w_index, PS, PG, dt, nc, gd, GZ, REF, rpm_slot, lam,
-             reward, obs, rew, bad, term, trunc, n_env_steps, dmax, lazy, S, Z, base, hold, fb, fa, ch, KEY, EP,
-             scale, offset_max, x0, ps0, gz0, ref0, auto)
+        call_at(step_at, (cuts[j], cuts[j + 1], A, redo, X, K, J, cmd, W, w_index, PS, PG, dt, nc, gd, GZ, REF,
+                          rpm_slot, lam, reward, obs, rew, bad, term, trunc, n_env_steps, dmax, lazy, S, Z, base,
+                          hold, fb, fa, ch, KEY, EP, scale, offset_max, x0, ps0, gz0, ref0, auto))
     return -1
 
 
 @numba.njit(parallel=True, cache=CACHE)
-def reset_parallel(cuts, idx, KEY, EP, S, Z, scale, offset_max, X, K, J, cmd, PS, GZ, REF, x0, ps, gz0, ref0, gd,
-                   h_env, rpm_slot, obs, rew, bad, sea_seeds):
+def reset_parallel(reset_at, cuts, idx, KEY, EP, S, Z, scale, offset_max, X, K, J, cmd, PS, GZ, REF, x0, ps, gz0,
+                   ref0, gd, h_env, rpm_slot, obs, rew, bad, sea_seeds):
     """:func:`reset` of the lanes ``idx[cuts[j]:cuts[j + 1]]`` (distinct lanes), one range per
-    ``prange`` iteration, spread over numba's threads (as :func:`step_parallel`, GIL held); the
-    numbers of one ``reset`` call."""
+    ``prange`` iteration, spread over numba's threads, through ``reset_at``, the address of
+    :func:`reset`'s machine code (as :func:`step_parallel`, GIL held); the numbers of one
+    ``reset`` call."""
     for j in numba.prange(cuts.shape[0] - 1):
         lo, hi = cuts[j], cuts[j + 1]
-        reset(idx[lo:hi], KEY, EP, S, Z, scale, offset_max, X, K, J, cmd, PS, GZ, REF, x0, ps, gz0, ref0, gd, h_env,
-              rpm_slot, obs, rew, bad, sea_seeds[lo:hi])
+        call_at(reset_at, (idx[lo:hi], KEY, EP, S, Z, scale, offset_max, X, K, J, cmd, PS, GZ, REF, x0, ps, gz0, ref0,
+                           gd, h_env, rpm_slot, obs, rew, bad, sea_seeds[lo:hi]))
+    return -1
 
 
 @numba.njit(inline="always")
@@ -269,11 +278,13 @@ def reset_one(i, KEY, EP, S, Z, scale, offset_max, X, K, J, cmd, PS, GZ, REF, x0
 def reset(idx, KEY, EP, S, Z, scale, offset_max, X, K, J, cmd, PS, GZ, REF, x0, ps, gz0, ref0, gd, h_env,
           rpm_slot, obs, rew, bad, sea_seeds):
     """:func:`reset_one` for the lanes ``idx``, their sea seeds into ``sea_seeds``; one compiled
-    call for all of them. Calls on disjoint lanes may run in parallel threads
-    (:func:`reset_parallel`)."""
+    call for all of them; returns the number of lanes (int64, as :func:`step` returns one: what
+    :func:`steerlab.numba_call_at.call_at` reads). Calls on disjoint lanes may run in parallel
+    threads (:func:`reset_parallel`)."""
     for q in range(idx.shape[0]):
         sea_seeds[q] = reset_one(idx[q], KEY, EP, S, Z, scale, offset_max, X, K, J, cmd, PS, GZ, REF, x0, ps,
                                  gz0, ref0, gd, h_env, rpm_slot, obs, rew, bad)
+    return np.int64(idx.shape[0])
 
 
 @numba.njit

@@ -195,15 +195,22 @@ class Episodes:
     def _sea_args(self):
         return (self.lazy, self.S, self.Z, self._base, self._hold, self._fb, self._fa, W_RUDDER)
 
-    def _parallel(self, name: str):
-        """The compiled threaded entry point ``name`` (taken on first use, so that the compile
-        message of :func:`steerlab.sim.drivers.entry` comes only when it is compiled)."""
-        fn = self._par.get(name)
-        if fn is None:
+    def _parallel(self, name: str, one: Any, one_args: tuple) -> tuple[Any, int]:
+        """The compiled threaded entry point ``name`` and the address of the one-call entry point
+        ``one`` it runs on each range (:mod:`steerlab.numba_call_at`), for a call ``one(*one_args)``
+        (the types of these arguments do not change over the life of an ``Episodes``: its own
+        arrays, and contiguous actions, lanes and flags). Taken on first use, so that the compile
+        message of :func:`steerlab.sim.drivers.entry` comes only when it is compiled."""
+        got = self._par.get(name)
+        if got is None:
+            import numba
+
+            from steerlab.numba_call_at import address_of
             from steerlab.sim.drivers import entry
 
-            fn = self._par[name] = entry(self._kernels, name)
-        return fn
+            at = address_of(one, tuple(numba.typeof(v) for v in one_args))
+            got = self._par[name] = (entry(self._kernels, name), at)
+        return got
 
     def _threads(self, m: int) -> int:
         """Threads for a compiled call over ``m`` lanes: 1 below ``threads_from``, else
@@ -225,7 +232,7 @@ class Episodes:
         (:meth:`step_autoreset`), with the same numbers."""
         from steerlab.gym.philox import seed_key
 
-        lanes = np.asarray(lanes, dtype=np.int64).reshape(-1)
+        lanes = np.ascontiguousarray(lanes, dtype=np.int64).reshape(-1)
         if seeds is not None or not self.keyed[lanes].all():
             new = {}                                       # all checked before any lane changes
             for q, i in enumerate(lanes.tolist()):
@@ -243,7 +250,8 @@ class Episodes:
                 self.rpm_slot, self.obs, self.rew, self.bad)
         threads = self._threads(m)
         if threads > 1 and np.unique(lanes).shape[0] == m:   # distinct lanes: disjoint rows, spread
-            launch(self._parallel("reset_parallel"), range_cuts(m, 1, threads), lanes, *args, sea_seeds)
+            par, at = self._parallel("reset_parallel", self._reset, (lanes, *args, sea_seeds))
+            launch(par, at, range_cuts(m, 1, threads), lanes, *args, sea_seeds)
         else:
             self._reset(lanes, *args, sea_seeds)
         infos = [{"episode": int(self.EP[i]) - 1, "initial_heading": float(self.X[i, IPSI])} for i in lanes.tolist()]
@@ -289,7 +297,7 @@ class Episodes:
         checked first, then ``threads`` contiguous ranges of whole groups
         (:func:`steerlab.sim.lanes.range_cuts`) spread over numba's threads (a ``prange``,
         :mod:`steerlab.threading_layer`). A lane's numbers do not depend on the split."""
-        a = np.asarray(actions, dtype=np.float64).reshape(self.n)
+        a = np.ascontiguousarray(actions, dtype=np.float64).reshape(self.n)
         again = None if self.lazy else redo.copy()
         args = (a, redo, self.X, self.K, self.J, self.cmd, self.W, self.w_index, self.PS, self.PG, self.dt,
                 self.nc, self.gd, self.GZ, self.REF, self.rpm_slot, self.lam, self.reward, self.obs, self.rew,
@@ -302,7 +310,10 @@ class Episodes:
             cuts = self._cuts.get(threads)
             if cuts is None:
                 cuts = self._cuts[threads] = range_cuts(self.n, LANES, threads)
-            i = launch(self._parallel("step_parallel"), cuts, *args)
+            if not all(f.dtype == np.bool_ and f.ndim == 1 and f.flags.c_contiguous for f in (redo, term, trunc)):
+                raise TypeError("redo, term and trunc must be contiguous 1-d bool arrays")   # the types step_at takes
+            par, at = self._parallel("step_parallel", self._vstep, (0, self.n, *args))
+            i = launch(par, at, cuts, *args)
         if i >= 0:
             raise self._refused(a[i])
         if again is not None and again.any():              # seas realised lane by lane: reset here

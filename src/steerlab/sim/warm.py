@@ -55,36 +55,46 @@ def _run(setup, batch: bool) -> None:
         simulate_batch([setup, setup])
 
 
-def warm_scenario_file(path, batch: bool = False) -> str:
+def warm_scenario_file(path, batch: bool = False, plants: bool = False) -> str:
     """Run the combination of a scenario file (ship, controller and its wrappers, guidance,
-    sensors) for :data:`WARM_DURATION` seconds, single run (and batch); returns ``"ok"``.
-    Bad input raises :class:`InputError` (the file's own message)."""
+    sensors) for :data:`WARM_DURATION` seconds, single run (and batch; and with ``plants`` the
+    plant-only step of its ship, with its options: e.g. an rpm schedule's kernel); returns
+    ``"ok"``. Bad input raises :class:`InputError` (the file's own message)."""
     from steerlab.sim.scenario import load_scenario
     from steerlab.sim.setup import build
 
     scenario = load_scenario(path)
-    _run(build(scenario.model_copy(update={"duration": min(scenario.duration, WARM_DURATION)})), batch)
+    setup = build(scenario.model_copy(update={"duration": min(scenario.duration, WARM_DURATION)}))
+    _run(setup, batch)
+    if plants:
+        _plant_step(setup)
     return "ok"
 
 
 def warm_plant(ship_id: str) -> str:
     """The ship's plant-only driver: the scalar RK4 step (the readable loop, the runtime ship,
     plant objects) and the rudder replay (identification); returns ``"ok"`` or why not."""
-    import numpy as np
-
-    from steerlab.identification.response import simulate_response
-    from steerlab.ships.state import IU
-    from steerlab.sim.kernels import plant_step
     from steerlab.sim.setup import build
 
     try:
         s = build(warm_scenario(ship_id, "pid"))
     except InputError as err:
         return f"skipped ({err})"
+    _plant_step(s)
+    return "ok"
+
+
+def _plant_step(s) -> None:
+    """One scalar RK4 step and one rudder replay of the ship of setup ``s`` (:func:`warm_plant`)."""
+    import numpy as np
+
+    from steerlab.identification.response import simulate_response
+    from steerlab.ships.state import IU
+    from steerlab.sim.kernels import plant_step
+
     x = s.x0.copy()
     plant_step(s.ship.rhs)(0.0, x, 0.0, s.w[0], s.ps, s.pg, s.dt, np.empty((5, x.shape[0])))
     simulate_response(s.ship.rhs, x.shape[0] - 1, s.ps, np.zeros(3), s.dt, speed=float(s.x0[IU]))
-    return "ok"
 
 
 def warm_trial(ship_id: str) -> str:

@@ -61,8 +61,11 @@ class MonteCarloResult:
 
 
 def confidence_interval(values, level: float = 0.95) -> tuple[float, float, float]:
-    """``(mean, lower, upper)``: Student-t interval of the mean of the finite ``values``."""
-    from scipy import stats
+    """``(mean, lower, upper)``: Student-t interval of the mean of the finite ``values``.
+
+    The t quantile is ``scipy.special.stdtrit`` (what ``scipy.stats.t.ppf`` returns, bit for bit,
+    tested) so that a Monte Carlo command does not import ``scipy.stats`` (about 0.4 s)."""
+    from scipy.special import stdtrit
 
     v = np.asarray(values, dtype=float)
     v = v[np.isfinite(v)]
@@ -72,7 +75,7 @@ def confidence_interval(values, level: float = 0.95) -> tuple[float, float, floa
     m = float(np.mean(v))
     if n == 1:
         return m, math.nan, math.nan
-    half = float(stats.t.ppf(0.5 + level / 2.0, n - 1) * np.std(v, ddof=1) / math.sqrt(n))
+    half = float(stdtrit(n - 1, 0.5 + level / 2.0) * np.std(v, ddof=1) / math.sqrt(n))
     return m, m - half, m + half
 
 
