@@ -231,37 +231,34 @@ def store(X, i0, n_act, XL):
 
 @_jit_fused
 def rk4_lanes(t, k, i0, n_act, CMD, W, w_index, dt, h2, s6, ACC, E, DPREV,
-              XL, PL, PGL, WL, K1, K2, K3, K4, XT):
+              XL, PL, PGL, WL, K1, K2, K3, K4, XT, XLf, K1f, K2f, K3f, K4f, XTf):
     """One RK4 step of every run of the group, stage by stage, then the metrics accumulator;
-    per run the same operations as :func:`rk4`."""
+    per run the same operations as :func:`rk4`. ``XLf, K1f, ..., XTf``: flat views, whose
+    stage inputs and update run over every column as in :func:`rk4_plants`."""
     # this step's disturbance row of every run, as columns
     for g in range(n_act):
         row = W[w_index[i0 + g], k]
-        for c in range(row.shape[0]):
+        for c in range(N_CHANNELS):     # a constant count: the copy is unrolled
             WL[c, g] = row[c]
         DPREV[g] = XL[NX - 1, g]
     t2 = t + h2
-    # the loops over g below are the vectorised ones: keep their bodies free of calls
+    # the loops below are the vectorised ones: keep their bodies free of calls
     for g in range(n_act):
         plant_rhs(t, XL[:, g], CMD[g], WL[:, g], PL[:, g], PGL[:, g], K1[:, g])
-    for q in range(NX):
-        for g in range(n_act):
-            XT[q, g] = rk4_stage(XL[q, g], h2, K1[q, g])
+    for j in range(NX * G):
+        XTf[j] = rk4_stage(XLf[j], h2, K1f[j])
     for g in range(n_act):
         plant_rhs(t2, XT[:, g], CMD[g], WL[:, g], PL[:, g], PGL[:, g], K2[:, g])
-    for q in range(NX):
-        for g in range(n_act):
-            XT[q, g] = rk4_stage(XL[q, g], h2, K2[q, g])
+    for j in range(NX * G):
+        XTf[j] = rk4_stage(XLf[j], h2, K2f[j])
     for g in range(n_act):
         plant_rhs(t2, XT[:, g], CMD[g], WL[:, g], PL[:, g], PGL[:, g], K3[:, g])
-    for q in range(NX):
-        for g in range(n_act):
-            XT[q, g] = rk4_stage(XL[q, g], dt, K3[q, g])
+    for j in range(NX * G):
+        XTf[j] = rk4_stage(XLf[j], dt, K3f[j])
     for g in range(n_act):
         plant_rhs(t + dt, XT[:, g], CMD[g], WL[:, g], PL[:, g], PGL[:, g], K4[:, g])
-    for q in range(NX):
-        for g in range(n_act):
-            XL[q, g] = rk4_update(XL[q, g], s6, K1[q, g], K2[q, g], K3[q, g], K4[q, g])
+    for j in range(NX * G):
+        XLf[j] = rk4_update(XLf[j], s6, K1f[j], K2f[j], K3f[j], K4f[j])
     for g in range(n_act):
         XL[NX - 1, g] = clamp(XL[NX - 1, g], PGL[:, g])
     for g in range(n_act):
@@ -295,7 +292,13 @@ def group(X, Z, PS, PG, PC, GD, GZ, W, w_index, i0, n_act, dt, nc, n_steps, rec_
           out_x, out_cmd, out_ref, ACC, rpm_slot):
     """Advance runs ``i0 .. i0 + n_act - 1`` of the batch arrays in place
     (arguments: :func:`steerlab.sim.lanes.lane_loop`)."""
+    if W.shape[2] != N_CHANNELS:
+        raise ValueError("disturbance rows must have N_CHANNELS channels")
     XL, PL, PGL, WL, K1, K2, K3, K4, XT, CMD, E, DPREV = scratch(PS.shape[1], PG.shape[1], W.shape[2])
+    for a in (XL, K1, K2, K3, K4, XT):      # the columns past a short group's runs: finite
+        a[:, :] = 0.0
+    flat = (XL.reshape(NX * G), K1.reshape(NX * G), K2.reshape(NX * G), K3.reshape(NX * G),
+            K4.reshape(NX * G), XT.reshape(NX * G))
     REF = np.zeros((G, NR))
     for g in range(G):
         REF[g, REF_RPM] = -1.0
@@ -336,7 +339,7 @@ def group(X, Z, PS, PG, PC, GD, GZ, W, w_index, i0, n_act, dt, nc, n_steps, rec_
         if k == n_steps:
             break
         rk4_lanes(t, k, i0, n_act, CMD, W, w_index, dt, h2, s6, ACC, E, DPREV,
-                  XL, PL, PGL, WL, K1, K2, K3, K4, XT)
+                  XL, PL, PGL, WL, K1, K2, K3, K4, XT, *flat)
     store(X, i0, n_act, XL)
 
 
