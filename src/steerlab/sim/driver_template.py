@@ -229,6 +229,34 @@ def store(X, i0, n_act, XL):
         store_row(X, i0 + g, g, XL)
 
 
+@numba.njit(inline="always")
+def flat_views(XL, K1, K2, K3, K4, XT):
+    """Flat ``(NX * LANES,)`` views of a group's state and stage arrays (``(NX, LANES)``, C
+    order), zeroed first so that the columns past a short group's runs hold finite values
+    (the flat loops below run over every column; no one reads those)."""
+    for a in (XL, K1, K2, K3, K4, XT):
+        a[:, :] = 0.0
+    return (XL.reshape(NX * G), K1.reshape(NX * G), K2.reshape(NX * G), K3.reshape(NX * G),
+            K4.reshape(NX * G), XT.reshape(NX * G))
+
+
+@_jit_fused
+def stage_flat(XTf, XLf, c, Kf):
+    """An RK4 stage's inputs ``XT = XL + c K`` (:func:`steerlab.sim.kernels.rk4_stage`) over a
+    group's flat views: one loop of a constant length, which the compiler vectorises at full
+    width (loops over ``g < n_act`` are too short for its unrolled vector body)."""
+    for j in range(NX * G):
+        XTf[j] = rk4_stage(XLf[j], c, Kf[j])
+
+
+@_jit_fused
+def update_flat(XLf, s6, K1f, K2f, K3f, K4f):
+    """The RK4 update (:func:`steerlab.sim.kernels.rk4_update`) over a group's flat views, as
+    :func:`stage_flat`."""
+    for j in range(NX * G):
+        XLf[j] = rk4_update(XLf[j], s6, K1f[j], K2f[j], K3f[j], K4f[j])
+
+
 @_jit_fused
 def rk4_lanes(t, k, i0, n_act, CMD, W, w_index, dt, h2, s6, ACC, E, DPREV,
               XL, PL, PGL, WL, K1, K2, K3, K4, XT, XLf, K1f, K2f, K3f, K4f, XTf):
@@ -245,20 +273,16 @@ def rk4_lanes(t, k, i0, n_act, CMD, W, w_index, dt, h2, s6, ACC, E, DPREV,
     # the loops below are the vectorised ones: keep their bodies free of calls
     for g in range(n_act):
         plant_rhs(t, XL[:, g], CMD[g], WL[:, g], PL[:, g], PGL[:, g], K1[:, g])
-    for j in range(NX * G):
-        XTf[j] = rk4_stage(XLf[j], h2, K1f[j])
+    stage_flat(XTf, XLf, h2, K1f)
     for g in range(n_act):
         plant_rhs(t2, XT[:, g], CMD[g], WL[:, g], PL[:, g], PGL[:, g], K2[:, g])
-    for j in range(NX * G):
-        XTf[j] = rk4_stage(XLf[j], h2, K2f[j])
+    stage_flat(XTf, XLf, h2, K2f)
     for g in range(n_act):
         plant_rhs(t2, XT[:, g], CMD[g], WL[:, g], PL[:, g], PGL[:, g], K3[:, g])
-    for j in range(NX * G):
-        XTf[j] = rk4_stage(XLf[j], dt, K3f[j])
+    stage_flat(XTf, XLf, dt, K3f)
     for g in range(n_act):
         plant_rhs(t + dt, XT[:, g], CMD[g], WL[:, g], PL[:, g], PGL[:, g], K4[:, g])
-    for j in range(NX * G):
-        XLf[j] = rk4_update(XLf[j], s6, K1f[j], K2f[j], K3f[j], K4f[j])
+    update_flat(XLf, s6, K1f, K2f, K3f, K4f)
     for g in range(n_act):
         XL[NX - 1, g] = clamp(XL[NX - 1, g], PGL[:, g])
     for g in range(n_act):
@@ -295,10 +319,7 @@ def group(X, Z, PS, PG, PC, GD, GZ, W, w_index, i0, n_act, dt, nc, n_steps, rec_
     if W.shape[2] != N_CHANNELS:
         raise ValueError("disturbance rows must have N_CHANNELS channels")
     XL, PL, PGL, WL, K1, K2, K3, K4, XT, CMD, E, DPREV = scratch(PS.shape[1], PG.shape[1], W.shape[2])
-    for a in (XL, K1, K2, K3, K4, XT):      # the columns past a short group's runs: finite
-        a[:, :] = 0.0
-    flat = (XL.reshape(NX * G), K1.reshape(NX * G), K2.reshape(NX * G), K3.reshape(NX * G),
-            K4.reshape(NX * G), XT.reshape(NX * G))
+    flat = flat_views(XL, K1, K2, K3, K4, XT)
     REF = np.zeros((G, NR))
     for g in range(G):
         REF[g, REF_RPM] = -1.0
@@ -375,20 +396,16 @@ def rk4_plants(n_act, T, CMD, dt, h2, s6, XL, PL, PGL, WL, K1, K2, K3, K4, XT, X
     # the loops below are the vectorised ones: keep their bodies free of calls
     for g in range(n_act):
         plant_rhs(T[g], XL[:, g], CMD[g], WL[:, g], PL[:, g], PGL[:, g], K1[:, g])
-    for j in range(NX * G):
-        XTf[j] = rk4_stage(XLf[j], h2, K1f[j])
+    stage_flat(XTf, XLf, h2, K1f)
     for g in range(n_act):
         plant_rhs(T[g] + h2, XT[:, g], CMD[g], WL[:, g], PL[:, g], PGL[:, g], K2[:, g])
-    for j in range(NX * G):
-        XTf[j] = rk4_stage(XLf[j], h2, K2f[j])
+    stage_flat(XTf, XLf, h2, K2f)
     for g in range(n_act):
         plant_rhs(T[g] + h2, XT[:, g], CMD[g], WL[:, g], PL[:, g], PGL[:, g], K3[:, g])
-    for j in range(NX * G):
-        XTf[j] = rk4_stage(XLf[j], dt, K3f[j])
+    stage_flat(XTf, XLf, dt, K3f)
     for g in range(n_act):
         plant_rhs(T[g] + dt, XT[:, g], CMD[g], WL[:, g], PL[:, g], PGL[:, g], K4[:, g])
-    for j in range(NX * G):
-        XLf[j] = rk4_update(XLf[j], s6, K1f[j], K2f[j], K3f[j], K4f[j])
+    update_flat(XLf, s6, K1f, K2f, K3f, K4f)
     for g in range(n_act):
         XL[NX - 1, g] = clamp(XL[NX - 1, g], PGL[:, g])
 
@@ -414,10 +431,7 @@ def step_lanes(X, K, CMD, W, w_index, PS, PG, idx, dt, n_sub, step_rows):
     if W.shape[2] != N_CHANNELS:
         raise ValueError("disturbance rows must have N_CHANNELS channels")
     XL, PL, PGL, WL, K1, K2, K3, K4, XT, CL, TL, _ = scratch(PS.shape[1], PG.shape[1], W.shape[2])
-    for a in (XL, K1, K2, K3, K4, XT):      # the columns past a short group's plants: finite
-        a[:, :] = 0.0
-    flat = (XL.reshape(NX * G), K1.reshape(NX * G), K2.reshape(NX * G), K3.reshape(NX * G),
-            K4.reshape(NX * G), XT.reshape(NX * G))
+    flat = flat_views(XL, K1, K2, K3, K4, XT)
     WI = np.empty(G, dtype=np.int64)        # the group's disturbance sequences and first rows
     K0 = np.empty(G, dtype=np.int64)
     h2 = 0.5 * dt
