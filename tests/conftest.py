@@ -96,6 +96,13 @@ def make_scenario(**over):
     return scenario_from_dict(make_scenario_dict(**over))
 
 
+@pytest.fixture(scope="session")
+def control():
+    """python-control, imported by the tests that use it rather than at collection (every
+    pytest-xdist worker collects every test module; the import costs about 0.5-2 s each time)."""
+    return pytest.importorskip("control")
+
+
 @pytest.fixture
 def scenario():
     """Factory: ``scenario(duration=..., controller={...}, guidance={...})`` -> Scenario."""
@@ -150,6 +157,31 @@ def pytest_runtest_logreport(report):
     if path and report.duration >= 0.05 and not os.environ.get("PYTEST_XDIST_WORKER"):
         with open(path, "a", encoding="utf-8") as f:
             f.write(f"{report.duration:.2f} {report.when} {report.nodeid}\n")
+
+
+def _cpu_seconds() -> float:
+    """User + system CPU of this process and of its waited-for children [s]."""
+    import resource
+
+    own, kids = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(resource.RUSAGE_CHILDREN)
+    return own.ru_utime + own.ru_stime + kids.ru_utime + kids.ru_stime
+
+
+@pytest.hookimpl(hookwrapper=True)
+def pytest_runtest_protocol(item, nextitem):
+    """With ``STEERLAB_TEST_CPU=FILE``, append ``cpu_s wall_s nodeid`` for every test (setup,
+    call and teardown together; CPU of the worker and the subprocesses it waited for): which
+    tests use the cores and which wait (sockets, sleeps, other processes' locks)."""
+    path = os.environ.get("STEERLAB_TEST_CPU")
+    if not path or os.name != "posix":
+        yield
+        return
+    c0, t0 = _cpu_seconds(), time.perf_counter()
+    yield
+    cpu, wall = _cpu_seconds() - c0, time.perf_counter() - t0
+    if wall >= 0.05:
+        with open(path, "a", encoding="utf-8") as f:
+            f.write(f"{cpu:.2f} {wall:.2f} {item.nodeid}\n")
 
 
 # ------------------------------------------------------------- compiles, test by test
@@ -207,3 +239,4 @@ def once_per_session(tmp_path_factory, name: str, make):
             folder.mkdir(exist_ok=True)
             result.write_text(json.dumps(make(folder)))
         return json.loads(result.read_text())
+

@@ -1,11 +1,13 @@
 """python-control interop: sl.linearize for every ship, PID-family transfer functions, sampled loop."""
 
+import importlib.util
 import math
 
 import numpy as np
 import pytest
 
-control = pytest.importorskip("control")
+# python-control: the ``control`` fixture (tests/conftest.py), imported by the tests that use it
+pytestmark = pytest.mark.skipif(importlib.util.find_spec("control") is None, reason="python-control not installed")
 
 from steerlab.components.controller import controller  # noqa: E402
 from steerlab.components.linear import linear_model, linearize, transfer_function  # noqa: E402
@@ -15,7 +17,7 @@ from steerlab.ships.registry import SHIPS, get_ship  # noqa: E402
 from steerlab.units import knots_to_ms, rad  # noqa: E402
 
 
-def test_nomoto1_is_its_definition_and_its_step_response_is_analytic():
+def test_nomoto1_is_its_definition_and_its_step_response_is_analytic(control):
     K, T = 0.08, 40.0
     sys = linearize("nomoto1", 10.0, ship_options={"K": K, "T": T})
     assert sys.state_labels == ["psi", "r"] and sys.input_labels == ["delta"]
@@ -28,7 +30,7 @@ def test_nomoto1_is_its_definition_and_its_step_response_is_analytic():
     np.testing.assert_allclose(psi, K * (t - T * (1.0 - np.exp(-t / T))), rtol=1e-6, atol=1e-9)
 
 
-def test_esso_unstable_pole_at_16_kn():
+def test_esso_unstable_pole_at_16_kn(control):
     poles = control.poles(linearize("esso", 16.0))
     assert np.max(poles.real) == pytest.approx(2.57e-3, abs=0.005e-3)   # Zwierzewicz et al. (2021)
     assert linearize("esso").name.startswith("esso@16")                  # default speed
@@ -57,7 +59,7 @@ def test_nomoto_and_norrbin_linear_model_is_their_first_order_nomoto(name):
     assert m["B"][i_r, 0] == pytest.approx(K / T, rel=1e-6)
 
 
-def test_lq_pd_closed_loop_poles_are_eq_3_10():
+def test_lq_pd_closed_loop_poles_are_eq_3_10(control):
     K, T = 0.05, 80.0
     c = controller("lq_pd", nomoto=(K, T), lam=0.5)
     C = transfer_function(c)
@@ -68,7 +70,7 @@ def test_lq_pd_closed_loop_poles_are_eq_3_10():
     np.testing.assert_allclose(np.sort_complex(control.poles(cl)), np.sort_complex(expected), rtol=1e-8)
 
 
-def test_sampled_pid_loop_matches_python_control():
+def test_sampled_pid_loop_matches_python_control(control):
     """steerlab's sampled loop (nomoto1 + fast linear gear + PID object at h = 0.1 s) against
     python-control's continuous closed loop with the same gear lag, for a 5 deg step."""
     K, T, T_sg = 0.1, 50.0, 0.1
@@ -117,7 +119,7 @@ def test_cli_linearize_nomoto1_and_norrbin(tmp_path):
     assert r.returncode == 2 and "speed_kn" in r.stderr and "Traceback" not in r.stderr
 
 
-def test_margins_and_step_info_work_on_exported_systems():
+def test_margins_and_step_info_work_on_exported_systems(control):
     K, T = 0.05, 80.0
     c = controller("pid", nomoto=(K, T), Kp=1.0, Ki=0.001, Kd=30.0)
     L = c.transfer_function() * linearize("nomoto1", 10.0, ship_options={"K": K, "T": T})[0, 0]

@@ -4,7 +4,6 @@ import math
 
 import numpy as np
 import pytest
-from scipy.signal import welch
 
 from steerlab.environment.channels import (W_CURRENT_E, W_CURRENT_N, W_RUDDER, W_WIND_DIR, W_WIND_SPEED,
                                            W_YAW_MOMENT, W_YAW_RATE)
@@ -86,6 +85,8 @@ def test_encounter_frequency():
 
 def _psd(x, dt, nperseg=1024):
     """Welch estimate, one-sided per rad/s, smoothed over 5 bins (a single sea realisation is spiky)."""
+    from scipy.signal import welch      # here, not at collection (about 0.7 s in every worker)
+
     f, P = welch(x, fs=1.0 / dt, nperseg=nperseg)
     P = np.convolve(P, np.ones(5) / 5, mode="same") / (2 * math.pi)
     return 2 * math.pi * f, P

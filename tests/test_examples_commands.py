@@ -203,6 +203,20 @@ def _in_process(argv, workdir):
     return subprocess.CompletedProcess(["steerlab", *argv], code, out.getvalue(), err.getvalue())
 
 
+def _wait_until_serving(server, timeout=60.0):
+    """Until ``serve-ship`` says it is bound (its first stderr line, "serve-ship: ... on HOST:PORT")
+    or exits: the autopilot then starts against a listening ship, without a fixed sleep."""
+    import select
+
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline and server.poll() is None:
+        ready, _, _ = select.select([server.stderr], [], [], 0.1)
+        if ready:
+            line = server.stderr.readline()
+            if not line or line.startswith(b"serve-ship:"):
+                return
+
+
 def _run(label, env_assign, argv, workdir):
     if not env_assign and argv[0] not in OWN_PROCESS:
         argv = _ports(_smaller(argv))
@@ -218,10 +232,10 @@ def _run(label, env_assign, argv, workdir):
         port = _free_port()
         scen = [argv[argv.index("--scenario") + 1]] if "--scenario" in argv else []
         server = subprocess.Popen([sys.executable, "-m", "steerlab", "serve-ship", *scen, "--bind",
-                                   f"127.0.0.1:{port}", "--speedup", "20", "--duration", "2000", "--quiet"],
+                                   f"127.0.0.1:{port}", "--speedup", "20", "--duration", "2000"],
                                   cwd=workdir, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
         argv = _ports(argv, port)
-        time.sleep(1.0)
+        _wait_until_serving(server)
     else:
         argv = _ports(argv)
     try:

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import json
 import os
+import shutil
 import subprocess
 import sys
 import textwrap
@@ -64,15 +65,54 @@ def _run(cache: Path, *command: str) -> dict:
     return json.loads(p.stdout.strip().splitlines()[-1])
 
 
+ENV_TEMPLATE_HEAD = 'r"""The compiled step and reset of the Gymnasium environments'
+
+
+def _is_esso_course_keeping_env(module: Path) -> bool:
+    """Is ``module`` (a generated ``d_<hash>.py``) the Esso course-keeping environment's step and
+    reset (the module the environments of SCRIPT use)?"""
+    text = module.read_text(encoding="utf-8", errors="replace")
+    return (text.startswith(ENV_TEMPLATE_HEAD) and "steerlab.ships.esso_3dof:esso_rhs" in text
+            and "steerlab.guidance.reference_models:course_guide" in text)
+
+
+def _seed_without_the_env_module(cache: Path) -> int:
+    """Fill the empty driver cache ``cache`` with hard links (or copies) of this steerlab's
+    drivers in the suite's own cache (which ``.ci/warm-cache`` fills), leaving out the Esso
+    course-keeping environment module and its machine code: the first process then compiles
+    that module and nothing else the test does not need (the Esso + PID loops, the route
+    task's module, ...). Returns how many modules were left out (0 if the suite's cache had
+    none: then it is compiled anyway)."""
+    from steerlab.sim import drivers
+
+    source = drivers.drivers_dir()
+    if not source.is_dir():
+        return 0
+    left_out = {p.stem for p in source.glob("d_*.py") if _is_esso_course_keeping_env(p)}
+
+    def ignore(folder, names):
+        return [n for n in names if n.split(".")[0] in left_out or ".tmp" in n]
+
+    def link_or_copy(src, dst):
+        try:
+            os.link(src, dst)
+        except OSError:
+            shutil.copy2(src, dst)
+
+    shutil.copytree(source, cache / "drivers" / source.name, ignore=ignore, copy_function=link_or_copy)
+    return len(left_out)
+
+
 @pytest.fixture(scope="module")
 def warmed(tmp_path_factory) -> dict:
-    """One cold compile for the two tests that need one (issue 14: CI time): on an empty driver
-    cache, a process runs ``steerlab cache warm --gym`` and then the environments (``first``);
-    then a fresh process runs them on that cache (``fresh``). Made once per test session
-    (shared by the pytest-xdist workers)."""
+    """One cold compile of the environments' module for the two tests that need one: on a
+    driver cache without it (:func:`_seed_without_the_env_module`), a process runs ``steerlab
+    cache warm --gym`` and then the environments (``first``); then a fresh process runs them on
+    that cache (``fresh``). Made once per test session (shared by the pytest-xdist workers)."""
     from conftest import once_per_session
 
     def make(cache: Path) -> dict:
+        _seed_without_the_env_module(cache)
         return {"first": _run(cache, *WARM_GYM), "fresh": _run(cache)}
 
     return once_per_session(tmp_path_factory, "gym-cache-warmed", make)

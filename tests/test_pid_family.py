@@ -8,7 +8,6 @@ kernel), so this file compiles three (ship, controller) pairs.
 
 import math
 
-import control
 import numpy as np
 import pytest
 
@@ -57,7 +56,7 @@ def _steady_kp(ctrl):
 # ------------------------------------------------------------------ tuning rules
 
 @pytest.mark.parametrize("t_r", [20.0, 38.0, 53.0, 120.0])
-def test_itae_eq6_closed_loop_denominator(t_r):
+def test_itae_eq6_closed_loop_denominator(t_r, control):
     """polynomial="eq6": the loop of Fig. 1 with the Nomoto model has the printed M(s) (6)."""
     k, T = 0.1256, 48.5
     h1, h2, h3 = itae_gains(t_r, k, T, "eq6")
@@ -67,7 +66,7 @@ def test_itae_eq6_closed_loop_denominator(t_r):
     np.testing.assert_allclose(den / den[0], [1.0, 1.75 * w0, w0**2, w0**3], rtol=1e-12)
 
 
-def test_itae_dorf_reading_is_eq10_as_printed():
+def test_itae_dorf_reading_is_eq10_as_printed(control):
     """Default reading: H1, H2, H3 and the pre-filter exactly as printed in (10)-(11)."""
     k, T, t_r = 0.1256, 48.5, 53.0
     h1, h2, h3 = itae_gains(t_r, k, T)
@@ -97,7 +96,7 @@ def test_itae_rejects_impossible_designs():
 
 
 @pytest.mark.parametrize("lam,K,T", [(0.1, 0.1, 50.0), (1.0, 0.05, 120.0), (10.0, 0.3, 20.0), (4.0, 1.0, 1.0)])
-def test_lq_pd_equals_python_control_lqr(lam, K, T):
+def test_lq_pd_equals_python_control_lqr(lam, K, T, control):
     """(3.5)-(3.6) are the LQR gains of [eps, r] with Q = diag(1, 0), R = lambda."""
     kp, kd = lq_pd_gains(lam, K, T)
     A = np.array([[0.0, 1.0], [0.0, -1.0 / T]])
@@ -107,7 +106,7 @@ def test_lq_pd_equals_python_control_lqr(lam, K, T):
     assert kp == pytest.approx(1.0 / math.sqrt(lam))
 
 
-def test_gain_shaping_gives_first_order_closed_loop():
+def test_gain_shaping_gives_first_order_closed_loop(control):
     """(18): with the error derivative the loop is 1/(T01 s + 1); the ship pole stays in the
     disturbance loop: characteristic polynomial (T s + 1)(T01 s + 1)/T01."""
     T01 = 20.0
@@ -182,7 +181,7 @@ def test_itae_prefilter_wraps_and_settles_on_the_set_point():
     assert z[0] == pytest.approx(rad(1.0), abs=1e-9)       # went the short way (2 deg)
 
 
-def test_itae_kernel_matches_the_continuous_design():
+def test_itae_kernel_matches_the_continuous_design(control):
     """Small step, fast gear: the sampled loop follows w0^3 / M(s) (the paper's design)."""
     t_r = 53.0
     sc = _scenario("itae_pid", dt=0.05, duration=200.0,

@@ -113,10 +113,11 @@ class Result:
     def to_parquet(self, path: str | os.PathLike[str]) -> Path:
         """Write Parquet (needs the optional ``pyarrow``)."""
         try:
-            import pyarrow as pa
             import pyarrow.parquet as pq
         except ImportError as err:  # pragma: no cover - depends on the environment
             raise RuntimeError("Parquet export needs pyarrow: pip install 'steerlab[parquet]'") from err
+        from steerlab.arrow_table import arrow_table
+
         path = Path(path)
-        pq.write_table(pa.table({k: np.asarray(v) for k, v in self.columns().items()}), path)
+        pq.write_table(arrow_table({k: np.asarray(v) for k, v in self.columns().items()}), path)
         return path

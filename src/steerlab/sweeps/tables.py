@@ -23,12 +23,13 @@ def write_table(stage: Path, stem: str, columns: dict, parquet: bool = True) -> 
     paths.append(p)
     if parquet:
         try:
-            import pyarrow as pa
             import pyarrow.parquet as pq
         except ImportError:  # pragma: no cover - optional
             return paths
+        from steerlab.arrow_table import arrow_table
+
         q = Path(stage) / f"{stem}.parquet"
-        pq.write_table(pa.table({k: list(columns[k]) for k in names}), q)
+        pq.write_table(arrow_table({k: list(columns[k]) for k in names}), q)
         paths.append(q)
     return paths
 
