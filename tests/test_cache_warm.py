@@ -81,9 +81,64 @@ def test_scenario_warm_covers_its_single_run_and_batch():
     _assert_warmed(lambda: warm_scenario_file(LOS_ROUTE, batch=True), use)
 
 
+_PYTHON_SIDE = """
+import json
+from steerlab.components.linear import linear_model
+from steerlab.control.registry import get_controller
+from steerlab.ships.registry import SHIPS, get_ship
+from steerlab.sim.engine import simulate
+from steerlab.sim.setup import build
+from steerlab.sim.warm import warm_pair, warm_plant, warm_scenario
+
+ship = next(name for name in sorted(SHIPS) if get_ship(name).linearise is None)
+rhs, update = get_ship(ship).rhs, get_controller("adrc").update
+warm_plant(ship)
+warm_pair(ship, "adrc")
+before = [sorted(map(str, rhs.signatures)), sorted(map(str, update.signatures))]
+linear_model(ship)
+simulate(build(warm_scenario(ship, "adrc")), "readable")
+after = [sorted(map(str, rhs.signatures)), sorted(map(str, update.signatures))]
+print(json.dumps({"ship": ship, "before": before, "after": after}))
+"""
+
+
+def test_plant_warm_covers_linearisation_and_pair_warm_the_readable_controller():
+    """The kernels called from Python: ``--plants`` warms the ship's rhs as linearisation calls
+    it (``sl.linearize``, the design rules: one float signature, whatever the straight-running
+    rudder's type), a pair's warm-up the controller's update as the readable loop calls it. In
+    a new process: one where no other test has already compiled them."""
+    import json
+    import subprocess
+
+    p = subprocess.run([sys.executable, "-c", _PYTHON_SIDE], capture_output=True, text=True, timeout=600)
+    assert p.returncode == 0, p.stderr
+    out = json.loads(p.stdout.strip().splitlines()[-1])
+    assert all(out["before"]), out                        # the warm-ups compiled (or loaded) both
+    assert out["after"] == out["before"], out             # linearisation and the readable loop: nothing new
+
+
+def test_lanes_warm_covers_the_batch_at_that_group_size():
+    """``--lanes``: the batch loop at another number of runs per vector group (another driver
+    per group size) is warmed too, and the batch at that size then compiles nothing."""
+    from steerlab.sim.batch import simulate_batch
+    from steerlab.sim.setup import build
+    from steerlab.sim.warm import warm_pair, warm_scenario
+
+    def use():
+        setup = build(warm_scenario("nomoto1", "pid"))
+        a = simulate_batch([setup] * 5, lanes=3)
+        b = simulate_batch([setup] * 5)
+        np.testing.assert_array_equal(a.final_states, b.final_states)
+
+    _assert_warmed(lambda: warm_pair("nomoto1", "pid", batch=True, lanes=(16, 3)), use)
+
+
 @pytest.mark.parametrize("argv, field", [
     (["--scenario", "no-such-file.toml"], "scenario"),
     (["--ships", "no-such-ship", "--plants"], "ship"),
+    (["--ships", "nomoto1", "--batch", "--lanes", "0"], "--lanes"),
+    (["--ships", "nomoto1", "--batch", "--lanes", "16", "65"], "--lanes"),
+    (["--ships", "nomoto1", "--lanes", "3"], "--lanes"),              # --lanes warms the batch: needs --batch
 ])
 def test_bad_warm_input_is_one_line_and_exit_2(argv, field, capsys, monkeypatch, tmp_path):
     monkeypatch.setenv("STEERLAB_CACHE_DIR", str(tmp_path))

@@ -38,6 +38,9 @@ def register(sub, formatter_class):
     p.add_argument("--controllers", nargs="+", default=list(COMMON_CONTROLLERS), metavar="TYPE",
                    help=f"warm: controller types, or 'all' (default: {' '.join(COMMON_CONTROLLERS)})")
     p.add_argument("--batch", action="store_true", help="warm: also the batch engine's loop")
+    p.add_argument("--lanes", nargs="+", type=int, default=None, metavar="N",
+                   help="warm, with --batch: the batch loop for these numbers of runs per vector group "
+                        "(simulate_batch's lanes, 1-64; default: the engine's 16)")
     p.add_argument("--gym", action="store_true",
                    help="warm: also the Gymnasium environments' step and reset (every task) of the Esso "
                         "and of the --ships")
@@ -83,6 +86,21 @@ def run(args) -> int:
     return _warm(args)
 
 
+def _lanes(args) -> tuple:
+    """The batch loop's group sizes to warm (``--lanes``), checked: 1-64, and only with --batch."""
+    from steerlab.errors import InputError
+    from steerlab.sim.lanes import LANES
+
+    if args.lanes is None:
+        return (LANES,)
+    if not args.batch:
+        raise InputError("--lanes", "warms the batch loop: give --batch too")
+    for n in args.lanes:
+        if not 1 <= n <= 64:
+            raise InputError("--lanes", f"must be in [1, 64], got {n}")
+    return tuple(dict.fromkeys(args.lanes))
+
+
 def _warm(args) -> int:
     from steerlab.control.registry import get_controller
     from steerlab.ships.registry import get_ship
@@ -102,10 +120,11 @@ def _warm(args) -> int:
         get_controller(c)
     for path in args.scenario:
         load_scenario(path)
-    jobs = [(f"{s} + {c}", warm_pair, (s, c, args.batch)) for s, c in pairs]
+    lanes = _lanes(args)
+    jobs = [(f"{s} + {c}", warm_pair, (s, c, args.batch, lanes)) for s, c in pairs]
     jobs += [(f"{s} plant step", warm_plant, (s,)) for s in ships if args.plants]
     jobs += [(f"{s} trial loop", warm_trial, (s,)) for s in ships if args.trials]
-    jobs += [(str(path), warm_scenario_file, (path, args.batch, args.plants)) for path in args.scenario]
+    jobs += [(str(path), warm_scenario_file, (path, args.batch, args.plants, lanes)) for path in args.scenario]
     from steerlab.cli import _progress
     from steerlab.progress import runs_progress
 

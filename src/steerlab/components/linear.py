@@ -62,6 +62,7 @@ def jacobian(rhs: Callable[..., None], x0: np.ndarray, delta0: float, ps: np.nda
     ``A[i, j] = d x_i' / d x_j`` over the ship's states, ``B[i] = d x_i' / d delta`` (SI).
     """
     n = len(x0)
+    delta0 = float(delta0)        # one compiled signature of rhs for every caller (an int 0 made a second)
     w = np.zeros(7) if w is None else w
     dx_p = np.zeros(n + 1)
     dx_m = np.zeros(n + 1)

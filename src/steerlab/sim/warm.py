@@ -34,38 +34,43 @@ def warm_scenario(ship_id: str, controller: str):
         "guidance": {"psi0_deg": 0.0, "changes": []}, "environment": {}})
 
 
-def warm_pair(ship_id: str, controller: str, batch: bool = False) -> str:
-    """Run the pair's single-run loop (and the batch loop) once; returns ``"ok"`` or why not."""
+def warm_pair(ship_id: str, controller: str, batch: bool = False, lanes=None) -> str:
+    """Run the pair's single-run loop (and the batch loop, at each group size of ``lanes``,
+    default the engine's) once; returns ``"ok"`` or why not."""
     from steerlab.sim.setup import build
 
     try:
         setup = build(warm_scenario(ship_id, controller))
     except InputError as err:      # a pair whose design needs more than the defaults
         return f"skipped ({err})"
-    _run(setup, batch)
+    _run(setup, batch, lanes)
     return "ok"
 
 
-def _run(setup, batch: bool) -> None:
+def _run(setup, batch: bool, lanes=None) -> None:
     from steerlab.sim.batch import simulate_batch
     from steerlab.sim.engine import simulate
+    from steerlab.sim.lanes import LANES
 
     simulate(setup)
+    simulate(setup, "readable")          # the controller's update called from Python
     if batch:
-        simulate_batch([setup, setup])
+        for n in lanes or (LANES,):
+            simulate_batch([setup, setup], lanes=n)
 
 
-def warm_scenario_file(path, batch: bool = False, plants: bool = False) -> str:
+def warm_scenario_file(path, batch: bool = False, plants: bool = False, lanes=None) -> str:
     """Run the combination of a scenario file (ship, controller and its wrappers, guidance,
-    sensors) for :data:`WARM_DURATION` seconds, single run (and batch; and with ``plants`` the
-    plant-only step of its ship, with its options: e.g. an rpm schedule's kernel); returns
-    ``"ok"``. Bad input raises :class:`InputError` (the file's own message)."""
+    sensors) for :data:`WARM_DURATION` seconds, single run (and batch, at each group size of
+    ``lanes``, default the engine's; and with ``plants`` the plant-only step of its ship, with
+    its options: e.g. an rpm schedule's kernel); returns ``"ok"``. Bad input raises
+    :class:`InputError` (the file's own message)."""
     from steerlab.sim.scenario import load_scenario
     from steerlab.sim.setup import build
 
     scenario = load_scenario(path)
     setup = build(scenario.model_copy(update={"duration": min(scenario.duration, WARM_DURATION)}))
-    _run(setup, batch)
+    _run(setup, batch, lanes)
     if plants:
         _plant_step(setup)
     return "ok"
@@ -73,7 +78,9 @@ def warm_scenario_file(path, batch: bool = False, plants: bool = False) -> str:
 
 def warm_plant(ship_id: str) -> str:
     """The ship's plant-only driver: the scalar RK4 step (the readable loop, the runtime ship,
-    plant objects) and the rudder replay (identification); returns ``"ok"`` or why not."""
+    plant objects) and the rudder replay (identification), and its kernel called from Python
+    (linearisation: ``sl.linearize``, the design rules); returns ``"ok"`` or why not."""
+    from steerlab.components.linear import linear_model
     from steerlab.sim.setup import build
 
     try:
@@ -81,6 +88,7 @@ def warm_plant(ship_id: str) -> str:
     except InputError as err:
         return f"skipped ({err})"
     _plant_step(s)
+    linear_model(ship_id, warm_speed_kn(ship_id))
     return "ok"
 
 
