@@ -57,10 +57,17 @@ def _result(p):
 
 @pytest.fixture(scope="module")
 def compiled_once(tmp_path_factory):
-    """``(cache, result)``: the first process's run on an empty cache (it compiles and saves the
-    loop), shared by the tests that start from that cache (each on its own copy of it)."""
+    """``(cache, result, concurrent)``: two processes started at once on an empty cache (both
+    compile the loop and save it: the concurrent-writers case), then a fresh process on a copy of
+    that cache; ``result`` is the run of a process that compiled, ``concurrent`` the three runs.
+    Shared by the tests that start from that cache (each on its own copy of it): one cold
+    compile for the module instead of one per test."""
     cache = tmp_path_factory.mktemp("compiled-once")
-    return cache, _run(cache)
+    procs = [_run(cache, wait=False) for _ in range(2)]
+    a, b = (_result(p) for p in procs)
+    fresh = _run(_copy(cache, tmp_path_factory.mktemp("fresh") / "cache"))
+    first = a if a["misses"] == 1 else b
+    return cache, first, {"a": a, "b": b, "fresh": fresh}
 
 
 def _copy(cache: Path, to: Path) -> Path:
@@ -68,24 +75,23 @@ def _copy(cache: Path, to: Path) -> Path:
     return to
 
 
-def test_a_fresh_process_loads_the_compiled_loop_instead_of_compiling(compiled_once, tmp_path):
-    cache, first = compiled_once
+def test_a_fresh_process_loads_the_compiled_loop_instead_of_compiling(compiled_once):
+    _, first, runs = compiled_once
     assert first["cached"] and first["misses"] == 1 and first["hits"] == 0      # compiled, saved
-    second = _run(_copy(cache, tmp_path / "cache"))
+    second = runs["fresh"]
     assert second["misses"] == 0 and second["hits"] == 1                         # loaded
     assert second["last"] == first["last"]                                        # same bits
 
 
-def test_two_processes_compiling_the_same_combination_at_once_both_succeed(tmp_path):
-    procs = [_run(tmp_path, wait=False) for _ in range(2)]
-    a, b = (_result(p) for p in procs)
-    assert a["last"] == b["last"]
-    third = _run(tmp_path)
-    assert third["hits"] == 1 and third["last"] == a["last"]
+def test_two_processes_compiling_the_same_combination_at_once_both_succeed(compiled_once):
+    _, _, runs = compiled_once
+    a, b = runs["a"], runs["b"]
+    assert a["cached"] and b["cached"] and a["last"] == b["last"]                 # both succeeded, same bits
+    assert runs["fresh"]["hits"] == 1 and runs["fresh"]["last"] == a["last"]      # what they saved loads
 
 
 def test_truncated_cache_files_are_detected_and_rebuilt(compiled_once, tmp_path):
-    cache, ref = compiled_once
+    cache, ref, _ = compiled_once
     cache = _copy(cache, tmp_path / "cache")
     files = [f for f in cache.rglob("*") if f.suffix in (".nbi", ".nbc", ".py")]
     assert any(f.suffix == ".nbc" for f in files)
@@ -105,7 +111,7 @@ def test_a_changed_steerlab_never_serves_stale_code(compiled_once, tmp_path):
     src = tmp_path / "src"
     shutil.copytree(SRC / "steerlab", src / "steerlab",
                     ignore=shutil.ignore_patterns("__pycache__"))
-    cache, ref = compiled_once
+    cache, ref, _ = compiled_once
     cache = _copy(cache, tmp_path / "cache")
     before = _run(cache, src)
     assert before["hits"] == 1 and before["last"] == ref["last"]

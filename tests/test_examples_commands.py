@@ -203,18 +203,48 @@ def _in_process(argv, workdir):
     return subprocess.CompletedProcess(["steerlab", *argv], code, out.getvalue(), err.getvalue())
 
 
-def _wait_until_serving(server, timeout=60.0):
-    """Until ``serve-ship`` says it is bound (its first stderr line, "serve-ship: ... on HOST:PORT")
-    or exits: the autopilot then starts against a listening ship, without a fixed sleep."""
-    import select
+class _ShipInThread:
+    """The ship an ``autopilot`` example connects to: :class:`steerlab.runtime.ship_server.ShipServer`
+    (what ``steerlab serve-ship`` runs) on 127.0.0.1:``port`` in a thread of this process, at a
+    speed-up of 20, with the example's scenario (or the bundled default). Started when it is
+    bound; :meth:`stop` ends it. (A ``serve-ship`` process per example would cost a Python
+    start-up each; the command itself runs in ``tests/test_runtime_cli.py``.)"""
 
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline and server.poll() is None:
-        ready, _, _ = select.select([server.stderr], [], [], 0.1)
-        if ready:
-            line = server.stderr.readline()
-            if not line or line.startswith(b"serve-ship:"):
-                return
+    def __init__(self, scenario_path, port: int, timeout: float = 60.0):
+        import asyncio
+        import threading
+
+        from steerlab.runtime.ship_server import ShipServer, ShipServerConfig
+        from steerlab.sim.scenario import default_scenario, load_scenario
+
+        scenario = load_scenario(scenario_path) if scenario_path else default_scenario()
+        self.server = ShipServer(scenario, ShipServerConfig(speedup=20.0, duration=2000.0).validate(),
+                                 bind=("127.0.0.1", port))
+        self.loop, self.error = None, None
+        bound = threading.Event()
+
+        def serve():
+            async def run():
+                self.loop = asyncio.get_running_loop()
+                await self.server.run(lambda _: bound.set())
+
+            try:
+                asyncio.run(run())
+            except BaseException as exc:          # noqa: BLE001 - reported by the test
+                self.error = exc
+            finally:
+                bound.set()
+
+        self.thread = threading.Thread(target=serve, name="example-ship", daemon=True)
+        self.thread.start()
+        bound.wait(timeout)
+        assert self.error is None, f"the example's ship did not start: {self.error!r}"
+
+    def stop(self) -> None:
+        if self.loop is not None and self.thread.is_alive():
+            self.loop.call_soon_threadsafe(self.server.stop)
+        self.thread.join(timeout=30)
+        assert not self.thread.is_alive(), "the example's ship did not stop"
 
 
 def _run(label, env_assign, argv, workdir):
@@ -230,12 +260,9 @@ def _run(label, env_assign, argv, workdir):
     server = None
     if argv[0] == "autopilot":
         port = _free_port()
-        scen = [argv[argv.index("--scenario") + 1]] if "--scenario" in argv else []
-        server = subprocess.Popen([sys.executable, "-m", "steerlab", "serve-ship", *scen, "--bind",
-                                   f"127.0.0.1:{port}", "--speedup", "20", "--duration", "2000"],
-                                  cwd=workdir, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+        scen = argv[argv.index("--scenario") + 1] if "--scenario" in argv else None
+        server = _ShipInThread(workdir / scen if scen else None, port)
         argv = _ports(argv, port)
-        _wait_until_serving(server)
     else:
         argv = _ports(argv)
     try:
@@ -243,8 +270,7 @@ def _run(label, env_assign, argv, workdir):
                               capture_output=True, text=True, timeout=600, stdin=subprocess.DEVNULL)
     finally:
         if server is not None:
-            server.terminate()
-            server.wait(timeout=30)
+            server.stop()
     return argv, proc
 
 
