@@ -65,14 +65,15 @@ def _run(cache: Path, *command: str) -> dict:
     return json.loads(p.stdout.strip().splitlines()[-1])
 
 
-ENV_TEMPLATE_HEAD = 'r"""The compiled step and reset of the Gymnasium environments'
-
-
 def _is_esso_course_keeping_env(module: Path) -> bool:
     """Is ``module`` (a generated ``d_<hash>.py``) the Esso course-keeping environment's step and
-    reset (the module the environments of SCRIPT use)?"""
+    reset (the module the environments of SCRIPT use)? A generated module starts as its
+    template does (:data:`steerlab.gym.plant_batch.TEMPLATE`)."""
+    from steerlab.gym.plant_batch import TEMPLATE
+
+    head = TEMPLATE.read_text(encoding="utf-8").split("\n", 1)[0]
     text = module.read_text(encoding="utf-8", errors="replace")
-    return (text.startswith(ENV_TEMPLATE_HEAD) and "steerlab.ships.esso_3dof:esso_rhs" in text
+    return (text.startswith(head) and "steerlab.ships.esso_3dof:esso_rhs" in text
             and "steerlab.guidance.reference_models:course_guide" in text)
 
 

@@ -86,19 +86,17 @@ def run(args) -> int:
     return _warm(args)
 
 
-def _lanes(args) -> tuple:
-    """The batch loop's group sizes to warm (``--lanes``), checked: 1-64, and only with --batch."""
+def _lanes(args):
+    """The batch loop's group sizes to warm (``--lanes``, checked, only with --batch), or None
+    for the engine's default."""
     from steerlab.errors import InputError
-    from steerlab.sim.lanes import LANES
+    from steerlab.sim.lanes import check_lanes
 
     if args.lanes is None:
-        return (LANES,)
+        return None
     if not args.batch:
         raise InputError("--lanes", "warms the batch loop: give --batch too")
-    for n in args.lanes:
-        if not 1 <= n <= 64:
-            raise InputError("--lanes", f"must be in [1, 64], got {n}")
-    return tuple(dict.fromkeys(args.lanes))
+    return tuple(dict.fromkeys(check_lanes(n, "--lanes") for n in args.lanes))
 
 
 def _warm(args) -> int:

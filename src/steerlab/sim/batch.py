@@ -229,15 +229,14 @@ class PackedBatch:
         number of runs done (at most twice a second, and at the end).
         """
         from steerlab.guidance.reference_vector import N_REF
-        from steerlab.sim.lanes import batch_loop
+        from steerlab.sim.lanes import batch_loop, check_lanes
 
         n, N = self.n, self.n_steps
         nx = self.X.shape[1]
         rec = N + 1 if record_every is None else int(record_every)
         if rec < 1:
             raise InputError("record_every", f"must be >= 1, got {record_every}")
-        if not 1 <= int(lanes) <= 64:
-            raise InputError("lanes", f"must be in [1, 64], got {lanes}")
+        check_lanes(lanes)
         n_rec = N // rec + 1
         out_x = np.empty((n, n_rec, nx))
         out_cmd = np.empty((n, n_rec))

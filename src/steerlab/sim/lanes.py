@@ -41,6 +41,19 @@ LANES = 16
 """Runs advanced together by one thread of the batch engine (two AVX-512 vectors of float64;
 measured on W1: 8 lanes 0.78x, 32 lanes 0.99x the speed of 16)."""
 
+MAX_LANES = 64
+"""The largest group a caller may ask for (``simulate_batch(lanes=...)``, ``cache warm --lanes``)."""
+
+
+def check_lanes(lanes, field: str = "lanes") -> int:
+    """``lanes`` as an int in [1, :data:`MAX_LANES`], else :class:`~steerlab.errors.InputError`
+    naming ``field``."""
+    from steerlab.errors import InputError
+
+    if not 1 <= int(lanes) <= MAX_LANES:
+        raise InputError(field, f"must be in [1, {MAX_LANES}], got {lanes}")
+    return int(lanes)
+
 
 def lane_loop(ship_rhs, ctrl_update, guide, nx: int, lanes: int = LANES):
     """Compiled loop advancing a group of up to ``lanes`` independent runs in lock step.
