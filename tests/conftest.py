@@ -147,6 +147,62 @@ def pytest_sessionfinish(session, exitstatus):
         session.exitstatus = 1
 
 
+# ------------------------------------------- a worker of their own for the wall-clock tests
+REALTIME_MODULES = ("tests/test_runtime_*.py", "tests/test_signalk_plugin.py")
+"""The tests of the real-time link (ship server and autopilot over loopback sockets, the browser
+bridge, the Signal K server): they wait on the wall clock. They are marked ``realtime``
+(``-m "not realtime"`` leaves them out) and, under ``-n auto``, run on a worker of their own
+beside one per core (``tests/xdist_lanes.py``)."""
+
+#: the CPU niceness of a pytest-xdist worker while it runs a compute test (not ``realtime``):
+#: when a real-time test's processes wake they get a core at once
+COMPUTE_NICENESS = 10
+
+
+def is_realtime(nodeid: str) -> bool:
+    """True for a test of one of :data:`REALTIME_MODULES` (``nodeid`` relative to the repository)."""
+    from fnmatch import fnmatch
+
+    module = nodeid.split("::", 1)[0]
+    return any(fnmatch(module, pattern) for pattern in REALTIME_MODULES)
+
+
+def pytest_collection_modifyitems(config, items):
+    for item in items:
+        if is_realtime(item.nodeid):
+            item.add_marker(pytest.mark.realtime)
+
+
+@pytest.hookimpl(optionalhook=True)
+def pytest_xdist_auto_num_workers(config):
+    from xdist_lanes import auto_workers
+
+    return auto_workers(config)
+
+
+@pytest.hookimpl(optionalhook=True)
+def pytest_xdist_make_scheduler(config, log):
+    if config.getvalue("dist") != "load":
+        return None                              # the user chose another distribution
+    from xdist.workermanage import parse_tx_spec_config
+    from xdist_lanes import LaneScheduling
+
+    return LaneScheduling(len(parse_tx_spec_config(config)), is_realtime, log.lanesched)
+
+
+@pytest.hookimpl(tryfirst=True)
+def pytest_runtest_setup(item):
+    """Under pytest-xdist's ``load`` distribution, a worker runs compute tests at a lower CPU
+    priority (:data:`COMPUTE_NICENESS`) than the real-time tests (see :data:`REALTIME_MODULES`).
+    The priority only goes down: a worker that has run a compute test stays at it."""
+    if (not os.environ.get("PYTEST_XDIST_WORKER") or not hasattr(os, "nice")
+            or item.config.getvalue("dist") != "load" or item.get_closest_marker("realtime")):
+        return
+    now = os.getpriority(os.PRIO_PROCESS, 0)
+    if now < COMPUTE_NICENESS:
+        os.nice(COMPUTE_NICENESS - now)
+
+
 # ---------------------------------------------------------------- test times, as they finish
 def pytest_runtest_logreport(report):
     """With ``STEERLAB_TEST_TIMES=FILE``, append ``seconds phase nodeid`` for every test phase
