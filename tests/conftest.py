@@ -190,13 +190,24 @@ def pytest_xdist_make_scheduler(config, log):
     return LaneScheduling(len(parse_tx_spec_config(config)), is_realtime, log.lanesched)
 
 
+@pytest.hookimpl(optionalhook=True)
+def pytest_configure_node(node):
+    """Tells each pytest-xdist worker whether the lanes scheduler runs (the workers' own
+    options do not say which distribution the controller uses)."""
+    node.workerinput["steerlab_lanes"] = node.config.getvalue("dist") == "load"
+
+
+def under_lanes(config) -> bool:
+    """True in a pytest-xdist worker of a run scheduled by ``tests/xdist_lanes.py``."""
+    return bool(getattr(config, "workerinput", {}).get("steerlab_lanes"))
+
+
 @pytest.hookimpl(tryfirst=True)
 def pytest_runtest_setup(item):
-    """Under pytest-xdist's ``load`` distribution, a worker runs compute tests at a lower CPU
-    priority (:data:`COMPUTE_NICENESS`) than the real-time tests (see :data:`REALTIME_MODULES`).
-    The priority only goes down: a worker that has run a compute test stays at it."""
-    if (not os.environ.get("PYTEST_XDIST_WORKER") or not hasattr(os, "nice")
-            or item.config.getvalue("dist") != "load" or item.get_closest_marker("realtime")):
+    """Under the lanes scheduler, a worker runs compute tests at a lower CPU priority
+    (:data:`COMPUTE_NICENESS`) than the real-time tests (see :data:`REALTIME_MODULES`). The
+    priority only goes down: a worker that has run a compute test stays at it."""
+    if not under_lanes(item.config) or not hasattr(os, "nice") or item.get_closest_marker("realtime"):
         return
     now = os.getpriority(os.PRIO_PROCESS, 0)
     if now < COMPUTE_NICENESS:
