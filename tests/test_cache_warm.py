@@ -117,6 +117,40 @@ def test_plant_warm_covers_linearisation_and_pair_warm_the_readable_controller()
     assert out["after"] == out["before"], out             # linearisation and the readable loop: nothing new
 
 
+_RUN_SIDE = """
+import json, sys
+from steerlab import fast_csv
+from steerlab.angles import wrap_to_pi
+from steerlab.cli import main
+from steerlab.ships.registry import get_ship
+from steerlab.sim.warm import warm_pair
+
+def signatures():
+    kernels = [get_ship("esso").rhs, wrap_to_pi, *fast_csv._compile()]
+    return [sorted(map(str, k.signatures)) for k in kernels]
+
+warm_pair("esso", "adrc")                 # the default scenario's pair
+before = signatures()
+assert main(["run", "--out", sys.argv[1]]) == 0
+print(json.dumps({"before": before, "after": signatures()}))
+"""
+
+
+def test_pair_warm_covers_what_the_default_run_calls_from_python(tmp_path):
+    """After the pair's warm-up, ``steerlab run`` on the bundled default calls no kernel with a
+    signature the warm-up did not: the ship's rhs called from Python (the wave's channel probe),
+    the metrics' heading wrap and the CSV formatter. In a new process (see above)."""
+    import json
+    import subprocess
+
+    p = subprocess.run([sys.executable, "-c", _RUN_SIDE, str(tmp_path / "out")], capture_output=True, text=True,
+                       timeout=600)
+    assert p.returncode == 0, p.stderr
+    out = json.loads(p.stdout.strip().splitlines()[-1])
+    assert all(out["before"]), out
+    assert out["after"] == out["before"], out
+
+
 def test_lanes_warm_covers_the_batch_at_that_group_size():
     """``--lanes``: the batch loop at another number of runs per vector group (another driver
     per group size) is warmed too, and the batch at that size then loads or compiles nothing

@@ -24,14 +24,15 @@ def warm_speed_kn(ship_id: str) -> float:
 
 
 def warm_scenario(ship_id: str, controller: str):
-    """A short scenario of the pair at a speed inside the ship's validity range."""
+    """A short scenario of the pair at a speed inside the ship's validity range, with a heading
+    change (the step metrics' path of :func:`steerlab.metrics.compute_metrics`)."""
     from steerlab.sim.scenario import scenario_from_dict
 
     return scenario_from_dict({
         "name": f"warm-{ship_id}-{controller}", "seed": 0, "dt": 0.1, "duration": WARM_DURATION,
         "ship": {"model": ship_id, "speed_kn": warm_speed_kn(ship_id)},
         "controller": {"type": controller},
-        "guidance": {"psi0_deg": 0.0, "changes": []}, "environment": {}})
+        "guidance": {"psi0_deg": 0.0, "changes": [{"t": 1.0, "psi_deg": 10.0}]}, "environment": {}})
 
 
 def warm_pair(ship_id: str, controller: str, batch: bool = False, lanes=None) -> str:
@@ -52,11 +53,34 @@ def _run(setup, batch: bool, lanes=None) -> None:
     from steerlab.sim.engine import simulate
     from steerlab.sim.lanes import LANES
 
-    simulate(setup)
+    _outputs(simulate(setup))
     simulate(setup, "readable")          # the controller's update called from Python
+    _kernel_from_python(setup)
     if batch:
         for n in lanes or (LANES,):
             simulate_batch([setup, setup], lanes=n)
+
+
+def _kernel_from_python(setup) -> None:
+    """The ship's kernel called from Python, as building a scenario does when it probes which
+    disturbance channel the ship reads (:mod:`steerlab.environment.channel_probe`; a wave on
+    ``channel = "auto"``) and linearisation does: a compiled signature of its own."""
+    from steerlab.environment.channel_probe import reads_channel
+    from steerlab.environment.channels import W_RUDDER
+
+    reads_channel(setup.ship, setup.ps, setup.x0, W_RUDDER)
+
+
+def _outputs(res) -> None:
+    """What ``steerlab run`` computes from a result: the metrics (their heading wraps) and the
+    time-series CSV's compiled formatter (:mod:`steerlab.fast_csv`, on two rows, no file)."""
+    import numpy as np
+
+    from steerlab.fast_csv import format_block
+    from steerlab.metrics import compute_metrics
+
+    compute_metrics(res)
+    format_block(np.column_stack(list(res.columns().values()))[:2])
 
 
 def warm_scenario_file(path, batch: bool = False, plants: bool = False, lanes=None) -> str:
@@ -88,6 +112,7 @@ def warm_plant(ship_id: str) -> str:
     except InputError as err:
         return f"skipped ({err})"
     _plant_step(s)
+    _kernel_from_python(s)
     linear_model(ship_id, warm_speed_kn(ship_id))
     return "ok"
 
