@@ -295,18 +295,16 @@ def workdir(tmp_path_factory):
     return d
 
 
-def _same_run(argv) -> tuple:
+def _same_run(argv, parser) -> tuple:
     """What a command runs, as tested: its smaller form (:func:`_smaller`) with any ``--out``
-    folder, as steerlab's own parser reads it (so the order of the options does not matter);
+    folder, as steerlab's own ``parser`` reads it (so the order of the options does not matter);
     the words themselves where the parser refuses them (that refusal is then what is tested)."""
-    from steerlab.cli import build_parser
-
     run = _smaller(argv)
     if "--out" in run:
         run = _set(run, "--out", "OUT")
     try:
         with contextlib.redirect_stderr(io.StringIO()):
-            parsed = vars(build_parser().parse_args([str(a) for a in run]))
+            parsed = vars(parser.parse_args([str(a) for a in run]))
     except SystemExit:
         return tuple(run)
     return tuple(sorted((k, repr(v)) for k, v in parsed.items()))
@@ -315,9 +313,11 @@ def _same_run(argv) -> tuple:
 def all_examples():
     """Help and doc examples, each distinct command once (two examples that differ only in their
     ``--out`` folder, or in a size the test makes small anyway, run once)."""
-    out, seen = [], set()
+    from steerlab.cli import build_parser
+
+    out, seen, parser = [], set(), build_parser()      # one parser: building it is ~10 ms each time
     for label, env, argv in help_examples() + doc_examples():
-        key = (tuple(sorted(env.items())), _same_run(argv))
+        key = (tuple(sorted(env.items())), _same_run(argv, parser))
         if key not in seen:
             seen.add(key)
             out.append((label, env, argv))

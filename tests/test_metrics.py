@@ -5,7 +5,6 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from scipy.optimize import brentq
 
 from steerlab.metrics import (compute_metrics, integral_metrics, last_setpoint_change, settling_time,
                               speed_loss_J, step_metrics)
@@ -138,12 +137,16 @@ def _last_crossing(f, level, t_max, dt=1e-3):
     t = np.arange(dt, t_max, dt)
     g = np.abs(f(t) - 1.0) - level
     idx = np.nonzero(np.sign(g[:-1]) != np.sign(g[1:]))[0][-1]
+    from scipy.optimize import brentq     # here, not at collection (every pytest worker collects)
+
     return brentq(lambda s: abs(f(s) - 1.0) - level, t[idx], t[idx + 1])
 
 
 def _first_crossing(f, level, t_max, dt=1e-3):
     t = np.arange(0.0, t_max, dt)
     idx = np.nonzero(f(t) >= level)[0][0]
+    from scipy.optimize import brentq
+
     return brentq(lambda s: f(s) - level, t[idx - 1], t[idx])
 
 
