@@ -154,6 +154,10 @@ bridge, the Signal K server): they wait on the wall clock. They are marked ``rea
 (``-m "not realtime"`` leaves them out) and, under ``-n auto``, run on a worker of their own
 beside one per core (``tests/xdist_lanes.py``)."""
 
+#: ``STEERLAB_TEST_LANES=0``: pytest-xdist's own ``-n auto`` and ``load`` scheduling instead
+#: (one worker per core, every test anywhere; ``benchmarks/bench_test_lanes.py`` compares them)
+LANES = os.environ.get("STEERLAB_TEST_LANES", "1") != "0"
+
 #: the CPU niceness of a pytest-xdist worker while it runs a compute test (not ``realtime``):
 #: when a real-time test's processes wake they get a core at once
 COMPUTE_NICENESS = 10
@@ -167,6 +171,27 @@ def is_realtime(nodeid: str) -> bool:
     return any(fnmatch(module, pattern) for pattern in REALTIME_MODULES)
 
 
+def lanes_wanted(config) -> bool:
+    """Whether this run gets the real-time lane: ``STEERLAB_TEST_LANES`` is not ``0`` and the
+    paths given to pytest may hold real-time tests (none given: the whole suite; a folder; one of
+    :data:`REALTIME_MODULES`). ``pytest tests/test_asa.py`` keeps one worker per core."""
+    if not LANES:
+        return False
+    root = Path(str(config.rootpath)).resolve()
+    for arg in config.args or ["tests"]:
+        path = Path(arg.split("::", 1)[0])
+        if not path.is_absolute():
+            path = Path(str(config.invocation_params.dir)) / path
+        if path.is_dir():
+            return True
+        try:
+            if is_realtime(path.resolve().relative_to(root).as_posix()):
+                return True
+        except ValueError:
+            continue
+    return False
+
+
 def pytest_collection_modifyitems(config, items):
     for item in items:
         if is_realtime(item.nodeid):
@@ -177,13 +202,13 @@ def pytest_collection_modifyitems(config, items):
 def pytest_xdist_auto_num_workers(config):
     from xdist_lanes import auto_workers
 
-    return auto_workers(config)
+    return auto_workers(config) if lanes_wanted(config) else None
 
 
 @pytest.hookimpl(optionalhook=True)
 def pytest_xdist_make_scheduler(config, log):
-    if config.getvalue("dist") != "load":
-        return None                              # the user chose another distribution
+    if config.getvalue("dist") != "load" or not lanes_wanted(config):
+        return None                   # the user chose another distribution, or no lane is needed
     from xdist.workermanage import parse_tx_spec_config
     from xdist_lanes import LaneScheduling
 
@@ -194,7 +219,7 @@ def pytest_xdist_make_scheduler(config, log):
 def pytest_configure_node(node):
     """Tells each pytest-xdist worker whether the lanes scheduler runs (the workers' own
     options do not say which distribution the controller uses)."""
-    node.workerinput["steerlab_lanes"] = node.config.getvalue("dist") == "load"
+    node.workerinput["steerlab_lanes"] = node.config.getvalue("dist") == "load" and lanes_wanted(node.config)
 
 
 def under_lanes(config) -> bool:

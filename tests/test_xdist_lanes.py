@@ -5,10 +5,12 @@ tests run elsewhere; and a compute test runs at the lower CPU priority."""
 from __future__ import annotations
 
 import os
+from pathlib import Path
 from types import SimpleNamespace
 
 import pytest
-from conftest import COMPUTE_NICENESS, is_realtime, under_lanes
+import conftest
+from conftest import COMPUTE_NICENESS, is_realtime, lanes_wanted, under_lanes
 from xdist_lanes import MIN_PENDING, QUEUED, LaneScheduling
 
 
@@ -131,3 +133,18 @@ def test_a_compute_test_runs_at_the_lower_cpu_priority_under_xdist(request):
     if not under_lanes(request.config):
         pytest.skip("runs under pytest-xdist's load distribution (the suite's default -n auto)")
     assert os.getpriority(os.PRIO_PROCESS, 0) >= COMPUTE_NICENESS
+
+
+@pytest.mark.parametrize("args, wanted", [
+    ([], True),                                                   # the whole suite (testpaths)
+    (["tests"], True),
+    (["tests/test_asa.py"], False),                               # no real-time test selected
+    (["tests/test_asa.py", "tests/test_runtime_e2e.py::test_hold_course_and_change_20_deg"], True),
+    (["tests/test_signalk_plugin.py"], True),
+])
+def test_the_lane_only_when_real_time_tests_may_run(args, wanted, monkeypatch):
+    repo = Path(__file__).resolve().parent.parent
+    config = SimpleNamespace(args=args, rootpath=repo, invocation_params=SimpleNamespace(dir=repo))
+    assert lanes_wanted(config) is wanted
+    monkeypatch.setattr(conftest, "LANES", False)                  # STEERLAB_TEST_LANES=0
+    assert lanes_wanted(config) is False

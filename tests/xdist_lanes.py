@@ -4,7 +4,8 @@ The runtime's tests (a ship server and an autopilot talking over loopback socket
 a headless browser, a Signal K server) spend most of their wall time waiting: on a worker that
 also runs the compute-heavy tests they hold a core idle for about a minute of the suite. With
 ``-n auto`` the suite therefore starts one worker more than there are cores
-(:func:`auto_workers`), and :class:`LaneScheduling` gives
+(:func:`auto_workers`; only when the paths given to pytest may hold real-time tests, and not
+with ``STEERLAB_TEST_LANES=0``: ``tests/conftest.py``), and :class:`LaneScheduling` gives
 
 * the **wall-clock tests** (``is_waiting(nodeid)``) to the last worker, the *lane*, in
   collection order;
