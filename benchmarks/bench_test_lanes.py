@@ -53,10 +53,12 @@ def run_suite(mode: str, pytest_args: list[str]) -> dict:
     p = subprocess.run([sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", *pytest_args],
                        cwd=REPO, env=env, capture_output=True, text=True)
     wall, cpu = time.perf_counter() - t0, _children_cpu() - c0
-    last = (p.stdout.strip().splitlines() or [""])[-1]
+    lines = p.stdout.strip().splitlines()
+    last = (lines or [""])[-1]
     m = re.search(r"in ([\d.]+)s", last)
     return {"mode": mode, "wall_s": round(wall, 2), "cpu_s": round(cpu, 2),
-            "pytest_s": float(m.group(1)) if m else None, "passed": p.returncode == 0, "summary": last}
+            "pytest_s": float(m.group(1)) if m else None, "passed": p.returncode == 0, "summary": last,
+            "failed": [line for line in lines if line.startswith(("FAILED ", "ERROR "))]}
 
 
 def main(argv=None) -> int:
@@ -74,7 +76,7 @@ def main(argv=None) -> int:
             r = run_suite(mode, args.pytest_args)
             runs.append(r)
             print(f"{mode:9s} wall {r['wall_s']:7.1f} s  cpu {r['cpu_s']:7.1f} s  {r['summary']}",
-                  file=sys.stderr, flush=True)
+                  *(f"  {line[:300]}" for line in r["failed"]), sep="\n", file=sys.stderr, flush=True)
     out = {"cores": cores, "runs": runs, "median": {}}
     for mode in MODES:
         mine = [r for r in runs if r["mode"] == mode]
