@@ -173,12 +173,12 @@ def is_realtime(nodeid: str) -> bool:
 
 def lanes_wanted(config) -> bool:
     """Whether this run gets the real-time lane: ``STEERLAB_TEST_LANES`` is not ``0`` and the
-    paths given to pytest may hold real-time tests (none given: the whole suite; a folder; one of
-    :data:`REALTIME_MODULES`). ``pytest tests/test_asa.py`` keeps one worker per core."""
+    paths given to pytest may hold real-time tests (none given: the ``testpaths``; a folder; one
+    of :data:`REALTIME_MODULES`). ``pytest tests/test_asa.py`` keeps one worker per core."""
     if not LANES:
         return False
     root = Path(str(config.rootpath)).resolve()
-    for arg in config.args or ["tests"]:
+    for arg in config.args or config.getini("testpaths") or ["."]:
         path = Path(arg.split("::", 1)[0])
         if not path.is_absolute():
             path = Path(str(config.invocation_params.dir)) / path

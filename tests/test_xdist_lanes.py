@@ -144,7 +144,8 @@ def test_a_compute_test_runs_at_the_lower_cpu_priority_under_xdist(request):
 ])
 def test_the_lane_only_when_real_time_tests_may_run(args, wanted, monkeypatch):
     repo = Path(__file__).resolve().parent.parent
-    config = SimpleNamespace(args=args, rootpath=repo, invocation_params=SimpleNamespace(dir=repo))
+    config = SimpleNamespace(args=args, rootpath=repo, invocation_params=SimpleNamespace(dir=repo),
+                             getini={"testpaths": ["tests"]}.get)
     monkeypatch.setattr(conftest, "LANES", True)                   # whatever this run's setting
     assert lanes_wanted(config) is wanted
     monkeypatch.setattr(conftest, "LANES", False)                  # STEERLAB_TEST_LANES=0
