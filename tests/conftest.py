@@ -147,6 +147,19 @@ def pytest_sessionfinish(session, exitstatus):
         session.exitstatus = 1
 
 
+# ------------------------------------------------------- Ctrl-C reaches the processes tests start
+def pytest_configure(config):
+    """Tests stop a steerlab process as a user does, with Ctrl-C (SIGINT, exit 130). A shell that
+    starts pytest as a background job (``pytest &`` in a script) makes it ignore SIGINT, and an
+    ignored signal stays ignored in every process started from it, so that Ctrl-C would do
+    nothing there (Python keeps an inherited ignore). Here SIGINT gets Python's own handler
+    back; the processes the tests start then begin with SIGINT at its default."""
+    import signal
+
+    if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
+        signal.signal(signal.SIGINT, signal.default_int_handler)
+
+
 # ------------------------------------------- a worker of their own for the wall-clock tests
 REALTIME_MODULES = ("tests/test_runtime_*.py", "tests/test_signalk_plugin.py")
 """The tests of the real-time link (ship server and autopilot over loopback sockets, the browser
