@@ -273,6 +273,8 @@ def main(argv=None) -> int:
     try:
         if getattr(args, "out", None):        # every command that writes: --out checked before any work
             restore = _prepare_out(args.out)
+        elif args.command in RUNS_UNTIL_STOPPED:
+            restore = _unwind_on_sigterm()
         return args.func(args)
     except InputError as err:
         _close_progress()
@@ -324,20 +326,31 @@ def _close_progress(forget: bool = False) -> None:
         progress.close_all(forget)
 
 
+#: commands that run until stopped (a ship server, an autopilot): SIGTERM (``kill``, a service
+#: manager's stop) unwinds them like Ctrl-C, through their shutdown path, exit 143
+RUNS_UNTIL_STOPPED = ("serve-ship", "autopilot")
+
+
 class _Terminated(KeyboardInterrupt):
-    """SIGTERM during a command that writes: unwinds like Ctrl-C (exit 143)."""
+    """SIGTERM during a command that writes or runs until stopped: unwinds like Ctrl-C (exit 143)."""
 
 
 def _prepare_out(out: str):
     """Refuse a bad ``--out`` before any work, repair leftovers of killed runs, and make SIGTERM
     unwind like Ctrl-C so the stage folder is removed (docs/reliability-outputs.md). Returns the
     function that restores the default SIGTERM handling (or None)."""
-    import signal
-    import threading
-
     from steerlab.outputs import prepare_out
 
     prepare_out(out)
+    return _unwind_on_sigterm()
+
+
+def _unwind_on_sigterm():
+    """Make SIGTERM raise :class:`_Terminated` (unwinding like Ctrl-C) in the main thread, when
+    nothing else handles it. Returns the function that restores the default handling (or None)."""
+    import signal
+    import threading
+
     if threading.current_thread() is not threading.main_thread() \
             or signal.getsignal(signal.SIGTERM) is not signal.SIG_DFL:
         return None
