@@ -20,10 +20,6 @@ import os
 import re
 import shutil
 import signal
-import subprocess
-import sys
-import threading
-import time
 
 import pytest
 
@@ -32,7 +28,8 @@ if not hasattr(signal, "SIGSTOP"):
     pytest.skip("the link cut freezes the ship server with SIGSTOP (POSIX only)", allow_module_level=True)
 
 from playwright.sync_api import expect, sync_playwright  # noqa: E402
-from runtime_scenario import runtime_scenario_toml
+from runtime_procs import SteerlabProcess  # noqa: E402
+from runtime_scenario import runtime_scenario_toml  # noqa: E402
 
 SPEEDUP = 2.0
 WATCHDOG = 2.0          # ship s (1 s wall): rides out scheduling stalls of a loaded machine
@@ -45,45 +42,6 @@ def _chromium() -> str | None:
         if name and (path := shutil.which(name)):
             return path
     return None
-
-
-class _Proc:
-    """A ``python -m steerlab ...`` process whose stderr lines are collected by a thread."""
-
-    def __init__(self, argv):
-        self.lines: list[str] = []
-        self.p = subprocess.Popen([sys.executable, "-m", "steerlab", *argv], stdin=subprocess.DEVNULL,
-                                  stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
-        self._reader = threading.Thread(target=self._read, daemon=True)
-        self._reader.start()
-
-    def _read(self):
-        for line in self.p.stderr:
-            self.lines.append(line.rstrip("\n"))
-
-    def wait_for(self, pattern: str, limit_s: float = 120.0) -> re.Match:
-        end = time.monotonic() + limit_s
-        while time.monotonic() < end:
-            for line in list(self.lines):
-                if m := re.search(pattern, line):
-                    return m
-            if self.p.poll() is not None and not self._reader.is_alive():
-                break
-            time.sleep(0.02)
-        raise AssertionError(f"no line matching {pattern!r}; stderr:\n" + "\n".join(self.lines))
-
-    def interrupt(self) -> None:
-        """Ctrl-C (after SIGCONT, in case it is frozen)."""
-        if self.p.poll() is None:
-            os.kill(self.p.pid, signal.SIGCONT)
-            os.kill(self.p.pid, signal.SIGINT)
-
-    def wait(self) -> int:
-        try:
-            return self.p.wait(timeout=30)
-        except subprocess.TimeoutExpired:
-            self.p.kill()
-            return self.p.wait(timeout=30)
 
 
 def _free_udp_port() -> int:
@@ -117,8 +75,8 @@ def test_bridge_page_in_headless_chromium(tmp_path):
     log = tmp_path / "autopilot.csv"
     port = _free_udp_port()
     # both start (import, compile) at once; the autopilot may raise a link alarm until the ship is up
-    server = _Proc(["serve-ship", str(sc), "--bind", f"127.0.0.1:{port}", "--speedup", str(SPEEDUP)])
-    autopilot = _Proc(["autopilot", "--connect", f"127.0.0.1:{port}", "--scenario", str(sc),
+    server = SteerlabProcess(["serve-ship", str(sc), "--bind", f"127.0.0.1:{port}", "--speedup", str(SPEEDUP)])
+    autopilot = SteerlabProcess(["autopilot", "--connect", f"127.0.0.1:{port}", "--scenario", str(sc),
                        "--controller", "pid", "--heading", "0", "--speedup", str(SPEEDUP),
                        "--watchdog", str(WATCHDOG), "--log", str(log), "--web", "127.0.0.1:0"])
     console_errors, requests = [], []

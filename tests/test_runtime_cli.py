@@ -109,48 +109,35 @@ def test_sigterm_stops_both_commands_through_their_shutdown_path(tmp_path):
     """``kill`` (SIGTERM, a service manager's stop) ends serve-ship and autopilot like Ctrl-C:
     their summary line, exit 143, and an autopilot log of whole rows (before: killed at once,
     exit -15, no summary)."""
-    import os
     import signal
-    import subprocess
-    import sys
-    import threading
     import time
 
-    def start(argv):
-        p = subprocess.Popen([sys.executable, "-m", "steerlab", *argv], stdin=subprocess.DEVNULL,
-                             stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
-        lines: list[str] = []
-        threading.Thread(target=lambda: lines.extend(p.stderr), daemon=True).start()
-        return p, lines
-
-    def wait_until(cond, limit_s=60.0):
-        end = time.monotonic() + limit_s
-        while not cond():
-            assert time.monotonic() < end, "timed out"
-            time.sleep(0.05)
+    from runtime_procs import SteerlabProcess
 
     sc = tmp_path / "rt.toml"
     sc.write_text(SCENARIO_TOML)
     port, log = _free_port(), tmp_path / "ap.csv"
-    ship, ship_err = start(["serve-ship", str(sc), "--bind", f"127.0.0.1:{port}", "--speedup", "4",
+    ship = SteerlabProcess(["serve-ship", str(sc), "--bind", f"127.0.0.1:{port}", "--speedup", "4",
                             "--duration", "600"])
     pilot = None
     try:
         assert _wait_for_ship(port)
-        pilot, pilot_err = start(["autopilot", "--connect", f"127.0.0.1:{port}", "--scenario", str(sc),
-                                  "--controller", "pid", "--heading", "10", "--log", str(log), "--duration", "600"])
-        wait_until(lambda: log.exists() and log.read_text().count("\n") > 5)     # it steers
-        for proc, err, name in ((pilot, pilot_err, "autopilot"), (ship, ship_err, "serve-ship")):
-            proc.send_signal(signal.SIGTERM)
-            assert proc.wait(timeout=30) == 143, "".join(err)
-            wait_until(lambda: any("steerlab: interrupted" in line for line in err), 10.0)
-            assert any(line.startswith(f"{name}: ") and ("samples" in line or "published" in line)
-                       for line in err), "".join(err)                         # its summary line
+        pilot = SteerlabProcess(["autopilot", "--connect", f"127.0.0.1:{port}", "--scenario", str(sc),
+                                 "--controller", "pid", "--heading", "10", "--log", str(log), "--duration", "600"])
+        end = time.monotonic() + 60.0
+        while not (log.exists() and log.read_text().count("\n") > 5):       # it steers
+            assert time.monotonic() < end and pilot.p.poll() is None, "\n".join(pilot.lines)
+            time.sleep(0.05)
+        for proc, name in ((pilot, "autopilot"), (ship, "serve-ship")):
+            proc.p.send_signal(signal.SIGTERM)
+            assert proc.wait() == 143, "\n".join(proc.lines)
+            proc.wait_for(r"^steerlab: interrupted$", 10.0)
+            proc.wait_for(rf"^{name}: .*(samples|published)", 10.0)             # its summary line
     finally:
         for proc in (pilot, ship):
-            if proc is not None and proc.poll() is None:
-                os.kill(proc.pid, signal.SIGKILL)
-                proc.wait()
+            if proc is not None and proc.p.poll() is None:
+                proc.p.kill()
+                proc.p.wait()
     with open(log, newline="") as f:
         rows = list(csv.reader(f))
     assert len(rows) > 5 and len({len(r) for r in rows[1:]}) == 1              # whole rows only

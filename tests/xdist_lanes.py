@@ -125,8 +125,8 @@ class LaneScheduling:
                 self.log("**Different tests collected, aborting run**")
                 return
             self.collection = collections[0]
-            for index, nodeid in enumerate(self.collection):
-                self.pools["wait" if self.is_waiting(nodeid) else "compute"].append(index)
+            for index in range(len(self.collection)):
+                self.pools[self._pool_of(index)].append(index)
         if len(self.nodes) > 1 and self.lane is None:
             self.lane = max(self.nodes, key=lambda n: _worker_number(n))
         for node in self.nodes:
