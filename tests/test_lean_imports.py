@@ -6,6 +6,8 @@ import json
 import subprocess
 import sys
 
+import pytest
+
 HEAVY = ("control", "scipy.linalg", "scipy.signal", "scipy.optimize", "scipy.stats", "matplotlib", "pymoo", "dask",
          "distributed", "websockets", "pyarrow", "pandas", "gymnasium", "pynmea2")
 
@@ -46,25 +48,50 @@ import numpy as np
 import numba
 import steerlab
 from steerlab.environment.iir_filter import lfilter
+
+def scipys_blas_loaded():    # scipy's own OpenBLAS (numpy's is libscipy_openblas64_)
+    with open("/proc/self/maps") as maps:
+        return any("libscipy_openblas-" in line for line in maps)
+
 lfilter(np.array([1.0]), np.array([1.0, -0.5]), np.ones(4))       # numba's registries load here
 assert "scipy.linalg" not in sys.modules, "numba's BLAS probe imported scipy.linalg"
-import scipy.linalg
-assert scipy.linalg.cython_blas is sys.modules["scipy.linalg.cython_blas"]
+assert not scipys_blas_loaded(), "numba's BLAS probe loaded scipy's BLAS"
+assert type(sys.modules["scipy.linalg.cython_blas"]).__name__ == "_LoadedOnFirstUse"
 @numba.njit
 def dot(a, b):
     return a @ b
 a = np.arange(6.0).reshape(2, 3)
 assert np.array_equal(dot(a, a.T), a @ a.T)                       # numba's BLAS binding works
+assert type(sys.modules["scipy.linalg.cython_blas"]).__name__ != "_LoadedOnFirstUse"
+assert scipys_blas_loaded()                                       # loaded by its first use
+import scipy.linalg
+assert scipy.linalg.cython_blas is sys.modules["scipy.linalg.cython_blas"]
 assert np.allclose(scipy.linalg.solve(np.eye(2) * 2.0, np.ones(2)), 0.5)
 print("ok")
 """
 
+BLAS_SCIPY_FIRST_SCRIPT = """
+import sys
+import numpy as np
+import steerlab
+from steerlab.environment.iir_filter import lfilter
+lfilter(np.array([1.0]), np.array([1.0, -0.5]), np.ones(4))
+import scipy.linalg                                               # scipy's own users: the whole module
+assert scipy.linalg.cython_blas is sys.modules["scipy.linalg.cython_blas"]
+assert type(scipy.linalg.cython_blas).__name__ != "_LoadedOnFirstUse"
+assert "dgemm" in scipy.linalg.cython_blas.__pyx_capi__
+print("ok")
+"""
 
-def test_numbas_blas_probe_skips_the_scipy_linalg_import_and_blas_still_works():
-    """steerlab.numba_blas_probe: the first kernel call does not import scipy.linalg (0.16 s),
-    a later ``import scipy.linalg`` is whole (``cython_blas`` attribute set), and numba's
-    BLAS-backed ``@`` gives numpy's result."""
-    out = subprocess.run([sys.executable, "-c", BLAS_SCRIPT], capture_output=True, text=True, timeout=300)
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc/self/maps")
+@pytest.mark.parametrize("script", [BLAS_SCRIPT, BLAS_SCIPY_FIRST_SCRIPT], ids=["numba-uses-blas", "scipy-first"])
+def test_numbas_blas_probe_skips_the_scipy_linalg_import_and_blas_still_works(script):
+    """steerlab.numba_blas_probe: the first kernel call neither imports scipy.linalg (0.16 s)
+    nor loads scipy's own BLAS (its threads' start-up spin); numba's BLAS-backed ``@`` loads it
+    and gives numpy's result; ``import scipy.linalg`` is whole (``cython_blas`` attribute set
+    to the real module), whether numba used BLAS first or not."""
+    out = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=300)
     assert out.returncode == 0, out.stderr
     assert out.stdout.strip() == "ok"
 
