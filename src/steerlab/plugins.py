@@ -102,6 +102,43 @@ def env_plugins() -> list[str]:
     return [p for p in os.environ.get(PLUGINS_ENV, "").split(os.pathsep) if p.strip()]
 
 
+class PicklesByName:
+    """Mixin of the spec dataclasses (ships, controllers): how a spec pickles.
+
+    A spec that any fresh process finds in its registry under the same name (steerlab's own, a
+    plug-in of an entry point or of ``STEERLAB_PLUGINS``, and what is derived from them) pickles
+    as that name, and the process that unpickles it (a ``spawn`` multiprocessing child, a Dask
+    worker) takes its own: kernels there are module-level ones, which the compiled drivers
+    name and load from the disk cache (:mod:`steerlab.sim.drivers`) instead of compiling them,
+    and specs whose functions are closures (a catalogue entry made by a factory, the
+    ``"<name>+wf"`` variants) pickle at all. A spec made from another one (``recipe =
+    (function, args)``: a controller behind the sensors or the wave filter, a ship's kernel
+    picked for its options) pickles as that recipe. Any other spec, such as one registered
+    while this process runs (:meth:`Registry.register`, which another process does not know,
+    or which replaces a built-in name there), pickles field by field as before.
+    """
+
+    def __reduce_ex__(self, protocol):
+        spec_type = next((c for c in type(self).__mro__ if c in Registry.of_spec_type), None)
+        name = getattr(self, "name", None)
+        if spec_type is not None and isinstance(name, str):
+            try:
+                everywhere = Registry.of_spec_type[spec_type].found_everywhere(self)
+            except Exception:  # noqa: BLE001 - a broken plug-in elsewhere: pickle by value
+                everywhere = False
+            if everywhere:
+                return (_registered_spec, (spec_type, name))
+        recipe = getattr(self, "recipe", None)
+        if recipe is not None and recipe[0](*recipe[1]) == self:      # (not a modified copy)
+            return recipe
+        return super().__reduce_ex__(protocol)
+
+
+def _registered_spec(spec_type: type, name: str):
+    """The spec ``name`` of the registry of ``spec_type`` (unpickling, :class:`PicklesByName`)."""
+    return Registry.of_spec_type[spec_type].get_spec(name)
+
+
 class Registry(Mapping[str, S]):
     """Lazy read-only mapping ``name -> spec`` of one kind of component (module docstring).
 
@@ -128,6 +165,9 @@ class Registry(Mapping[str, S]):
         controllers' ``"<name>+wf"`` wave-filter variants).
     """
 
+    #: the registry of each spec class (the last one made for it): :class:`PicklesByName`
+    of_spec_type: dict = {}
+
     def __init__(self, kind: str, package: str, collect: Callable[[ModuleType], Iterable[S]], spec_type: type[S],
                  field: str, group: str, skip: Iterable[str] = (), recursive: bool = False,
                  derive: Callable[[S], Iterable[S]] | None = None) -> None:
@@ -147,6 +187,8 @@ class Registry(Mapping[str, S]):
         self._derived: dict = {}          # spec name -> (spec, the specs derived from it)
         self._plugins: bool | None = None  # any entry point or STEERLAB_PLUGINS module (looked up once)
         self._index: dict | None = None   # the index of steerlab.registry_index (read once)
+        self._at_run_time: set = set()   # names register() added (a fresh process lacks them)
+        Registry.of_spec_type[spec_type] = self
 
     # ------------------------------------------------------------ discovery
     def _modules(self):
@@ -269,8 +311,10 @@ class Registry(Mapping[str, S]):
         """Add ``spec`` under ``spec.name`` (``replace=True`` to override a known name); returns it."""
         found = self._discover()
         self._add(found, spec, "register", replace)
+        self._at_run_time.add(spec.name)
         for d in self._derive(spec):
             self._add(found, d, f"derived from {spec.name!r}", replace)
+            self._at_run_time.add(d.name)
         for fn in self._listeners:
             fn(spec)
         return spec
@@ -287,11 +331,13 @@ class Registry(Mapping[str, S]):
         found = self._discover()
         spec = found.pop(name, None)
         self._origin.pop(name, None)
+        self._at_run_time.discard(name)
         if spec is not None:
             for d in self._derive(spec):
                 if d.name in found and found[d.name] is d:
                     found.pop(d.name)
                     self._origin.pop(d.name, None)
+                    self._at_run_time.discard(d.name)
         for fn in self._listeners:
             fn(None)
 
@@ -331,6 +377,11 @@ class Registry(Mapping[str, S]):
             if spec is not None:
                 return spec
         return self._discover().get(name)
+
+    def found_everywhere(self, spec: S) -> bool:
+        """Whether ``spec`` is the one this registry holds under its name, and any fresh process
+        finds it there too: not added by :meth:`register` while this process runs."""
+        return spec.name not in self._at_run_time and self.find(spec.name) is spec
 
     def get_spec(self, name: str) -> S:
         """The spec called ``name`` (:meth:`find`); an unknown name is an :class:`InputError` on

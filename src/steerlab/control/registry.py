@@ -22,11 +22,11 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Callable, Optional
 
-from steerlab.plugins import Registry
+from steerlab.plugins import PicklesByName, Registry
 
 
 @dataclass(frozen=True)
-class ControllerSpec:
+class ControllerSpec(PicklesByName):
     name: str
     description: str
     update: Callable
@@ -35,6 +35,9 @@ class ControllerSpec:
     build: Callable
     source: str = ""
     params: Optional[object] = field(default=None, compare=False)   #: records.Layout of the record
+    #: ``(function, args)`` that made this spec from another one, e.g. ``(sensed_spec, (inner,))``:
+    #: it pickles as that (:class:`steerlab.plugins.PicklesByName`)
+    recipe: Optional[tuple] = field(default=None, compare=False, repr=False)
 
 
 def _collect(module) -> list:

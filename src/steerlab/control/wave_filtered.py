@@ -138,13 +138,33 @@ class WaveFiltered(NamedTuple):
         return z
 
 
+class _PickledByControllerName:
+    """Mixin of the ``"<name>+wf"`` config classes, which :func:`wave_filtered` makes at run time
+    (they have no importable name): a config pickles as its controller's name and its pydantic
+    state, and unpickles as an instance of that controller's config class in the other process's
+    registry (a setup sent to a ``spawn`` multiprocessing child or a Dask worker)."""
+
+    def __reduce__(self):
+        return (_config_of_controller, (self.type, self.__getstate__()))
+
+
+def _config_of_controller(name: str, state: dict):
+    """A config of the registered controller ``name`` with pydantic ``state`` (see above)."""
+    from steerlab.control.registry import get_controller
+
+    cls = get_controller(name).config
+    cfg = cls.__new__(cls)
+    cfg.__setstate__(state)
+    return cfg
+
+
 @lru_cache(maxsize=None)
 def wave_filtered(spec: ControllerSpec) -> ControllerSpec:
     """``spec`` behind the wave filter, registered as ``spec.name + "+wf"`` (memoised)."""
     name = spec.name + SUFFIX
     kernel = bound_kernel(_wf_update_template, name.replace("+", "_") + "_update", _inner=spec.update)
     cfg_cls = create_model(
-        spec.config.__name__ + "WaveFiltered", __base__=spec.config,
+        spec.config.__name__ + "WaveFiltered", __base__=(spec.config, _PickledByControllerName),
         type=(Literal[name], ...),
         wave_filter=(WaveFilterConfig, WaveFilterConfig()),
         filter_K=(Optional[float], Field(None, gt=0.0, le=100.0, description="filter model K [1/s]")),
@@ -169,7 +189,8 @@ def wave_filtered(spec: ControllerSpec) -> ControllerSpec:
         name=name, description=f"{spec.description}, behind the noise-adaptive wave filter",
         update=kernel, n_state=OFF_Z + spec.n_state, config=cfg_cls, build=build,
         source=f"{spec.source}; wave filter: van Amerongen (1982) Fig. 4.13-4.14",
-        params=None if spec.params is None else wave_filtered_layout(spec.params))
+        params=None if spec.params is None else wave_filtered_layout(spec.params),
+        recipe=(wave_filtered, (spec,)))
 
 
 def wave_filtered_variants(spec: ControllerSpec) -> list:

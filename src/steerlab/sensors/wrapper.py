@@ -124,7 +124,8 @@ def sensed_spec(spec: ControllerSpec) -> ControllerSpec:
     return ControllerSpec(name=name, description=f"{spec.description}, measured through sensor models",
                           update=kernel, n_state=spec.n_state, config=spec.config, build=spec.build,
                           source=spec.source,
-                          params=None if spec.params is None else sensed_layout(spec.params))
+                          params=None if spec.params is None else sensed_layout(spec.params),
+                          recipe=(sensed_spec, (spec,)))
 
 
 class SensorParams(NamedTuple):

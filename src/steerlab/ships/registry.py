@@ -9,13 +9,13 @@ package: :func:`register_ship`, the entry-point group ``steerlab.ships`` or the
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING, Any, Callable, Mapping, Optional
 
 from pydantic import ValidationError
 
 from steerlab.errors import InputError
-from steerlab.plugins import Registry
+from steerlab.plugins import PicklesByName, Registry
 from steerlab.ships.b2_estimate import b2_estimate
 
 if TYPE_CHECKING:
@@ -23,7 +23,7 @@ if TYPE_CHECKING:
 
 
 @dataclass(frozen=True)
-class ShipSpec:
+class ShipSpec(PicklesByName):
     """A ship model as the engine sees it.
 
     * ``rhs(t, x, delta, w, p, dx)``: numba kernel writing the derivatives of the ship states
@@ -60,6 +60,9 @@ class ShipSpec:
     #: ``options -> kernel``: a kernel suited to these validated options (None: always ``rhs``);
     #: it must give the same derivatives as ``rhs`` for every record ``pack`` makes with them
     kernel_for_options: Callable | None = None
+    #: ``(function, args)`` that made this spec from another one (:meth:`for_options`): it
+    #: pickles as that (:class:`steerlab.plugins.PicklesByName`)
+    recipe: tuple | None = field(default=None, compare=False, repr=False)
 
     def for_options(self, options: Any) -> "ShipSpec":
         """This spec with the kernel :attr:`kernel_for_options` picks for ``options`` (e.g. the
@@ -67,7 +70,7 @@ class ShipSpec:
         if self.kernel_for_options is None:
             return self
         rhs = self.kernel_for_options(options)
-        return self if rhs is self.rhs else replace(self, rhs=rhs)
+        return self if rhs is self.rhs else replace(self, rhs=rhs, recipe=(ShipSpec.for_options, (self, options)))
 
     def b2(self, speed: float, method: str, options: Optional[FrozenConfig] = None) -> float:
         """Rudder efficiency [1/s^2], steerlab sign: ``exact`` (linearisation) or ``estimate`` (eq 29).
