@@ -211,8 +211,14 @@ def test_wrapper_records_compose_with_the_inner_layout():
     assert filtered.size == p.size and p[filtered.index("inner.Kp")] == 2.5 and p[filtered.index("filter_T")] == 40.0
     assert filtered.unpack(p)["wave_filter.T_lf"] == 20.0
     assert wf.wave_filtered_state_layout(pid.STATE).index("inner.integral") == wf.OFF_Z + pid.Z_INT
-    with pytest.raises(InputError, match=r"controller\.filter_K: 0\.0 is out of range; allowed range \(0\.0, 100\.0\]"):
+    with pytest.raises(InputError, match=r"controller\.filter_K: must be non-zero"):
         wf.WaveFiltered(inner, K=0.0, T=40.0).pack(inner.pack())
+    with pytest.raises(InputError, match=r"controller\.filter_K: 200\.0 is out of range; allowed range \[-100\.0, 100\.0\]"):
+        wf.WaveFiltered(inner, K=200.0, T=40.0).pack(inner.pack())
+    with pytest.raises(InputError, match=r"controller\.filter_K: must have the sign of filter_T"):
+        wf.WaveFiltered(inner, K=-0.05, T=40.0).pack(inner.pack())
+    unstable = wf.WaveFiltered(inner, K=-0.12, T=-421.0).pack(inner.pack())     # Esso's first-order model
+    assert filtered.unpack(unstable)["filter_K"] == -0.12
     with pytest.raises(InputError, match=r"controller\.wave_filter\.xi_min: 2\.0 is out of range"):
         wf.WaveFiltered(inner, K=0.1, T=40.0, filt=wave_filter.WaveFilterParams(xi_min=2.0)).pack(inner.pack())
 

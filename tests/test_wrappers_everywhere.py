@@ -183,3 +183,25 @@ def test_n_state_is_checked_at_build_time(monkeypatch):
         build(_scenario("los"))
     assert err.value.field == "controller.type"
     assert "'pid'" in str(err.value) and f"n_state = {spec.n_state + 1}" in str(err.value)
+
+
+def test_wf_takes_a_course_unstable_ships_own_nomoto_model():
+    """Without filter_K/T the filter's model is the ship's first-order Nomoto model; for a
+    course-unstable ship (Esso) that has K < 0 and T < 0 (K/T > 0). It was refused as out of
+    range, so ``"<name>+wf"`` ran on no course-unstable ship without hand-set filter values."""
+    import tomllib
+
+    data = tomllib.loads(_toml("wf").replace("filter_K = 0.05\nfilter_T = 100.0\n", ""))
+    setup = build(scenario_from_dict(data))
+    record = setup.controller.params.unpack(setup.pc)
+    K, T = record["filter_K"], record["filter_T"]
+    assert (K, T) == pytest.approx(setup.ship.nomoto(16.0 * 1852 / 3600)) and K < 0 and T < 0
+    res = simulate(setup)
+    plain = simulate(build(scenario_from_dict({**data, "controller": {"type": "pid"}})))
+    # low waves (wave_power 1e-3): the filter passes the heading on; the turn is the plain PID's
+    assert np.isfinite(res.states).all()
+    assert np.abs(np.degrees(res.states[:, 2] - plain.states[:, 2])).max() < 0.1
+    assert np.degrees(res.states[-1, 2]) > 5.0                       # turning to the new course
+    bad = {**data, "controller": {**data["controller"], "filter_K": -0.05, "filter_T": 100.0}}
+    with pytest.raises(InputError, match=r"controller\.filter_K: must have the sign of filter_T"):
+        build(scenario_from_dict(bad))

@@ -47,7 +47,7 @@ from functools import lru_cache
 from typing import Literal, NamedTuple, Optional
 
 import numpy as np
-from pydantic import Field, create_model
+from pydantic import create_model
 
 from steerlab.control.registry import ControllerSpec
 from steerlab.control.wave_filter import PARAMS as WF_PARAMS
@@ -66,8 +66,9 @@ NX_MAX = 32
 PARAMS = Layout("controller", "P_", [
     *(RecordField("WF_" + f.const, "wave_filter." + f.name, f.unit, f.doc, f.lo, f.hi, f.lo_open, f.hi_open,
                   f.default) for f in WF_PARAMS.fields),
-    RecordField("K", "filter_K", "1/s", "Nomoto gain of the filter's model (default: the ship's at the design speed)",
-                0.0, 100.0, lo_open=True),
+    RecordField("K", "filter_K", "1/s", "Nomoto gain of the filter's model, non-zero, with the sign of filter_T "
+                "(a course-unstable ship's first-order model has K < 0 and T < 0) (default: the ship's at the "
+                "design speed)", -100.0, 100.0),
     RecordField("T", "filter_T", "s", "Nomoto time constant of the filter's model, non-zero", -1e4, 1e4),
 ], size_name="OFF_P")
 PARAMS.export(globals())         # P_WF_TLF = 0, ..., P_K = 4, P_T = 5, OFF_P = 6 (the inner record from here)
@@ -124,6 +125,11 @@ class WaveFiltered(NamedTuple):
         head = PARAMS.pack(values, filter_K=self.K, filter_T=self.T)
         if abs(self.T) < 1e-6:
             raise InputError("controller.filter_T", "must be non-zero (|T| >= 1e-6 s)")
+        if abs(self.K) < 1e-9:
+            raise InputError("controller.filter_K", "must be non-zero (|K| >= 1e-9 1/s)")
+        if (self.K > 0.0) != (self.T > 0.0):
+            raise InputError("controller.filter_K", f"must have the sign of filter_T (K/T > 0: a positive rudder "
+                                                    f"turns to starboard), got K = {self.K:g} 1/s, T = {self.T:g} s")
         return np.concatenate([head, np.asarray(inner_p, dtype=np.float64)])
 
     def init_state(self, x0, ref0) -> np.ndarray:
@@ -167,8 +173,7 @@ def wave_filtered(spec: ControllerSpec) -> ControllerSpec:
         spec.config.__name__ + "WaveFiltered", __base__=(spec.config, _PickledByControllerName),
         type=(Literal[name], ...),
         wave_filter=(WaveFilterConfig, WaveFilterConfig()),
-        filter_K=(Optional[float], Field(None, gt=0.0, le=100.0, description="filter model K [1/s]")),
-        filter_T=(Optional[float], Field(None, ge=-1e4, le=1e4, description="filter model T [s]")))
+        **{n: (Optional[float], f) for n, (_, f) in PARAMS.config_fields(["filter_K", "filter_T"]).items()})
 
     def build(cfg, ctx):
         data = cfg.model_dump(exclude={"wave_filter", "filter_K", "filter_T"})
