@@ -225,3 +225,20 @@ def test_course_unstable_ship_needs_explicit_initial_model():
     s = build(scenario_from_dict({"ship": {"model": "esso"},
                                   "controller": {"type": "asa", "K_star0": 2.0, "tau_star0": 3.0}}))
     assert s.pc.size > 0
+
+
+def test_an_initial_model_outside_the_bounds_says_it_came_from_the_ship():
+    """The small tanker's Bech model at 16 kn gives K* = K L/U = 42 > K_star_max = 5: the error
+    names K_star0 with the ship's model it came from (it was a bare "42.37 is out of range")."""
+    from steerlab.errors import InputError
+    from steerlab.sim.scenario import scenario_from_dict
+    from steerlab.sim.setup import build
+
+    ship = {"model": "small-tanker-bech", "speed_kn": 16.0}
+    with pytest.raises(InputError, match=r"^controller\.K_star0: ship 'small-tanker-bech' at 8\.23 m/s \(L = 170 m\) "
+                                         r"has the Nomoto model .* initial K_star = 42\.\d+ lies outside \[0\.2, 5\.0\]"):
+        build(scenario_from_dict({"ship": ship, "controller": {"type": "asa"}}))
+    with pytest.raises(InputError, match=r"^controller\.tau_star0: .* initial tau_star = 81\.\d+ lies outside"):
+        build(scenario_from_dict({"ship": ship, "controller": {"type": "asa", "K_star0": 4.0}}))
+    s = build(scenario_from_dict({"ship": ship, "controller": {"type": "asa", "K_star0": 4.0, "tau_star0": 8.0}}))
+    assert s.pc.size > 0

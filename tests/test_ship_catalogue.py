@@ -218,6 +218,21 @@ def test_b2_estimate_needs_dimensions_exact_is_k_over_t():
     assert get_ship("tanker-176k-model-norrbin").b2(knots_to_ms(3.1), "estimate") > 0
 
 
+def test_spectrum_waves_on_a_ship_without_beam_name_the_yaw_gain_setting():
+    """The waves' yaw gain is Daidola-Graham's estimate from beam and block coefficient, which
+    the thesis entries do not give: the error names the setting that replaces it (it named
+    ``ship.dims B``, which no scenario can set); with the setting given, the waves run."""
+    sea = {"model": "spectrum", "sea_state": 5}
+    scenario = {"ship": {"model": "capella-nomoto-10deg", "speed_kn": 12.0}, "controller": {"type": "pid"},
+                "environment": {"wave": sea}}
+    with pytest.raises(InputError, match=r"^environment\.wave\.yaw_accel_per_slope: ship 'capella-nomoto-10deg' "
+                                         r"has no beam and block coefficient.*allowed range \[0, 100\]"):
+        build(scenario_from_dict(scenario))
+    scenario["environment"]["wave"] = {**sea, "yaw_accel_per_slope": 0.02}
+    s = build(scenario_from_dict(scenario))
+    assert np.abs(s.w).max() > 0.0                     # the sea is there
+
+
 # ------------------------------------------------------------------ CLI
 
 def _cli(*args):

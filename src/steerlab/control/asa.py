@@ -313,6 +313,13 @@ def build(cfg: ASAConfig, ctx):
                 f"T = {T:.4g} s (course-unstable): ASA's initial K*, tau* come from a course-stable "
                 f"model (thesis 4.3.2); give K_star0 in [{cfg.K_star_min}, {cfg.K_star_max}] and "
                 f"tau_star0 in [{cfg.tau_star_min}, {cfg.tau_star_max}] explicitly"))
+        for name, value, lo, hi in (("K_star0", ks0, cfg.K_star_min, cfg.K_star_max),
+                                    ("tau_star0", ts0, cfg.tau_star_min, cfg.tau_star_max)):
+            if getattr(cfg, name) is None and lo <= hi and not lo <= value <= hi:   # (lo > hi: its own error)
+                raise InputError(f"controller.{name}", (
+                    f"ship {ctx.ship.name!r} at {ctx.speed:.3g} m/s (L = {L:.4g} m) has the Nomoto model "
+                    f"K = {K:.4g} 1/s, T = {T:.4g} s, so the initial {name[:-1]} = {value:.4g} lies outside "
+                    f"[{lo}, {hi}]; give {name} in that range, or widen {name[:-1]}_min/{name[:-1]}_max"))
     ks0 = cfg.K_star0 if cfg.K_star0 is not None else ks0
     ts0 = cfg.tau_star0 if cfg.tau_star0 is not None else ts0
     uf = knots_to_ms(cfg.freeze_speed_kn) if cfg.freeze_speed_kn is not None else 0.2 * U0

@@ -112,9 +112,19 @@ def spectrum_components(cfg, speed: float, seed: int):
 
 
 def yaw_gain(cfg, ship) -> tuple[float, float]:
-    """``(L [m], yaw acceleration per unit slope [1/s^2])``: configured, or Daidola-Graham's estimate."""
+    """``(L [m], yaw acceleration per unit slope [1/s^2])``: configured, or Daidola-Graham's estimate.
+
+    A ship without beam or block coefficient (the thesis catalogue's Nomoto and Norrbin
+    entries) has no estimate: that is one error on the setting that replaces it.
+    """
     c_B, L, B = ship.dims
-    return L, (cfg.yaw_accel_per_slope if cfg.yaw_accel_per_slope is not None else daidola_gain(L, B, c_B))
+    if cfg.yaw_accel_per_slope is not None:
+        return L, cfg.yaw_accel_per_slope
+    if not (math.isfinite(B) and math.isfinite(c_B)):
+        raise InputError(f"{F}.yaw_accel_per_slope",
+                         f"ship {ship.name!r} has no beam and block coefficient, so the waves' yaw gain cannot be "
+                         "estimated (Daidola-Graham); set it [1/s^2], allowed range [0, 100], or turn the waves off")
+    return L, daidola_gain(L, B, c_B)
 
 
 def _route(cfg, ctx: SeaContext, allowed):
