@@ -189,6 +189,10 @@ def test_speed_outside_the_table_is_an_input_error_naming_the_range():
     with pytest.raises(InputError, match=r"ship\.speed_kn.*11\.66-23\.33 kn.*6-12 m/s"):
         build(scenario_from_dict({"ship": {"model": "frigate-norrbin", "speed_kn": 5.0},
                                   "controller": {"type": "pid"}}))
+    # a one-row table: the speed it holds, and the refused value as given (it read "got 3.1 kn")
+    with pytest.raises(InputError, match=r"tabulated at 3\.1 kn only .*; got 3\.1003 kn$"):
+        build(scenario_from_dict({"ship": {"model": "tanker-176k-model-norrbin", "speed_kn": 3.1003},
+                                  "controller": {"type": "pid"}}))
 
 
 def test_interpolation_between_rows():

@@ -179,9 +179,12 @@ class CatalogueEntry:
             if self.index == "speed":
                 u = "kn" if self.units[0] == "kn" else "m/s"
                 f = (lambda v: v / KNOT) if u == "kn" else (lambda v: v)
-                raise InputError(field, f"ship {self.id!r} is tabulated for {lo / KNOT:.4g}-{hi / KNOT:.4g} kn "
-                                        f"({f(lo):.4g}-{f(hi):.4g} {u} in {self.table}); got {value / KNOT:.4g} kn")
-            raise InputError(field, f"ship {self.id!r} is tabulated for {lo:.4g}-{hi:.4g} rpm; got {value:.4g}")
+                span = (f"at {lo / KNOT:.6g} kn only ({f(lo):.6g} {u}" if hi - lo <= tol else
+                        f"for {lo / KNOT:.4g}-{hi / KNOT:.4g} kn ({f(lo):.4g}-{f(hi):.4g} {u}")
+                raise InputError(field, f"ship {self.id!r} is tabulated {span} in {self.table}); "
+                                        f"got {value / KNOT:.6g} kn")
+            span = f"at {lo:.6g} rpm only" if hi - lo <= tol else f"for {lo:.4g}-{hi:.4g} rpm"
+            raise InputError(field, f"ship {self.id!r} is tabulated {span}; got {value:.6g}")
         v = min(max(value, lo), hi)
         out = dict(self.constants)
         for j, name in enumerate(self.columns[1:], start=1):
