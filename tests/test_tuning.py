@@ -137,6 +137,19 @@ def test_de_resume_is_identical_to_an_uninterrupted_run_and_leaves_no_temporary(
     assert sorted(f.name for f in tmp_path.iterdir()) == ["de.ckpt"]
 
 
+def test_a_checkpoint_in_a_folder_not_yet_made_is_written_there(lq_conditions, tmp_path):
+    """``--checkpoint out/tune.ckpt`` on a fresh clone (docs/tuning.md): the folder is made, as
+    ``--out`` makes its own; one that cannot be made is the input error on ``--checkpoint``."""
+    pm = build_param_map(lq_conditions, ["kp", "kd"], np.array([[0.1, 5.0], [1.0, 100.0]]))
+    ck = tmp_path / "out" / "runs" / "de.ckpt"
+    run_optimiser(PopulationEvaluator(lq_conditions, pm, [parse_cost("ise")]), "de", 1, 6, 0, checkpoint=ck)
+    assert ck.is_file()
+    (tmp_path / "a-file").write_text("not a folder")
+    with pytest.raises(InputError, match=r"^--checkpoint: cannot create its folder .*a-file"):
+        run_optimiser(PopulationEvaluator(lq_conditions, pm, [parse_cost("ise")]), "de", 1, 6, 0,
+                      checkpoint=tmp_path / "a-file" / "de.ckpt")
+
+
 def test_a_failed_checkpoint_write_leaves_no_temporary(tmp_path):
     from steerlab.tuning.optimisers import _atomic_pickle
 

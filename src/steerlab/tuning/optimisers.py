@@ -116,6 +116,18 @@ def _remove_stale_temporaries(path: Path) -> None:
             tmp.unlink(missing_ok=True)
 
 
+def _checkpoint_folder(path) -> None:
+    """Create the checkpoint's folder before the first generation, as ``--out`` does its own:
+    ``--checkpoint out/tune.ckpt`` on a fresh clone (no ``out/`` yet) failed when the first
+    generation's checkpoint was written. A folder that cannot be made is the input error."""
+    folder = Path(path).parent
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError as err:
+        why = "a file is in the way" if isinstance(err, FileExistsError) else err.strerror
+        raise InputError("--checkpoint", f"cannot create its folder {str(folder)!r}: {why}") from None
+
+
 def load_checkpoint(path, problem_key: dict) -> dict | None:
     """The checkpoint at ``path`` if it exists and belongs to ``problem_key`` (else InputError)."""
     p = Path(path)
@@ -165,6 +177,8 @@ def run_optimiser(evaluator, method: str, generations: int, pop_size: int, seed:
     if method != "nsga2" and n_obj != 1:
         raise InputError("--cost", f"method {method!r} takes exactly one cost expression, got {n_obj}")
     key = dict(problem_key or {}, method=method, seed=seed, pop_size=pop_size)
+    if checkpoint:
+        _checkpoint_folder(checkpoint)
     ck = load_checkpoint(checkpoint, key) if checkpoint else None
     prog = _Progress(progress, generations, evaluator.param_map.names)
     if method == "de":
