@@ -1,8 +1,9 @@
 """Every example command runs: the examples of every subcommand's ``--help`` and every command
 in a ```sh block of README.md and docs/*.md.
 
-Each command is run as printed from a copy of the repository's ``examples/`` folder (the files
-the examples name), through the CLI's entry point :func:`steerlab.cli.main` in the test's own
+Each command is run as printed from a fresh copy of the repository's ``examples/`` folder (the
+files the examples name; nothing another command wrote, as on a fresh clone: a shared folder
+once hid that ``tune --checkpoint out/tune.ckpt`` failed without ``out/``), through the CLI's entry point :func:`steerlab.cli.main` in the test's own
 process (commands with environment assignments, real-time servers and clients, and the cache
 commands in a new ``python -m steerlab`` process), with smaller sizes where the command offers them (``--quick``, fewer runs,
 generations, repeats; real-time commands for a few ship seconds, faster than real time, on free
@@ -288,7 +289,7 @@ def test_the_example_files_exist_and_the_parsers_find_the_examples():
             assert stale not in argv, f"{label}: names {stale}, which is not shipped"
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture
 def workdir(tmp_path_factory):
     d = tmp_path_factory.mktemp("examples-cwd")
     shutil.copytree(REPO / "examples", d / "examples")
