@@ -61,13 +61,19 @@ def compiled_once(tmp_path_factory):
     compile the loop and save it: the concurrent-writers case), then a fresh process on a copy of
     that cache; ``result`` is the run of a process that compiled, ``concurrent`` the three runs.
     Shared by the tests that start from that cache (each on its own copy of it): one cold
-    compile for the module instead of one per test."""
-    cache = tmp_path_factory.mktemp("compiled-once")
-    procs = [_run(cache, wait=False) for _ in range(2)]
-    a, b = (_result(p) for p in procs)
-    fresh = _run(_copy(cache, tmp_path_factory.mktemp("fresh") / "cache"))
-    first = a if a["misses"] == 1 else b
-    return cache, first, {"a": a, "b": b, "fresh": fresh}
+    compile for the test session, whichever pytest-xdist workers run these tests."""
+    from conftest import once_per_session
+
+    def make(folder: Path) -> dict:
+        cache = folder / "cache"
+        cache.mkdir()
+        procs = [_run(cache, wait=False) for _ in range(2)]
+        a, b = (_result(p) for p in procs)
+        fresh = _run(_copy(cache, folder / "fresh"))
+        return {"cache": str(cache), "first": a if a["misses"] == 1 else b, "runs": {"a": a, "b": b, "fresh": fresh}}
+
+    made = once_per_session(tmp_path_factory, "driver-cache-compiled-once", make)
+    return Path(made["cache"]), made["first"], made["runs"]
 
 
 def _copy(cache: Path, to: Path) -> Path:

@@ -1,6 +1,7 @@
 """The Zwierzewicz et al. (2021) reproduction runs end to end (quick mode) and reports sanely."""
 
 import json
+from pathlib import Path
 
 import pytest
 
@@ -15,10 +16,17 @@ PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 
 @pytest.fixture(scope="module")
 def quick_run(tmp_path_factory):
-    out = tmp_path_factory.mktemp("zw2021")
-    messages = []
-    rows = zw.run(out, progress=messages.append, quick=True)
-    return out, rows, messages
+    """``(out, rows, messages)`` of one quick run, made once per test session (the tests of
+    this module may run in several pytest-xdist workers)."""
+    from conftest import once_per_session
+
+    def make(out: Path) -> dict:
+        messages: list = []
+        rows = zw.run(out, progress=messages.append, quick=True)
+        return {"out": str(out), "rows": rows, "messages": messages}
+
+    made = once_per_session(tmp_path_factory, "zwierzewicz2021-quick", make)
+    return Path(made["out"]), made["rows"], made["messages"]
 
 
 def _find(rows, prefix):

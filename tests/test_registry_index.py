@@ -61,9 +61,13 @@ PID_ON_ESSO = {"ship": {"model": "esso"}, "controller": {"type": "pid", "Kp": 2.
 def indexed(tmp_path_factory) -> Path:
     """A cache where a process validated PID_ON_ESSO, writing the index (tests that start from
     an index take a copy: one such process for the module instead of one per test)."""
-    cache = tmp_path_factory.mktemp("indexed")
-    _probe(PID_ON_ESSO, cache)
-    return cache
+    from conftest import once_per_session
+
+    def make(cache: Path) -> dict:
+        _probe(PID_ON_ESSO, cache)
+        return {"cache": str(cache)}
+
+    return Path(once_per_session(tmp_path_factory, "registry-index-indexed", make)["cache"])
 
 
 def _copy(cache: Path, to: Path) -> Path:
