@@ -195,6 +195,25 @@ def test_a_spinning_ship_is_not_reported_as_good(tmp_path, capsys):
     assert not (tmp_path / "o").exists()
 
 
+def test_a_python_result_says_whether_it_can_be_reported(tmp_path):
+    """``Result.divergence()``: the CLI's check for users of the Python API (``simulate`` returns
+    such runs as they are): None for a good run; the spin, with the time it began; the first
+    non-finite sample."""
+    from steerlab.sim.engine import simulate
+
+    good = simulate(build(make_scenario(duration=20.0)))
+    assert good.divergence() is None
+    p = _write(tmp_path, 'duration = 1500.0\n[controller]\ntype = "pid"\nKp = 0.0\nKi = 0.0\nKd = 0.0\n'
+                         '[environment]\nconstant_rudder_deg = 35.0\n')
+    from steerlab.sim.scenario import load_scenario
+
+    spun = simulate(load_scenario(p)).divergence()
+    assert isinstance(spun, DivergedError) and "the ship spun" in spun.what and 0.0 < spun.time < 1500.0
+    good.states[57:, 4] = np.nan
+    bad = good.divergence()
+    assert bad.time == pytest.approx(5.7) and bad.what.startswith("v = nan") and "validity range" in bad.hint
+
+
 def test_kosoko_at_10_kn_diverges_and_says_so(tmp_path):
     """The issue's case: catalogued 0.1-2.9 kn, run at 10 kn with dt 0.5 s; it exited 0 with metrics."""
     out = tmp_path / "o"

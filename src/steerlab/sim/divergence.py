@@ -18,6 +18,7 @@ and on-line accumulators of a batch:
 from __future__ import annotations
 
 import math
+from typing import Optional
 
 import numpy as np
 
@@ -48,18 +49,32 @@ def likely_cause(setup) -> str:
     return "likely cause: " + "; or ".join(parts)
 
 
-def check_run(result, setup) -> None:
-    """Raise :class:`DivergedError` if ``result`` (of ``setup``) left the finite numbers or spun."""
+def divergence(result, setup=None) -> Optional[DivergedError]:
+    """The :class:`DivergedError` of ``result`` if it left the finite numbers or spun, else None.
+
+    ``setup`` (the run's :class:`~steerlab.sim.setup.SimSetup`, optional) makes the hint of a
+    non-finite run name its speed against the ship's validity range (:func:`likely_cause`).
+    """
     X = result.states
     bad = ~np.isfinite(X)
     if bad.any():
         k, j = np.argwhere(bad)[0]
         name = result.state_names[j] if j < len(result.state_names) else f"state {j}"
-        raise DivergedError(float(result.time[k]), f"{name} = {float(X[k, j])!r}", likely_cause(setup))
+        hint = likely_cause(setup) if setup is not None else ("likely cause: a speed outside the ship's "
+                                                                "validity range, or a dt too large for the model")
+        return DivergedError(float(result.time[k]), f"{name} = {float(X[k, j])!r}", hint)
     off = np.abs(np.unwrap(result.psi - result.psi_ref))
     if off.size and float(off.max()) > SPIN_LIMIT:
         k = int(np.argmax(off > SPIN_LIMIT))
-        raise DivergedError(float(result.time[k]), "the ship spun: its heading left the reference by more "
-                            "than a full turn", "the closed loop is unstable: the controller does not suit "
-                            "this ship (check its design model and gains); for open-loop turns use "
-                            "'steerlab trial'")
+        return DivergedError(float(result.time[k]), "the ship spun: its heading left the reference by more "
+                             "than a full turn", "the closed loop is unstable: the controller does not suit "
+                             "this ship (check its design model and gains); for open-loop turns use "
+                             "'steerlab trial'")
+    return None
+
+
+def check_run(result, setup) -> None:
+    """Raise :class:`DivergedError` if ``result`` (of ``setup``) left the finite numbers or spun."""
+    err = divergence(result, setup)
+    if err is not None:
+        raise err

@@ -16,6 +16,8 @@ from steerlab.environment.channels import CHANNEL_NAMES, CHANNEL_UNITS
 if TYPE_CHECKING:
     import pandas
 
+    from steerlab.errors import DivergedError
+
 
 @dataclass
 class Result:
@@ -59,6 +61,17 @@ class Result:
     def heading_error(self) -> np.ndarray:
         """``wrap_to_pi(psi_ref - psi)`` [rad]."""
         return wrap_to_pi_array(self.psi_ref - self.psi)
+
+    def divergence(self) -> Optional[DivergedError]:
+        """Why this run cannot be reported, or None: a :class:`~steerlab.errors.DivergedError` if
+        a state left the finite numbers, or if the ship *spun* (its heading left the reference
+        by more than a full turn, ``max |unwrap(psi - psi_ref)| > 2 pi``: an unstable closed
+        loop, whose wrapped heading error would make the metrics look bounded). The check the
+        CLI makes before it reports a run (exit 3); ``simulate`` returns such runs as they are
+        (an open-loop turn spins on purpose). ``raise r.divergence()`` if it is not None."""
+        from steerlab.sim.divergence import divergence
+
+        return divergence(self)
 
     @property
     def dt(self) -> float:
