@@ -206,3 +206,25 @@ def test_tune_estimate_names_seeds(tmp_path, capsys):
     err = capsys.readouterr().err
     assert code == 2 and "--seeds: 500 conditions of 3000 steps x a population of 30 needs about" in err, err
     assert time.perf_counter() - t0 < 20.0
+
+
+def test_a_run_that_never_settles_far_off_its_course_says_what_to_try(tmp_path, capsys):
+    """The default PID gains on the Zeefakkel (thesis Table 2.3) overshoot a 20 deg change to
+    126 deg and end 96 deg off: the run still reports (no spin), and stderr says why and what
+    designs settings, within the output width; a run that settles gets no such line."""
+    from steerlab.commands._run_options import tracking_hint
+    from steerlab.text_table import MAX_WIDTH
+
+    toml = ('name = "zeefakkel-pid"\nduration = 600.0\n[ship]\nmodel = "zeefakkel-nomoto-10deg"\nspeed_kn = 12.0\n'
+            '[controller]\ntype = "pid"\n[guidance]\npsi0_deg = 0.0\nchanges = [{ t = 10.0, psi_deg = 20.0 }]\n')
+    p = tmp_path / "zee.toml"
+    p.write_text(toml)
+    assert main(["run", str(p), "--out", str(tmp_path / "o")]) == 0
+    err = capsys.readouterr().err
+    assert "the heading did not settle on its reference (final error -95.6 deg)" in err
+    assert "'zeefakkel-nomoto-10deg'" in err and "steerlab tune" in err
+    hint = err[err.index("the heading did not settle"):].split("wrote")[0]
+    assert max(len(line) for line in err.splitlines() if line.split("] ", 1)[-1] in hint) <= MAX_WIDTH
+    assert tracking_hint({"settling_time_1deg_s": 36.5, "final_error_deg": 0.0}, "x") is None      # settled
+    assert tracking_hint({"settling_time_1deg_s": None, "final_error_deg": 3.0}, "x") is None       # close
+    assert tracking_hint({"settling_time_1deg_s": float("nan"), "final_error_deg": -9.0}, "x")      # far

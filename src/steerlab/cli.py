@@ -12,6 +12,7 @@ from __future__ import annotations
 import argparse
 import math
 import sys
+import textwrap
 from pathlib import Path
 
 from steerlab.errors import EXIT_BAD_INPUT, EXIT_DIVERGED, DivergedError, InputError
@@ -102,6 +103,9 @@ def _run(args, figures) -> int:
         write_run_report(stage, result, metrics, scenario, figures=[stage / name for name in FIGURE_NAMES])
         figures.wait()                        # the report names the figures; they are complete here
     print(format_metrics_table(metrics))
+    hint = ro.tracking_hint(metrics, setup.ship.name)
+    for line in textwrap.wrap(hint or "", 86):    # within the output width with the time prefix
+        say(line)
     say(f"wrote {args.out}/report.html")
     return 0
 

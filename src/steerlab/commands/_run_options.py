@@ -102,3 +102,24 @@ def write_diverged(stage, result, scenario, err: DivergedError, args) -> int:
               stage / "metrics.json", digits=None)
     (stage / "scenario.json").write_text(scenario.model_dump_json(indent=2) + "\n", encoding="utf-8")
     return len(head.time)
+
+
+#: a run whose heading ends farther than this from its reference, never settled, gets a hint [deg]
+UNSETTLED_HINT_DEG = 5.0
+
+
+def tracking_hint(metrics: dict, ship: str) -> str | None:
+    """A line for the user when the heading never settled and ends far from its reference (a
+    controller whose settings do not suit the ship, e.g. the default PID gains on a catalogue
+    ship they were not chosen for), else None. Metrics as :func:`steerlab.metrics.compute_metrics`
+    gives them (``settling_time_1deg_s`` None when not settled; ``final_error_deg`` [deg])."""
+    settled = metrics.get("settling_time_1deg_s")
+    final = metrics.get("final_error_deg")
+    if settled is not None and not (isinstance(settled, float) and math.isnan(settled)):
+        return None
+    if final is None or not math.isfinite(final) or abs(final) <= UNSETTLED_HINT_DEG:
+        return None
+    return (f"the heading did not settle on its reference (final error {final:.3g} deg): the controller's "
+            f"settings may not suit ship {ship!r}; a controller designed from the ship's model "
+            "(type = \"adrc\" with c0 = \"exact\", or \"itae_pid\" for a course-stable ship) or "
+            "'steerlab tune' finds settings that do")
