@@ -172,6 +172,16 @@ def swap_into_place(stage: Path, target: Path) -> None:
         os.rename(stage, target)
 
 
+def make_folder(folder: Path, field: str, what: str = "") -> None:
+    """Create ``folder`` and its parents (nothing if it exists); one that cannot be made is the
+    :class:`InputError` on ``field`` (``what`` names it in the message, e.g. ``"its folder "``)."""
+    try:
+        Path(folder).mkdir(parents=True, exist_ok=True)
+    except OSError as err:
+        why = "a file is in the way" if isinstance(err, FileExistsError) else err.strerror
+        raise InputError(field, f"cannot create {what}{str(folder)!r}: {why}") from None
+
+
 @contextlib.contextmanager
 def staged_output(out_dir: Path):
     """Write into a hidden sibling folder; swap it for ``out_dir`` whole, only on success.
@@ -181,10 +191,7 @@ def staged_output(out_dir: Path):
     (files of an earlier run that this one did not write do not survive).
     """
     target = prepare_out(out_dir)
-    try:
-        target.parent.mkdir(parents=True, exist_ok=True)
-    except OSError as err:
-        raise InputError("--out", f"cannot create {str(target.parent)!r}: {err.strerror}") from None
+    make_folder(target.parent, "--out")
     stage = target.parent / f".{target.name}{PARTIAL}{os.getpid()}"
     shutil.rmtree(stage, ignore_errors=True)
     stage.mkdir()

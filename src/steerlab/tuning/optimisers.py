@@ -120,12 +120,9 @@ def _checkpoint_folder(path) -> None:
     """Create the checkpoint's folder before the first generation, as ``--out`` does its own:
     ``--checkpoint out/tune.ckpt`` on a fresh clone (no ``out/`` yet) failed when the first
     generation's checkpoint was written. A folder that cannot be made is the input error."""
-    folder = Path(path).parent
-    try:
-        folder.mkdir(parents=True, exist_ok=True)
-    except OSError as err:
-        why = "a file is in the way" if isinstance(err, FileExistsError) else err.strerror
-        raise InputError("--checkpoint", f"cannot create its folder {str(folder)!r}: {why}") from None
+    from steerlab.outputs import make_folder
+
+    make_folder(Path(path).parent, "--checkpoint", "its folder ")
 
 
 def load_checkpoint(path, problem_key: dict) -> dict | None:
