@@ -19,6 +19,10 @@ from typing import TYPE_CHECKING, Any
 
 __version__ = "0.1.0"
 
+# the steerlab command's numpy on one OpenBLAS thread: before numpy is imported (blas_threads)
+from steerlab import blas_threads  # noqa: E402  (isort: skip)
+
+blas_threads.one_thread_for_commands()
 # before any kernel is defined: cached kernels are keyed on the whole package, not one file
 from steerlab import numba_cache  # noqa: F401,E402  (isort: skip)
 # a cached kernel is loaded without numba's compile-time registries (numba_cache_load)
