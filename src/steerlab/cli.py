@@ -15,7 +15,7 @@ import sys
 import textwrap
 from pathlib import Path
 
-from steerlab.errors import EXIT_BAD_INPUT, EXIT_DIVERGED, DivergedError, InputError
+from steerlab.errors import EXIT_BAD_INPUT, EXIT_DIVERGED, DivergedError, InertSettingWarning, InputError
 from steerlab.outputs import _clean, _json_default, dump_json, staged_output  # noqa: F401 (re-exported)
 
 MAX_MESSAGE = 300   #: longest error or warning line [characters]
@@ -274,6 +274,7 @@ def main(argv=None) -> int:
 
         drivers.on_compile = _say_compiling
     restore = None
+    shown_by = _warnings_as_lines()
     try:
         if getattr(args, "out", None):        # every command that writes: --out checked before any work
             restore = _prepare_out(args.out)
@@ -301,6 +302,9 @@ def main(argv=None) -> int:
         _close_progress(forget=True)
         if restore is not None:
             restore()
+        import warnings
+
+        warnings.showwarning = shown_by
 
 
 def console_main() -> None:
@@ -321,6 +325,40 @@ def _say_compiling(msg: str) -> None:
 
     _close_progress()
     print(textwrap.fill(msg, 100, subsequent_indent="  "), file=sys.stderr, flush=True)
+
+
+#: the warning lines this command has printed (a repeated warning is printed once)
+SHOWN_WARNINGS: set[str] = set()
+
+
+def print_warning(text: str) -> None:
+    """Print ``steerlab: warning: TEXT`` as one line on stderr (below an open progress bar),
+    once per command."""
+    line = one_line(text)
+    if line in SHOWN_WARNINGS:
+        return
+    SHOWN_WARNINGS.add(line)
+    _close_progress()
+    print(f"steerlab: warning: {line}", file=sys.stderr, flush=True)
+
+
+def _warnings_as_lines():
+    """Show steerlab's :class:`~steerlab.errors.InertSettingWarning` as one line
+    (:func:`print_warning`) instead of Python's two-line form with a source line; other
+    warnings as Python shows them. Returns the previous ``warnings.showwarning`` (restored
+    when the command ends)."""
+    import warnings
+
+    previous = warnings.showwarning
+    SHOWN_WARNINGS.clear()
+
+    def show(message, category, filename, lineno, file=None, line=None):
+        if not issubclass(category, InertSettingWarning):
+            return previous(message, category, filename, lineno, file, line)
+        print_warning(str(message))
+
+    warnings.showwarning = show
+    return previous
 
 
 def _close_progress(forget: bool = False) -> None:

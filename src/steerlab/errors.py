@@ -53,5 +53,15 @@ class DivergedError(RuntimeError):
         super().__init__(f"the run diverged{at} ({what}); {hint}")
 
 
+class InertSettingWarning(UserWarning):
+    """A setting the run's models do not feel, e.g. a wind on a ship without a wind model.
+
+    The run goes on as it would without the setting (the scenario stays valid: the same wind
+    still drives the sea report and the time series' wind columns); the message names the
+    setting, why it has no effect and what would give it one. The CLI prints it as one line
+    ``steerlab: warning: ...`` on stderr.
+    """
+
+
 EXIT_BAD_INPUT = 2      #: bad input: one line naming the field (InputError)
 EXIT_DIVERGED = 3       #: the run diverged or the ship spun (DivergedError)

@@ -10,9 +10,9 @@ a traceback. Only the design stage is guarded; library code raises as it does.
 from __future__ import annotations
 
 import contextlib
-import sys
+import warnings as _warnings
 
-from steerlab.errors import InputError
+from steerlab.errors import InertSettingWarning, InputError
 
 
 @contextlib.contextmanager
@@ -28,16 +28,17 @@ def design_guard(stage: str = "scenario design"):
 
 
 def warn(lines) -> None:
-    """Print each warning as one ``steerlab: warning: ...`` line on stderr."""
-    from steerlab.cli import one_line
+    """Print each warning as one ``steerlab: warning: ...`` line on stderr (each once per command)."""
+    from steerlab.cli import print_warning
 
     for line in lines:
-        print(f"steerlab: warning: {one_line(line)}", file=sys.stderr, flush=True)
+        print_warning(line)
 
 
 def design_checked(scenario, max_memory: float | None = None):
     """``(setup, warnings)``: the scenario refused if impossible, built under :func:`design_guard`,
-    its warnings printed (see :mod:`steerlab.sim.sanity`); refused first if its set-up would not fit
+    its warnings printed (see :mod:`steerlab.sim.sanity`; with the settings its models do not
+    feel, :class:`~steerlab.errors.InertSettingWarning`); refused first if its set-up would not fit
     in memory (``max_memory`` [GB], :mod:`steerlab.resources`)."""
     from steerlab.sim.sanity import check_scenario, scenario_warnings
     from steerlab.sim.setup import build
@@ -45,9 +46,15 @@ def design_checked(scenario, max_memory: float | None = None):
     from steerlab.resources import check_setup_memory
 
     check_setup_memory(scenario, max_memory)  # before build() allocates the disturbance sequence
-    with design_guard():
+    with design_guard(), _warnings.catch_warnings(record=True) as caught:
+        _warnings.simplefilter("always", InertSettingWarning)
         check_scenario(scenario)
         setup = build(scenario)
         warnings = scenario_warnings(scenario)
+    for w in caught:          # a setting the models do not feel (InertSettingWarning): listed too
+        if issubclass(w.category, InertSettingWarning):
+            warnings.append(str(w.message))
+        else:
+            _warnings.showwarning(w.message, w.category, w.filename, w.lineno)
     warn(warnings)
     return setup, warnings

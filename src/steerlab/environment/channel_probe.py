@@ -12,14 +12,18 @@ import numpy as np
 from steerlab.environment.channels import N_CHANNELS
 
 
-def reads_channel(ship, ps, x0, channel: int, probe: float = 1e-3) -> bool:
-    """Whether ``ship.rhs`` at the plant state ``x0`` depends on disturbance ``channel``."""
+def reads_channel(ship, ps, x0, channel: int, probe: float = 1e-3, w0=None) -> bool:
+    """Whether ``ship.rhs`` at the plant state ``x0`` depends on disturbance ``channel``.
+
+    ``w0`` is the disturbance row the probe is added to (default: all channels zero), e.g. a
+    wind direction for a probe of the wind speed.
+    """
     x = np.asarray(x0, dtype=float).copy()
     n = ship.n_states
     d0 = np.zeros(n + 1)
     d1 = np.zeros(n + 1)
-    w = np.zeros(N_CHANNELS)
+    w = np.zeros(N_CHANNELS) if w0 is None else np.array(w0, dtype=float)
     ship.rhs(0.0, x, 0.0, w, ps, d0)
-    w[channel] = probe
+    w[channel] += probe
     ship.rhs(0.0, x, 0.0, w, ps, d1)
     return bool(np.any(d0[:n] != d1[:n]))

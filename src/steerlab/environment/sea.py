@@ -127,14 +127,25 @@ def yaw_gain(cfg, ship) -> tuple[float, float]:
     return L, daidola_gain(L, B, c_B)
 
 
+_CODES = {"yaw_rate": W_YAW_RATE, "yaw_moment": W_YAW_MOMENT, "rudder": W_RUDDER}
+
+
 def _route(cfg, ctx: SeaContext, allowed):
+    """The channel the waves go to: ``auto``'s choice, or the configured one if the model offers
+    it and the ship reads it (a channel the ship does not read would be a calm sea, silently)."""
     ch = cfg.channel
-    if ch == "auto":
-        first = allowed[0]
-        code = W_YAW_RATE if first == "yaw_rate" else W_YAW_MOMENT
-        return first if reads_channel(ctx.ship, ctx.ps, ctx.x0, code) else "rudder"
-    if ch not in allowed:
+    if ch not in allowed and ch != "auto":
         raise InputError(f"{F}.channel", f"{ch!r} not available for model {cfg.model!r}; allowed: auto, {', '.join(allowed)}")
+    reads = {c: reads_channel(ctx.ship, ctx.ps, ctx.x0, _CODES[c]) for c in allowed}
+    if ch == "auto":
+        ch = allowed[0] if reads[allowed[0]] else "rudder"
+    if not reads[ch]:
+        read = [c for c in allowed if reads[c]]
+        if not read:
+            raise InputError(f"{F}.channel", f"ship {ctx.ship.name!r} reads none of the wave channels "
+                             f"({', '.join(allowed)}), so the waves would not act on it; turn the waves off")
+        raise InputError(f"{F}.channel", f"ship {ctx.ship.name!r} does not read the {ch} channel, so the waves "
+                         f"would not act on it; allowed for this ship: auto, {', '.join(read)}")
     return ch
 
 

@@ -76,7 +76,7 @@ def scenario_dict(controller: dict, wind: bool, duration: float = 100.0) -> dict
         "controller": {**controller, "sample_time": 0.125},
         "guidance": {"type": "berthing", "route": ROUTE, "lookahead_L": 2.0, "accept_radius_m": 1.0,
                      "rpm_plan": RPM_PLAN, "stop_radius_m": 0.5, "model_scale": 7.2},
-        "environment": {"wind_speed": WIND_SPEED if wind else 0.0, "wind_dir_deg": WIND_FROM_DEG},
+        "environment": {"wind_speed": WIND_SPEED, "wind_dir_deg": WIND_FROM_DEG} if wind else {},
     }
 
 

@@ -11,6 +11,7 @@ from steerlab.control.registry import ControllerSpec, get_controller
 from steerlab.environment.disturbance import Disturbance, build_disturbance
 from steerlab.environment.sea import SeaContext, add_sea, uses_sea
 from steerlab.errors import InputError
+from steerlab.sim.inert_settings import warn_inert_settings
 from steerlab.guidance.plan import GuidancePlan, build_guidance
 from steerlab.guidance.reference_vector import REF_PSI, REF_R, initial_reference
 from steerlab.sensors.wrapper import SUFFIX as SENSORS_SUFFIX
@@ -174,6 +175,7 @@ class Design:
                            env.wave_sample_time, env.wave_power, wind_speed=env.wind_speed,
                            wind_dir=rad(env.wind_dir_deg), current_speed=env.current_speed,
                            current_dir=rad(env.current_dir_deg))
+        warn_inert_settings(s, ship, ps, x0)     # settings its models do not read: one warning each
         return cls(s, ship, ctrl_spec, ps, pg, pc, z0, x0, ref0, plan, nc, ts, speed, ship_options, dist,
                    gear, ctx, ctrl)
 
