@@ -170,3 +170,14 @@ def test_guidance_settings_of_another_type_are_named(guidance, names):
     found = [m for m in inert_settings(make_scenario(guidance=guidance)) if m.startswith("guidance.")]
     assert [m.split(":", 1)[0] for m in found] == [f"guidance.{n}" for n in names]
     assert all(f'has no effect with type = "{guidance["type"]}" (read by type ' in m for m in found)
+
+
+@pytest.mark.parametrize("ship, unread", [("nomoto1", True), ("b481", True), ("esso", False), ("kosoko", False)])
+def test_a_propeller_rate_the_ship_does_not_take_is_named(ship, unread):
+    scenario = make_scenario(ship={"model": ship, "speed_kn": 10.0, "rpm": 80.0}, duration=20.0)
+    with warnings.catch_warnings(record=True) as rec:
+        warnings.simplefilter("always", InertSettingWarning)
+        build(scenario)
+    rpm = [str(r.message) for r in rec if str(r.message).startswith("ship.rpm: ")]
+    assert rpm == ([f"ship.rpm: has no effect: ship {ship!r} takes no propeller rate (its speed is ship.speed_kn)"]
+                   if unread else [])

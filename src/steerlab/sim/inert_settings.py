@@ -18,7 +18,10 @@ the one the scenario describes without them: no number changes.
 from __future__ import annotations
 
 import warnings
+from collections.abc import Callable
 from typing import Any
+
+import numpy as np
 
 from steerlab.errors import InertSettingWarning
 
@@ -109,12 +112,29 @@ def inert_settings(scenario: Any) -> list[str]:
     return out + _guidance_block(scenario.guidance)
 
 
-def warn_inert_settings(scenario: Any, ship: Any, ps: Any, x0: Any) -> list[str]:
-    """Warn (:class:`~steerlab.errors.InertSettingWarning`) for each of :func:`inert_settings` and
-    for a wind the ship does not read; returns the messages."""
+def rpm_unread(scenario: Any, ship: Any, ps: Any, repack: Callable[[float], Any]) -> str | None:
+    """The message for a ``[ship] rpm`` the ship's record does not take (None if it does, or if
+    none is given): ``repack(rpm)`` packs the ship's record at another rate (0.9 times the given
+    one); the same record means the rate is not read (the Nomoto, Norrbin, Bech and van Leeuwen
+    models steer at a constant speed)."""
+    rpm = scenario.ship.rpm
+    if rpm is None or not np.array_equal(np.asarray(ps), np.asarray(repack(0.9 * rpm))):
+        return None
+    return (f"ship.rpm: has no effect: ship {ship.name!r} takes no propeller rate (its speed is "
+            "ship.speed_kn)")
+
+
+def warn_inert_settings(scenario: Any, ship: Any, ps: Any, x0: Any,
+                        repack: Callable[[float], Any] | None = None) -> list[str]:
+    """Warn (:class:`~steerlab.errors.InertSettingWarning`) for each of :func:`inert_settings`,
+    for a wind the ship does not read and for a propeller rate it does not take (with ``repack``,
+    :func:`rpm_unread`); returns the messages."""
     from steerlab.environment.wind_felt import unfelt_wind_message, wind_felt
 
     messages = inert_settings(scenario)
+    rpm = None if repack is None else rpm_unread(scenario, ship, ps, repack)
+    if rpm is not None:
+        messages.append(rpm)
     wind = unfelt_wind_message(ship.name, scenario.environment)
     if wind is not None and not wind_felt(ship, ps, x0):
         messages.append(wind)

@@ -175,7 +175,8 @@ class Design:
                            env.wave_sample_time, env.wave_power, wind_speed=env.wind_speed,
                            wind_dir=rad(env.wind_dir_deg), current_speed=env.current_speed,
                            current_dir=rad(env.current_dir_deg))
-        warn_inert_settings(s, ship, ps, x0)     # settings its models do not read: one warning each
+        # settings its models do not read: one warning each
+        warn_inert_settings(s, ship, ps, x0, lambda rpm: ship.pack(speed, rpm, ship_options))
         return cls(s, ship, ctrl_spec, ps, pg, pc, z0, x0, ref0, plan, nc, ts, speed, ship_options, dist,
                    gear, ctx, ctrl)
 
