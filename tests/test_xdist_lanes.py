@@ -11,7 +11,7 @@ from types import SimpleNamespace
 import pytest
 import conftest
 from conftest import COMPUTE_NICENESS, is_realtime, lanes_wanted, under_lanes
-from xdist_lanes import MIN_PENDING, QUEUED, LaneScheduling
+from xdist_lanes import MIN_PENDING, MODULE_TAIL, QUEUED, LaneScheduling
 
 
 class FakeWorker:
@@ -55,7 +55,7 @@ def _run_all(sched, nodes, crash=None):
         assert steps < 10_000
         for node in list(sched.nodes):
             pending = sched.node2pending[node]
-            assert len(pending) <= QUEUED
+            assert len(pending) <= QUEUED + MODULE_TAIL
             if not pending:
                 continue
             if crash and node is crash[0] and len(ran[node.gateway.id]) == crash[1]:
@@ -93,8 +93,21 @@ def test_no_worker_idles_while_tests_are_left():
 
 def test_queues_stay_short_so_the_tail_is_balanced():
     sched, nodes = _session(COLLECTION)
-    assert all(MIN_PENDING <= len(sched.node2pending[n]) <= QUEUED for n in nodes)
-    _run_all(sched, nodes)                                             # asserts <= QUEUED at every step
+    assert all(MIN_PENDING <= len(sched.node2pending[n]) <= QUEUED + MODULE_TAIL for n in nodes)
+    _run_all(sched, nodes)                                   # asserts <= QUEUED + MODULE_TAIL at every step
+
+
+def test_a_short_module_runs_on_one_worker_a_long_one_is_shared():
+    """Module-scoped fixtures are made once per worker: a module of up to MODULE_TAIL + 1 tests
+    goes to one worker wherever a top-up starts in it; a longer one is shared out."""
+    sizes = [3, MODULE_TAIL + 1, 2, 7, MODULE_TAIL + 1, 1, 40, 4]
+    collection = [f"tests/test_m{m}.py::t{i}" for m, n in enumerate(sizes) for i in range(n)]
+    sched, nodes = _session(collection, workers=2)
+    ran, _ = _run_all(sched, nodes)
+    worker_of = {i: w for w, tests in ran.items() for i in tests}
+    shared = {m: len({worker_of[i] for i, nodeid in enumerate(collection) if nodeid.startswith(f"tests/test_m{m}.py")})
+              for m in range(len(sizes))}
+    assert shared == {0: 1, 1: 1, 2: 1, 3: 1, 4: 1, 5: 1, 6: 2, 7: 1}
 
 
 def test_a_crashed_worker_is_reported_and_its_other_tests_run_elsewhere():

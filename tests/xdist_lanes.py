@@ -9,7 +9,8 @@ with ``STEERLAB_TEST_LANES=0``: ``tests/conftest.py``), and :class:`LaneScheduli
 
 * the **wall-clock tests** (``is_waiting(nodeid)``) to the last worker, the *lane*, in
   collection order;
-* every other test to the other workers, a few at a time.
+* every other test to the other workers, a few at a time, a short module's tests together
+  (:data:`MODULE_TAIL`).
 
 A worker whose own pool is empty takes tests from the other pool, so no worker idles while
 tests are left (on a machine with many cores the compute workers finish first and share the
@@ -30,6 +31,11 @@ from typing import Any
 MIN_PENDING = 2
 #: a worker's queue is topped up to this many tests when it falls to :data:`MIN_PENDING`
 QUEUED = 5
+#: ... and then by the rest of the last test's module when at most this many of its tests are
+#: left: a module of up to ``MODULE_TAIL + 1`` tests runs on one worker, so its module-scoped
+#: fixtures (a KVLCC2 trial set, a compiled in-memory driver: seconds each) are made once, not
+#: once per worker that gets some of its tests
+MODULE_TAIL = 8
 
 
 def auto_workers(config: Any) -> int | None:
@@ -161,13 +167,33 @@ class LaneScheduling:
         if len(pending) > MIN_PENDING:
             return
         send = pool[:QUEUED - len(pending)]
+        send += self._rest_of_module(pool, len(send))
         del pool[:len(send)]
         pending.extend(send)
         node.send_runtest_some(send)
 
+    def _rest_of_module(self, pool: list[int], taken: int) -> list[int]:
+        """The tests of ``pool`` after the first ``taken`` that belong to the module of the last
+        one taken, if there are at most :data:`MODULE_TAIL` of them (else none)."""
+        assert self.collection is not None
+        if taken == 0:
+            return []
+        module = _module(self.collection[pool[taken - 1]])
+        end = taken
+        while end < len(pool) and _module(self.collection[pool[end]]) == module:
+            end += 1
+            if end - taken > MODULE_TAIL:
+                return []
+        return pool[taken:end]
+
     def _pool_of(self, index: int) -> str:
         assert self.collection is not None
         return "wait" if self.is_waiting(self.collection[index]) else "compute"
+
+
+def _module(nodeid: str) -> str:
+    """``tests/test_a.py::test_x[1]`` -> ``tests/test_a.py``."""
+    return nodeid.split("::", 1)[0]
 
 
 def _worker_number(node: Any) -> int:
