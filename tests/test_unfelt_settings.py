@@ -78,7 +78,7 @@ def _windy(ship="esso", **environment):
 def test_wind_on_a_ship_without_a_wind_model_warns_and_the_run_is_the_calm_run():
     with pytest.warns(InertSettingWarning) as rec:
         windy = simulate(_windy(gusts={"speed_std": 2.0}))
-    assert len(rec) == 1
+    assert len(rec) == 1 and rec[0].filename == __file__          # the user's line, not steerlab's
     text = str(rec[0].message)
     assert text.startswith("environment.wind_speed: ship 'esso' has no wind model, so the wind (15 m/s) and its "
                            "gusts do not act on it") and "[environment.wind_rudder]" in text and "\n" not in text

@@ -17,6 +17,7 @@ the one the scenario describes without them: no number changes.
 
 from __future__ import annotations
 
+import sys
 import warnings
 from collections.abc import Callable
 from typing import Any
@@ -24,6 +25,7 @@ from typing import Any
 import numpy as np
 
 from steerlab.errors import InertSettingWarning
+from steerlab.numba_cache import PACKAGE_ROOT
 
 #: [environment.wave] fields each wave model reads (besides ``model``; the eq (39) waves read
 #: ``environment.wave_power`` and ``wave_sample_time`` instead)
@@ -138,6 +140,19 @@ def warn_inert_settings(scenario: Any, ship: Any, ps: Any, x0: Any,
     wind = unfelt_wind_message(ship.name, scenario.environment)
     if wind is not None and not wind_felt(ship, ps, x0):
         messages.append(wind)
+    level = _first_caller_outside_steerlab()
     for message in messages:
-        warnings.warn(message, InertSettingWarning, stacklevel=3)
+        warnings.warn(message, InertSettingWarning, stacklevel=level)
     return messages
+
+
+def _first_caller_outside_steerlab() -> int:
+    """The ``stacklevel`` (for a ``warnings.warn`` in the caller of this function) of the first
+    frame outside the steerlab package: the user's line that asked for the run (a notebook
+    cell, a script), which Python's warning then names, and by which its default filter shows
+    a repeated warning once per line."""
+    package = str(PACKAGE_ROOT)
+    frame, level = sys._getframe(2), 2
+    while frame is not None and frame.f_code.co_filename.startswith(package):
+        frame, level = frame.f_back, level + 1
+    return level
