@@ -14,7 +14,14 @@ from pathlib import Path
 
 import pytest
 
-from steerlab.sim.scenario import scenario_from_dict
+# numpy's OpenBLAS on one thread, as in the steerlab command (steerlab.blas_threads): the commands
+# the tests run in this process fork (figure children, pools), and OpenBLAS restarts its
+# busy-waiting threads after every fork (7-8 % of the CPU of the command tests, measured
+# alternately under pytest-xdist). Set before numpy is first imported (the line below); a value
+# the user set is kept; subprocesses inherit it.
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+
+from steerlab.sim.scenario import scenario_from_dict  # noqa: E402
 
 # Subprocess tests (``python -m steerlab ...``) must import this checkout's ``src`` (pytest's
 # ``pythonpath`` only reaches this process), whichever checkout an editable install points to.
