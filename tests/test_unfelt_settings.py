@@ -181,3 +181,19 @@ def test_a_propeller_rate_the_ship_does_not_take_is_named(ship, unread):
     rpm = [str(r.message) for r in rec if str(r.message).startswith("ship.rpm: ")]
     assert rpm == ([f"ship.rpm: has no effect: ship {ship!r} takes no propeller rate (its speed is ship.speed_kn)"]
                    if unread else [])
+
+
+def test_the_tables_name_every_wave_and_guidance_setting():
+    """Each field of ``[environment.wave]`` and ``[guidance]`` is read by some model or type in
+    the tables of ``steerlab.sim.inert_settings`` (a new field left out would be called unread
+    for every model), and the tables' keys are the schema's models and types."""
+    from typing import get_args
+
+    from steerlab.environment.sea_config import WaveConfig
+    from steerlab.sim.inert_settings import _GUIDANCE_FIELDS, _WAVE_FIELDS
+    from steerlab.sim.scenario import GuidanceConfig
+
+    assert set(WaveConfig.model_fields) - {"model"} == set().union(*_WAVE_FIELDS.values())
+    assert set(GuidanceConfig.model_fields) - {"type"} == set().union(*_GUIDANCE_FIELDS.values())
+    assert set(_WAVE_FIELDS) == set(get_args(WaveConfig.model_fields["model"].annotation))
+    assert set(_GUIDANCE_FIELDS) == set(get_args(GuidanceConfig.model_fields["type"].annotation))
