@@ -137,6 +137,25 @@ def test_de_resume_is_identical_to_an_uninterrupted_run_and_leaves_no_temporary(
     assert sorted(f.name for f in tmp_path.iterdir()) == ["de.ckpt"]
 
 
+def test_a_scipy_that_keeps_des_state_otherwise_refuses_only_the_checkpoint(lq_conditions, tmp_path, monkeypatch):
+    """A DE checkpoint keeps private attributes of scipy's solver: a scipy without one of them
+    refuses ``--checkpoint`` in one line before the first generation (nothing written), and a run
+    without a checkpoint does not read them (same result as with this scipy's)."""
+    from steerlab.tuning import optimisers
+
+    pm = build_param_map(lq_conditions, ["kp", "kd"], np.array([[0.1, 5.0], [1.0, 100.0]]))
+    before = run_optimiser(PopulationEvaluator(lq_conditions, pm, [parse_cost("ise")]), "de", 2, 6, 0)
+    monkeypatch.setattr(optimisers, "DE_SOLVER_STATE",
+                        optimisers.DE_SOLVER_STATE + (("moved", "_kept_elsewhere_by_this_scipy"),))
+    after = run_optimiser(PopulationEvaluator(lq_conditions, pm, [parse_cost("ise")]), "de", 2, 6, 0)
+    assert np.array_equal(after.x, before.x) and after.history == before.history
+    ck = tmp_path / "de.ckpt"
+    with pytest.raises(InputError, match=r"^--checkpoint: this scipy \(.*\) keeps differential evolution's state "
+                                         r"differently \(no _kept_elsewhere_by_this_scipy\)"):
+        run_optimiser(PopulationEvaluator(lq_conditions, pm, [parse_cost("ise")]), "de", 2, 6, 0, checkpoint=ck)
+    assert list(tmp_path.iterdir()) == []
+
+
 def test_a_checkpoint_in_a_folder_not_yet_made_is_written_there(lq_conditions, tmp_path):
     """``--checkpoint out/tune.ckpt`` on a fresh clone (docs/tuning.md): the folder is made, as
     ``--out`` makes its own; one that cannot be made is the input error on ``--checkpoint``."""

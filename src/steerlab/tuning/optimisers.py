@@ -183,6 +183,35 @@ def run_optimiser(evaluator, method: str, generations: int, pop_size: int, seed:
     return _run_pymoo(evaluator, method, generations, pop_size, seed, checkpoint, key, ck, prog)
 
 
+#: what a DE checkpoint keeps of scipy's ``DifferentialEvolutionSolver``: ``(checkpoint key,
+#: solver attribute)``. scipy has no public way to continue a run, so private attributes are
+#: among them; a scipy that keeps them differently refuses ``--checkpoint`` before the first
+#: generation, in one line (a run without a checkpoint does not read them)
+DE_SOLVER_STATE = (("population", "population"), ("population_energies", "population_energies"),
+                   ("feasible", "feasible"), ("constraint_violation", "constraint_violation"),
+                   ("nfev", "_nfev"), ("random_index", "_random_population_index"))
+
+
+def _check_de_solver_state(solver) -> None:
+    """One ``--checkpoint`` InputError if ``solver`` lacks an attribute of :data:`DE_SOLVER_STATE`."""
+    missing = [attr for _, attr in DE_SOLVER_STATE if not hasattr(solver, attr)]
+    if missing:
+        import scipy
+
+        raise InputError("--checkpoint", f"this scipy ({scipy.__version__}) keeps differential evolution's state "
+                                         f"differently (no {', '.join(missing)}), so a DE checkpoint cannot be "
+                                         "written or resumed; run without --checkpoint, or use --method ga")
+
+
+def _de_solver_state(solver) -> dict:
+    """The checkpoint's copy of the solver's state (:data:`DE_SOLVER_STATE`)."""
+    out = {}
+    for name, attr in DE_SOLVER_STATE:
+        value = getattr(solver, attr)
+        out[name] = value if isinstance(value, (int, np.integer)) else np.array(value, copy=True)
+    return out
+
+
 def _run_de(ev, generations, pop_size, seed, checkpoint, key, ck, prog) -> TuningResult:
     # scipy's own solver object (what differential_evolution builds and runs), driven here so
     # that a checkpoint holds its exact state: the unit-scaled population, its energies, the
@@ -218,12 +247,7 @@ def _run_de(ev, generations, pop_size, seed, checkpoint, key, ck, prog) -> Tunin
         prog(state["gen"], ev.n_sims, best_f, best_x)
         state["last"] = {"version": CHECKPOINT_VERSION, "key": key, "generation": state["gen"],
                          "population": np.asarray(intermediate_result.population), "energies": energies,
-                         "solver": {"population": solver.population.copy(),
-                                    "population_energies": solver.population_energies.copy(),
-                                    "feasible": np.array(solver.feasible, copy=True),
-                                    "constraint_violation": np.array(solver.constraint_violation, copy=True),
-                                    "nfev": solver._nfev,
-                                    "random_index": solver._random_population_index.copy()},
+                         "solver": _de_solver_state(solver) if checkpoint else None,
                          "rng_state": rng.bit_generator.state,
                          "history": history, "n_sims": ev.n_sims, "best_x": best_x, "best_f": best_f}
         if checkpoint:
@@ -234,14 +258,12 @@ def _run_de(ev, generations, pop_size, seed, checkpoint, key, ck, prog) -> Tunin
                                      rng=rng, popsize=popsize, maxiter=remaining, init="latinhypercube",
                                      tol=0.0, atol=0.0, callback=callback) as solver:
         state["solver"] = solver
+        if checkpoint:
+            _check_de_solver_state(solver)
         if ck is not None:                   # continue exactly where the checkpoint's generation ended
             saved = ck["solver"]
-            solver.population = saved["population"].copy()
-            solver.population_energies = saved["population_energies"].copy()
-            solver.feasible = saved["feasible"].copy()
-            solver.constraint_violation = saved["constraint_violation"].copy()
-            solver._nfev = saved["nfev"]
-            solver._random_population_index = saved["random_index"].copy()   # shuffled in place each draw
+            for name, attr in DE_SOLVER_STATE:     # (the sample index is shuffled in place each draw)
+                setattr(solver, attr, saved[name] if name == "nfev" else saved[name].copy())
             rng.bit_generator.state = ck["rng_state"]
         solver.solve()
     return _de_result(state.get("last", ck), history, state["gen"], ev, resumed=gen0 or None)
