@@ -120,6 +120,15 @@ def test_the_cli_prints_the_warning_once_as_one_steerlab_line(tmp_path, capsys, 
         assert [w for w in listed if w.startswith("environment.wind_speed: ship 'esso' has no wind model")]
 
 
+def test_a_gymnasium_environments_warning_names_the_users_gym_make_line():
+    gym = pytest.importorskip("gymnasium")
+    import steerlab.gym  # noqa: F401  (registers the environments)
+
+    with pytest.warns(InertSettingWarning, match="^environment.wind_speed: ship 'esso' has no wind model") as rec:
+        gym.make("steerlab/CourseKeeping-v0", environment={"wind_speed": 5.0}, episode_s=5.0)
+    assert [r.filename for r in rec] == [__file__]
+
+
 @pytest.mark.parametrize("environment, fields", [
     ({"wave_power": 0.5}, ["wave_power"]),
     ({"wave_power": 0.5, "waves": True}, []),

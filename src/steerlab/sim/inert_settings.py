@@ -17,9 +17,11 @@ the one the scenario describes without them: no number changes.
 
 from __future__ import annotations
 
+import os
 import sys
 import warnings
 from collections.abc import Callable
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -148,11 +150,19 @@ def warn_inert_settings(scenario: Any, ship: Any, ps: Any, x0: Any,
 
 def _first_caller_outside_steerlab() -> int:
     """The ``stacklevel`` (for a ``warnings.warn`` in the caller of this function) of the first
-    frame outside the steerlab package: the user's line that asked for the run (a notebook
-    cell, a script), which Python's warning then names, and by which its default filter shows
-    a repeated warning once per line."""
-    package = str(PACKAGE_ROOT)
+    frame outside the steerlab package and outside the Gymnasium package (whose ``gym.make``
+    builds steerlab's environments): the user's line that asked for the run (a notebook cell, a
+    script), which Python's warning then names, and by which its default filter shows a
+    repeated warning once per line."""
+    inside = (str(PACKAGE_ROOT) + os.sep,) + _gymnasium_root()
     frame, level = sys._getframe(2), 2
-    while frame is not None and frame.f_code.co_filename.startswith(package):
+    while frame is not None and frame.f_code.co_filename.startswith(inside):
         frame, level = frame.f_back, level + 1
     return level
+
+
+def _gymnasium_root() -> tuple[str, ...]:
+    """Gymnasium's package folder, if it is imported (it is, when it builds an environment)."""
+    gymnasium = sys.modules.get("gymnasium")
+    file = getattr(gymnasium, "__file__", None)
+    return (str(Path(file).resolve().parent) + os.sep,) if file else ()
