@@ -136,16 +136,22 @@ def _route(cfg, ctx: SeaContext, allowed):
     ch = cfg.channel
     if ch not in allowed and ch != "auto":
         raise InputError(f"{F}.channel", f"{ch!r} not available for model {cfg.model!r}; allowed: auto, {', '.join(allowed)}")
-    reads = {c: reads_channel(ctx.ship, ctx.ps, ctx.x0, _CODES[c]) for c in allowed}
+    reads: dict = {}              # probed on demand: realised once per seed (a Monte-Carlo's every run)
+
+    def read(c: str) -> bool:
+        if c not in reads:
+            reads[c] = reads_channel(ctx.ship, ctx.ps, ctx.x0, _CODES[c])
+        return reads[c]
+
     if ch == "auto":
-        ch = allowed[0] if reads[allowed[0]] else "rudder"
-    if not reads[ch]:
-        read = [c for c in allowed if reads[c]]
-        if not read:
+        ch = allowed[0] if read(allowed[0]) else "rudder"
+    if not read(ch):
+        read_by_ship = [c for c in allowed if read(c)]
+        if not read_by_ship:
             raise InputError(f"{F}.channel", f"ship {ctx.ship.name!r} reads none of the wave channels "
                              f"({', '.join(allowed)}), so the waves would not act on it; turn the waves off")
         raise InputError(f"{F}.channel", f"ship {ctx.ship.name!r} does not read the {ch} channel, so the waves "
-                         f"would not act on it; allowed for this ship: auto, {', '.join(read)}")
+                         f"would not act on it; allowed for this ship: auto, {', '.join(read_by_ship)}")
     return ch
 
 
