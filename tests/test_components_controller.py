@@ -192,3 +192,70 @@ def test_top_level_names_resolve_and_import_steerlab_stays_light():
             "    assert callable(getattr(sl, n)), n\n"
             "assert 'gymnasium' not in sys.modules\n")
     subprocess.run([sys.executable, "-c", code], check=True)
+
+
+# ------------------------------------------------- the vector step compiled once ever (issue 14)
+
+_VECTOR_SCRIPT = """
+import json
+import numpy as np
+from steerlab.components.controller import controller
+from steerlab.components.controller_vector import vector_kernel
+vec = controller("pid", nomoto=(0.05, 80.0), Kp=1.5).vector(3).reset()
+u = vec.step(1.0, np.array([0.0, 0.1, -0.1]), 0.01, 0.2)
+run = vector_kernel(vec.spec.update)
+print(json.dumps({"u": u.tolist(), "hits": sum(run.stats.cache_hits.values()),
+                  "misses": sum(run.stats.cache_misses.values())}))
+"""
+
+
+def test_the_vector_step_is_loaded_by_a_fresh_process_instead_of_compiled(tmp_path):
+    """``Controller.vector`` steps through a generated driver module
+    (``components/controller_vector_template.py``): the first process compiles and saves its
+    step, the next one loads it, with the same orders."""
+    import json
+    import os
+    import subprocess
+    import sys
+
+    env = {**os.environ, "STEERLAB_CACHE_DIR": str(tmp_path / "cache")}
+    env.pop("STEERLAB_DRIVER_CACHE", None)
+
+    def fresh():
+        p = subprocess.run([sys.executable, "-c", _VECTOR_SCRIPT], env=env, capture_output=True, text=True,
+                           timeout=600)
+        assert p.returncode == 0, p.stderr
+        return json.loads(p.stdout.strip().splitlines()[-1])
+
+    first, second = fresh(), fresh()
+    assert (first["misses"], first["hits"]) == (1, 0)         # compiled, saved
+    assert (second["misses"], second["hits"]) == (0, 1)       # loaded
+    assert second["u"] == first["u"] and first["u"][1] < first["u"][0] < first["u"][2]
+
+
+def test_a_vector_of_a_kernel_that_cannot_be_named_steps_from_an_in_memory_module():
+    import numba
+
+    from steerlab.components.controller_vector import vector_kernel
+
+    vec = controller("pid", nomoto=(0.05, 80.0)).vector(2).reset()
+    inner = vec.spec.update
+
+    @numba.njit
+    def closure_update(z, p, t, x, ref, h):       # the same law, but no importable name
+        return inner(z, p, t, x, ref, h)
+
+    named, mem = vector_kernel(inner), vector_kernel(closure_update)
+    assert named.py_func.__module__.startswith("steerlab_driver_") and not named.py_func.__module__.startswith(
+        "steerlab_driver_mem_")
+    assert mem.py_func.__module__.startswith("steerlab_driver_mem_")
+    X = np.zeros((2, len(vec.plant_state_names)))
+    X[:, 2] = [0.0, 0.2]
+    R = np.tile(vec._R[0], (2, 1))
+    R[:, 0] = 0.1
+    Z1, Z2 = vec.state.copy(), vec.state.copy()
+    o1, o2 = np.zeros(2), np.zeros(2)
+    for t in (0.0, 1.0, 2.0):
+        named(Z1, vec.params, t, X, R, vec.sample_time, o1)
+        mem(Z2, vec.params, t, X, R, vec.sample_time, o2)
+        assert np.array_equal(o1, o2) and np.array_equal(Z1, Z2) and o1[0] > o1[1]

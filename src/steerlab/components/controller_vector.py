@@ -9,10 +9,9 @@ from its own design (different gains), as long as the type and sample time are t
 
 from __future__ import annotations
 
-from functools import lru_cache
+from pathlib import Path
 from typing import TYPE_CHECKING, Any, Callable, Iterable, Optional, Union
 
-import numba
 import numpy as np
 from numpy.typing import ArrayLike
 
@@ -20,20 +19,22 @@ from steerlab.errors import InputError
 from steerlab.guidance.reference_vector import initial_reference
 from steerlab.ships.state import IPSI, IR, IU
 
+TEMPLATE = Path(__file__).with_name("controller_vector_template.py")
+
 if TYPE_CHECKING:
     from steerlab.components.controller import Controller
 
 
-@lru_cache(maxsize=None)
 def vector_kernel(update: Callable[..., float]) -> Callable[..., None]:
-    """``run(Z, P, t, X, R, h, out)``: ``out[i] = update(Z[i], P[i], t, X[i], R[i], h)`` for each i."""
+    """``run(Z, P, t, X, R, h, out)``: ``out[i] = update(Z[i], P[i], t, X[i], R[i], h)`` for each i.
 
-    @numba.njit
-    def run(Z, P, t, X, R, h, out):
-        for i in range(Z.shape[0]):
-            out[i] = update(Z[i], P[i], t, X[i], R[i], h)
+    The entry point of :mod:`steerlab.components.controller_vector_template` bound to
+    ``update``: loaded from the driver cache in a fresh process, generated and compiled once
+    otherwise, built in memory for a kernel that cannot be named
+    (:func:`steerlab.sim.drivers.driver`; memoised there)."""
+    from steerlab.sim import drivers
 
-    return run
+    return drivers.entry(drivers.driver(None, update, None, template=TEMPLATE), "run")
 
 
 def _column(name, v, n):

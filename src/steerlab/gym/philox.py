@@ -89,7 +89,7 @@ def philox_block(c0, c1, c2, c3, k0, k1):
     return c0, c1, c2, c3
 
 
-@numba.njit
+@numba.njit(cache=True)
 def philox4x64(c0, c1, c2, c3, k0, k1, out):
     """:func:`philox_block` into ``out[0:4]``."""
     out[0], out[1], out[2], out[3] = philox_block(c0, c1, c2, c3, k0, k1)
@@ -135,7 +135,7 @@ def _word(buf, pos, b, episode, st, k0, k1):
     return buf[pos], pos + 1, b
 
 
-@numba.njit
+@numba.njit(cache=True)
 def normals(k0, k1, episode, stream, out, scale):
     """``out[j] = z_j * scale``, ``z_j`` the standard normals of (key, episode, stream) by
     the ziggurat method (see the module docstring) from the words of blocks ``b = 0, 1, ...``

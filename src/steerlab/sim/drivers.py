@@ -132,8 +132,9 @@ def _source(bindings: str, template: Path = TEMPLATE) -> str:
 
 
 def describe_key(ship_rhs, ctrl_update, guide) -> str:
-    parts = [describe(kernel_ref(ship_rhs)) if kernel_ref(ship_rhs) else getattr(ship_rhs, "__name__", "?")]
-    for k in (ctrl_update, guide):
+    """``esso_rhs + pid_update + course_guide``: the kernels of a combination (those given)."""
+    parts = []
+    for k in (ship_rhs, ctrl_update, guide):
         if k is not None:
             r = kernel_ref(k)
             parts.append(describe(r) if r else getattr(k, "__name__", "?"))
