@@ -75,6 +75,12 @@ def test_every_registered_ship_and_controller_pickles_as_its_name():
     for registry in (SHIPS, CONTROLLERS):
         for name in registry:
             spec = registry[name]
+            if not registry.found_everywhere(spec):
+                # registered while this process runs, by a test of another module that ran in
+                # this worker before (test_user_plugin registers its example): by value, by design
+                # (test_a_spec_registered_while_the_process_runs_pickles_field_by_field)
+                assert name.startswith("my_"), name       # never one of steerlab's own
+                continue
             assert pickle.loads(pickle.dumps(spec)) is spec, name
             assert len(pickle.dumps(spec)) < 300, name      # the name, not the kernels' code
 

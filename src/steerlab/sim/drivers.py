@@ -22,6 +22,11 @@ Cache layout and guarantees
   created by writing a temporary file and linking it into place only if absent; numba
   writes its cache files by atomic rename. Two processes compiling the same combination at
   once both succeed (each compiles; the last rename wins; both results are identical).
+* **A user's edited kernel is compiled afresh.** A kernel of a plug-in or of the user's own
+  package is named in the module by reference, and the module's text also carries the digest
+  of every user source file that kernel is compiled from (its module and the project modules
+  it imports: :mod:`steerlab.kernel_sources`): an edit to any of them gives another module,
+  never the old machine code.
 * **Corrupt entries are rebuilt.** Before the first use in a process, the driver's module
   text and numba's index and data files are read back; a truncated or unreadable file is
   deleted and the driver recompiled, never a crash.
@@ -50,6 +55,7 @@ from pathlib import Path
 from typing import Callable, Optional
 
 from steerlab.kernel_refs import describe, kernel_ref
+from steerlab.kernel_sources import source_digests
 from steerlab.numba_cache import _fingerprint
 
 TEMPLATE = Path(__file__).with_name("driver_template.py")
@@ -114,10 +120,15 @@ def driver(ship_rhs, ctrl_update=None, guide=None, nx: int = 0, lanes: int = 16,
         return mod
 
 
-def _bindings(refs: dict, nx: int, lanes: int, cache: bool) -> str:
+def _bindings(refs: dict, nx: int, lanes: int, cache: bool, sources=()) -> str:
+    """The bindings block of a generated driver: its kernels by reference, its sizes, and the
+    digests of the user source files its kernels are compiled from (``sources``,
+    :func:`steerlab.kernel_sources.source_digests`: an edit to one of them gives another
+    text, hence another module and machine code)."""
     lines = [BEGIN, "from steerlab.kernel_refs import resolve as _resolve"]
     for name in ("SHIP_RHS", "CTRL_UPDATE", "GUIDE"):
         lines.append(f"{name} = _resolve({refs[name]!r})")
+    lines += [f"# compiled from {module} (sha256 {digest})" for module, digest in sources]
     lines += [f"NX = {int(nx)}", f"LANES = {int(lanes)}", f"CACHE = {bool(cache)}", END]
     return "\n".join(lines)
 
@@ -146,9 +157,10 @@ def _make(key: _Key) -> types.ModuleType:
             "GUIDE": kernel_ref(key.guide)}
     nameable = all(refs[n] is not None or k is None
                    for n, k in (("SHIP_RHS", key.ship), ("CTRL_UPDATE", key.ctrl), ("GUIDE", key.guide)))
-    if enabled() and nameable:
+    sources = source_digests(refs.values()) if enabled() and nameable else None
+    if sources is not None:
         try:
-            return _from_disk(key, _source(_bindings(refs, key.nx, key.lanes, True), key.template))
+            return _from_disk(key, _source(_bindings(refs, key.nx, key.lanes, True, sources), key.template))
         except (OSError, ImportError, AttributeError):
             # read-only or full disk, or a plug-in kernel whose module cannot be imported back
             # by name: the same driver, compiled in memory

@@ -1,0 +1,149 @@
+"""The source files a user's kernel is compiled from, for keying cached machine code on them.
+
+A generated driver (:mod:`steerlab.sim.drivers`) fuses the ship, controller and guidance
+kernels it binds into one piece of machine code, cached on disk under the hash of the module's
+text, in a directory named after steerlab's own fingerprint. That text names the kernels
+(``("ref", "my_ship:my_rhs")``), not their code: a user who edited the ``my_rhs`` of a plug-in
+and ran again was served the machine code of the old equation, with the old numbers and no
+word (numba's own cache has the same blind spot for the functions a cached function calls).
+
+:func:`source_digests` lists, for every kernel a reference names outside steerlab, the
+contents' digest of its module's file and of every module of the same project that module
+imports (followed through their imports, read from the source with :mod:`ast`). A driver
+writes them into its text, so an edit to any of them gives another driver, compiled afresh;
+steerlab's own kernels add nothing (the fingerprint directory covers them), so the drivers of
+steerlab's catalogue are unchanged. Installed packages (``site-packages``, the standard
+library) are not followed: their files change with their version, on an upgrade, after which
+``steerlab cache clear`` drops the old machine code.
+
+A module whose source cannot be read (a compiled extension, a zip import) makes the kernel
+unkeyable: :func:`source_digests` returns None and the driver is built in memory, never from a
+cache that might be stale.
+"""
+
+from __future__ import annotations
+
+import ast
+import hashlib
+import importlib.util
+import sys
+import sysconfig
+from functools import lru_cache
+from pathlib import Path
+from typing import Optional
+
+from steerlab.numba_cache import PACKAGE_ROOT
+
+
+@lru_cache(maxsize=1)
+def _installed_roots() -> tuple[str, ...]:
+    """Folders of installed code (the standard library, site-packages): not followed."""
+    paths = sysconfig.get_paths()
+    roots = {paths.get(k) for k in ("stdlib", "platstdlib", "purelib", "platlib")}
+    roots |= {p for p in sys.path if p.rstrip("/\\").endswith(("site-packages", "dist-packages"))}
+    return tuple(str(Path(r).resolve()) for r in roots if r)
+
+
+def _spec(name: str):
+    """``importlib.util.find_spec(name)``, or None when it cannot be found (a dotted name's
+    parents are imported to find it: only asked of a user's own packages)."""
+    try:
+        return importlib.util.find_spec(name)
+    except Exception:  # noqa: BLE001 - a name that is no module (``from X import function``)
+        return None
+
+
+def _origin(spec) -> Optional[str]:
+    if spec is None:
+        return None
+    if spec.origin and spec.origin not in ("built-in", "frozen", "namespace"):
+        return spec.origin
+    locations = list(spec.submodule_search_locations or [])
+    return locations[0] if locations else None
+
+
+def _outside_the_project(path: Path) -> bool:
+    """steerlab itself (the fingerprint covers it) or installed code (not followed)."""
+    try:
+        path.relative_to(PACKAGE_ROOT)
+        return True
+    except ValueError:
+        return str(path).startswith(_installed_roots())
+
+
+def _project_file(module: str) -> Optional[Path]:
+    """The source file of ``module`` when it is a user's (not steerlab, not installed, not
+    built in); None otherwise. Never imports an installed package to find out."""
+    loaded = sys.modules.get(module)
+    if loaded is not None:
+        origin = getattr(loaded, "__file__", None)
+    else:
+        top = module.partition(".")[0]
+        top_origin = _origin(_spec(top))                   # a top-level name: nothing imported
+        if top_origin is None or _outside_the_project(Path(top_origin).resolve()):
+            return None
+        origin = top_origin if top == module else _origin(_spec(module))
+    if not origin:
+        return None
+    path = Path(origin).resolve()
+    return None if _outside_the_project(path) or path.suffix != ".py" else path
+
+
+def _imports(path: Path, module: str, text: str) -> set[str]:
+    """Absolute names of the modules ``text`` (the source of ``module``) imports, and of
+    ``from X import y`` also ``X.y`` (``y`` may be a submodule)."""
+    package = module if path.name == "__init__.py" else module.rpartition(".")[0]
+    names: set[str] = set()
+    for node in ast.walk(ast.parse(text, filename=str(path))):
+        if isinstance(node, ast.Import):
+            names.update(a.name for a in node.names)
+        elif isinstance(node, ast.ImportFrom):
+            base = node.module or ""
+            if node.level:
+                parts = package.split(".") if package else []
+                parts = parts[:len(parts) - (node.level - 1)] if node.level > 1 else parts
+                base = ".".join(p for p in (*parts, base) if p)
+            if base:
+                names.add(base)
+                names.update(f"{base}.{a.name}" for a in node.names if a.name != "*")
+    return names
+
+
+def _module_of_ref(ref) -> list[str]:
+    """The modules of the kernels a reference names (a bound kernel: its template's and its
+    bindings')."""
+    if ref is None:
+        return []
+    if ref[0] == "ref":
+        return [ref[1].partition(":")[0]]
+    _, template, _, inner = ref
+    out = [template.partition(":")[0]]
+    for _, r in inner:
+        out += _module_of_ref(r)
+    return out
+
+
+def source_digests(refs) -> Optional[list[tuple[str, str]]]:
+    """``[(module, sha256 of its file[:16]), ...]`` (sorted) of the user modules the kernels of
+    ``refs`` (kernel references, :mod:`steerlab.kernel_refs`; None entries skipped) are
+    compiled from, followed through the modules they import; ``[]`` for steerlab's own
+    kernels; None when a user module's source cannot be read."""
+    seen: dict[str, str] = {}
+    todo = [m for ref in refs for m in _module_of_ref(ref)]
+    while todo:
+        module = todo.pop()
+        if module in seen:
+            continue
+        path = _project_file(module)
+        if path is None:
+            seen[module] = ""
+            continue
+        try:
+            data = path.read_bytes()
+            text = data.decode("utf-8")
+            imported = _imports(path, module, text)
+        except (OSError, UnicodeDecodeError, SyntaxError, ValueError):
+            return None
+        seen[module] = hashlib.sha256(data).hexdigest()[:16]
+        todo += sorted(imported - seen.keys())
+    return sorted((m, d) for m, d in seen.items() if d)

@@ -1,0 +1,102 @@
+"""A user's edited kernel is never served from the driver cache as it was (steerlab.kernel_sources):
+the drivers' text carries the digests of the user source files their kernels are compiled from."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+import textwrap
+from pathlib import Path
+
+from steerlab.kernel_sources import source_digests
+
+SRC = Path(__file__).resolve().parent.parent / "src"
+
+#: a user's ship kernel (first-order Nomoto), its gain from a helper module of the project
+SHIP = textwrap.dedent("""
+    import numba
+    import numpy as np                      # installed: not followed
+    from helpers import gain
+
+    @numba.njit
+    def rhs(t, x, delta, w, p, dx):
+        dx[:] = 0.0
+        dx[2] = x[5]
+        dx[5] = gain() * (p[1] * delta - x[5]) / p[0]
+""")
+HELPERS = "import numba\n\n@numba.njit\ndef gain():\n    return {gain}\n"
+
+#: one plant step of the user's ship through its generated driver, in a fresh process
+STEP = textwrap.dedent("""
+    import json
+    import numpy as np
+    import usership
+    from steerlab.environment.channels import N_CHANNELS
+    from steerlab.sim.drivers import driver
+    mod = driver(usership.rhs, None, None, 7)
+    x = np.zeros(7)
+    x[5] = 0.1
+    pg = np.array([0.6, 0.05, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0])
+    mod.rk4_step(0.0, x, 0.1, np.zeros(N_CHANNELS), np.array([50.0, 0.1]), pg, 0.1, np.zeros((5, 7)))
+    print(json.dumps({"r": x[5], "loaded": sum(mod.rk4_step.stats.cache_hits.values())}))
+""")
+
+
+def _project(folder: Path, gain: str) -> Path:
+    folder.mkdir(exist_ok=True)
+    (folder / "usership.py").write_text(SHIP)
+    (folder / "helpers.py").write_text(HELPERS.format(gain=gain))
+    return folder
+
+
+def _step(folder: Path, cache: Path) -> dict:
+    env = {**os.environ, "STEERLAB_CACHE_DIR": str(cache),
+           "PYTHONPATH": os.pathsep.join([str(folder), str(SRC)])}
+    env.pop("STEERLAB_DRIVER_CACHE", None)
+    p = subprocess.run([sys.executable, "-c", STEP], cwd=folder, env=env, capture_output=True, text=True,
+                       timeout=600)
+    assert p.returncode == 0, p.stderr
+    return json.loads(p.stdout.strip().splitlines()[-1])
+
+
+def test_an_edit_to_a_module_the_kernel_imports_gives_its_new_numbers_in_the_next_process(tmp_path):
+    """Before, the second process loaded the machine code compiled for the old helper (gain 1):
+    the old numbers, silently. The helper is not the kernel's own module: an import followed."""
+    project, cache = _project(tmp_path / "project", "1.0"), tmp_path / "cache"
+    first = _step(project, cache)
+    assert first["loaded"] == 0 and _step(project, cache) == {"r": first["r"], "loaded": 1}   # cached
+    (project / "helpers.py").write_text(HELPERS.format(gain="100.0"))
+    edited = _step(project, cache)
+    assert edited["loaded"] == 0 and edited["r"] != first["r"]           # compiled afresh, new numbers
+    assert abs(edited["r"] - first["r"]) > 1e-3                          # 100 times the yaw dynamics
+    again = _step(project, cache)
+    assert again == {"r": edited["r"], "loaded": 1}                      # and cached again
+
+
+def test_digests_follow_the_projects_imports_and_nothing_else(tmp_path, monkeypatch):
+    project = _project(tmp_path / "p", "1.0")
+    (project / "pkg").mkdir()
+    (project / "pkg" / "__init__.py").write_text("")
+    (project / "pkg" / "law.py").write_text("from . import consts\nfrom .consts import K\n")
+    (project / "pkg" / "consts.py").write_text("K = 2.0\n")
+    monkeypatch.syspath_prepend(str(project))
+    ship = source_digests([("ref", "usership:rhs")])
+    assert [m for m, _ in ship] == ["helpers", "usership"]               # numpy, numba: installed
+    law = source_digests([("bound", "steerlab.control.wave_filtered:_wf_template", "law_wf",
+                           (("_inner", ("ref", "pkg.law:update")),))])
+    assert [m for m, _ in law] == ["pkg", "pkg.consts", "pkg.law"]        # relative imports too
+    before = dict(law)
+    (project / "pkg" / "consts.py").write_text("K = 3.0\n")
+    assert dict(source_digests([("ref", "pkg.law:update")]))["pkg.consts"] != before["pkg.consts"]
+    # steerlab's own kernels: nothing (the fingerprint directory covers them), so the drivers
+    # of the catalogue keep their text
+    assert source_digests([("ref", "steerlab.ships.esso_3dof:esso_rhs"), None,
+                           ("ref", "steerlab.control.pid:pid_update")]) == []
+
+
+def test_a_module_whose_source_cannot_be_read_makes_the_kernel_unkeyable(tmp_path, monkeypatch):
+    (tmp_path / "broken.py").write_bytes(b"x = '\xff\xfe'\n")                # not UTF-8
+    monkeypatch.syspath_prepend(str(tmp_path))
+    assert source_digests([("ref", "broken:rhs")]) is None                 # -> built in memory
