@@ -109,17 +109,17 @@ def _imports(path: Path, module: str, text: str) -> set[str]:
     return names
 
 
-def _module_of_ref(ref) -> list[str]:
+def _module_of_ref(kref) -> list[str]:
     """The modules of the kernels a reference names (a bound kernel: its template's and its
     bindings')."""
-    if ref is None:
+    if kref is None:
         return []
-    if ref[0] == "ref":
-        return [ref[1].partition(":")[0]]
-    _, template, _, inner = ref
-    out = [template.partition(":")[0]]
-    for _, r in inner:
-        out += _module_of_ref(r)
+    kind, path = kref[:2]
+    if kind == "ref":
+        return [path.partition(":")[0]]
+    out = [path.partition(":")[0]]
+    for _, inner in kref[3]:
+        out += _module_of_ref(inner)
     return out
 
 
@@ -129,7 +129,7 @@ def source_digests(refs) -> Optional[list[tuple[str, str]]]:
     compiled from, followed through the modules they import; ``[]`` for steerlab's own
     kernels; None when a user module's source cannot be read."""
     seen: dict[str, str] = {}
-    todo = [m for ref in refs for m in _module_of_ref(ref)]
+    todo = [m for kref in refs for m in _module_of_ref(kref)]
     while todo:
         module = todo.pop()
         if module in seen:

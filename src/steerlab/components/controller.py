@@ -162,7 +162,12 @@ class Controller:
         ref = self._ref
         ref[REF_PSI] = _finite("heading_ref", heading_ref)
         ref[REF_R] = _finite("yaw_rate_ref", yaw_rate_ref)
-        u = float(self.spec.update(self.state, self.params, _finite("t", t), x, ref, self.sample_time))
+        call = self.__dict__.get("_call")
+        if call is None:      # the law's kernel as Python calls it (a wrapped law: from the driver cache)
+            from steerlab.sim.controller_calls import controller_step
+
+            call = self._call = controller_step(self.spec.update)
+        u = float(call(self.state, self.params, _finite("t", t), x, ref, self.sample_time))
         self._last = u
         return u
 

@@ -9,7 +9,6 @@ from its own design (different gains), as long as the type and sample time are t
 
 from __future__ import annotations
 
-from pathlib import Path
 from typing import TYPE_CHECKING, Any, Callable, Iterable, Optional, Union
 
 import numpy as np
@@ -19,22 +18,16 @@ from steerlab.errors import InputError
 from steerlab.guidance.reference_vector import initial_reference
 from steerlab.ships.state import IPSI, IR, IU
 
-TEMPLATE = Path(__file__).with_name("controller_vector_template.py")
-
 if TYPE_CHECKING:
     from steerlab.components.controller import Controller
 
 
 def vector_kernel(update: Callable[..., float]) -> Callable[..., None]:
-    """``run(Z, P, t, X, R, h, out)``: ``out[i] = update(Z[i], P[i], t, X[i], R[i], h)`` for each i.
+    """``run(Z, P, t, X, R, h, out)``: ``out[i] = update(Z[i], P[i], t, X[i], R[i], h)`` for each i
+    (:func:`steerlab.sim.controller_calls.vector_step`: compiled once ever)."""
+    from steerlab.sim.controller_calls import vector_step
 
-    The entry point of :mod:`steerlab.components.controller_vector_template` bound to
-    ``update``: loaded from the driver cache in a fresh process, generated and compiled once
-    otherwise, built in memory for a kernel that cannot be named
-    (:func:`steerlab.sim.drivers.driver`; memoised there)."""
-    from steerlab.sim import drivers
-
-    return drivers.entry(drivers.driver(None, update, None, template=TEMPLATE), "run")
+    return vector_step(update)
 
 
 def _column(name, v, n):

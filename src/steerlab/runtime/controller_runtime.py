@@ -11,6 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from steerlab.errors import InputError
+from steerlab.sim.controller_calls import controller_step
 from steerlab.ships.state import IPSI, IR, IU, IV, IX, IY
 from steerlab.guidance.reference_vector import REF_PSI, REF_R
 
@@ -52,13 +53,13 @@ class ControllerRuntime:
         gear = d.gear
         self._design, self.p = d.ctrl, s.pc
         self.name = s.controller.name
-        self.kernel = s.controller.update
+        self.kernel = controller_step(s.controller.update)      # a wrapped law: from the driver cache
         self.h = float(sample_time)
         self.nx = s.x0.shape[0]
         self.x = np.zeros(self.nx)
         self.z = np.asarray(s.z0, dtype=float).copy()
         self.delta_max = gear.delta_max
-        self.kernel(self.z.copy(), self.p, 0.0, s.x0.copy(), np.zeros(2), self.h)   # compile now
+        self.kernel(self.z.copy(), self.p, 0.0, s.x0.copy(), np.zeros(2), self.h)   # load or compile now
 
     def measured_state(self, x_n, y_e, psi, u, v, r, delta) -> np.ndarray:
         """The plant-state vector the kernels expect (model-specific extra states are 0)."""

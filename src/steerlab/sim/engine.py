@@ -15,6 +15,7 @@ from steerlab.angles import wrap_to_pi_array
 from steerlab.guidance.reference_models import course_guide
 from steerlab.guidance.reference_vector import N_REF, REF_NAMES, REF_PSI, REF_R, REF_RPM, initial_reference
 from steerlab.metrics_online import accumulate, new_accumulator
+from steerlab.sim.controller_calls import controller_step
 from steerlab.sim.kernels import closed_loop, plant_step
 from steerlab.sim.result import Result
 from steerlab.sim.setup import SimSetup, build
@@ -57,7 +58,7 @@ def simulate_readable(scenario_or_setup: Union[Scenario, SimSetup]) -> Result:
     """The closed loop written out step by step in Python (same kernels as the compiled one)."""
     s = _as_setup(scenario_or_setup)
     rk4_step = plant_step(s.ship.rhs)
-    update = s.controller.update
+    update = controller_step(s.controller.update)   # the kernel (a wrapped law: a cached entry calling it)
     x = s.x0.copy()
     z = s.z0.copy()
     nx = x.shape[0]
