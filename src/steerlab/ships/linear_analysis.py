@@ -42,10 +42,7 @@ def nomoto_from_linear(A1, B1) -> dict:
     L = np.concatenate((np.concatenate((A, B), axis=1), np.concatenate((C, D), axis=1)), axis=0)
     M = np.pad(np.eye(2), ((0, 1), (0, 1)), "constant")
     zeros = np.array([z for z in eigvals(L, M, overwrite_a=True) if not np.isinf(z)], dtype=complex)
-    T1, T2 = (float(-1.0 / p.real) for p in poles)
-    T3 = float(-1.0 / zeros[0].real) if len(zeros) else 0.0
-    return {"K": K, "T1": T1, "T2": T2, "T3": T3, "T": T1 + T2 - T3,
-            "poles": [complex(p) for p in poles], "zero": complex(zeros[0]) if len(zeros) else None}
+    return _reading(K, poles, zeros)
 
 
 def _nomoto_from_linear_by_python_control(A1, B1) -> dict:
@@ -59,6 +56,12 @@ def _nomoto_from_linear_by_python_control(A1, B1) -> dict:
     K = float(num[-1] / den[-1])
     poles = np.sort_complex(control.poles(sys))
     zeros = control.zeros(sys)
+    return _reading(K, poles, zeros)
+
+
+def _reading(K: float, poles, zeros) -> dict:
+    """The Nomoto reading of gain ``K`` [1/s], the two poles and the zero (if any) [1/s] of
+    ``r/delta``: ``T_i = -1 / Re(pole_i)``, ``T3 = -1 / Re(zero)``, ``T = T1 + T2 - T3`` [s]."""
     T1, T2 = (float(-1.0 / p.real) for p in poles)
     T3 = float(-1.0 / zeros[0].real) if len(zeros) else 0.0
     return {"K": K, "T1": T1, "T2": T2, "T3": T3, "T": T1 + T2 - T3,
