@@ -20,6 +20,12 @@ interleaved with the runs):
 * ``first_sim_and_batch_beyond_import``: in a fresh process with a warm cache, the time of
   the first ``simulate`` plus the first ``simulate_batch`` (of 32 runs) after
   ``import steerlab`` (target: <= 0.8 s);
+* ``first_controller_steps_beyond_import``: in a fresh process with a warm cache, the time of
+  designing and stepping a wave-filtered PID (``sl.controller("pid+wf", ship="esso")``, a law
+  wrapped at run time) and eight ADRCs in one call (``sl.controllers("adrc", n=8, ...)``), the
+  components API's first orders, after ``import steerlab`` (median 1.46 s before the session of
+  2026-11-26 afternoon: the wrapped law and the vector step compiled in every process, and
+  the wave filter's Nomoto design imported python-control);
 * ``run_default_cold``: the default run with an empty driver cache (a fresh
   ``STEERLAB_CACHE_DIR``; target <= 10 s, and it says that it is compiling).
 
@@ -91,6 +97,19 @@ def _timed_cpu(cmd, env) -> tuple[float, float, subprocess.CompletedProcess]:
     return dt, _cpu_of_children() - c0, p
 
 
+FIRST_STEPS = """
+import time
+t0 = time.perf_counter()
+import numpy as np
+import steerlab as sl
+t1 = time.perf_counter()
+sl.controller("pid+wf", ship="esso", speed_kn=16.0).reset().step(0.0, 0.0, 0.0, 0.1)
+sl.controllers("adrc", n=8, ship="esso", speed_kn=16.0).reset().step(0.0, np.zeros(8), 0.0, 0.1)
+t2 = time.perf_counter()
+print(t1 - t0, t2 - t1)
+"""
+
+
 def measure(repeats: int, cold: bool, progress=print, first_calls: bool = True) -> dict:
     """The medians and ratios of the module docstring (``first_calls=False``: without the
     first-calls measurement; the CPU times are user + system of the whole process tree)."""
@@ -106,7 +125,8 @@ def measure(repeats: int, cold: bool, progress=print, first_calls: bool = True) 
     progress("warming the cache (default run, first calls) ...")
     _timed(run_cmd, _env(warm))
     _timed([py, "-c", FIRST_CALLS], _env(warm))
-    ref, run, ref_cpu, run_cpu, imports, first = [], [], [], [], [], []
+    _timed([py, "-c", FIRST_STEPS], _env(warm))
+    ref, run, ref_cpu, run_cpu, imports, first, steps = [], [], [], [], [], [], []
     for i in range(repeats):
         progress(f"repeat {i + 1}/{repeats}")
         dt, cpu, _ = _timed_cpu(reference_cmd, _env(warm))
@@ -120,6 +140,8 @@ def measure(repeats: int, cold: bool, progress=print, first_calls: bool = True) 
             a, b = (float(v) for v in p.stdout.split())
             imports.append(a)
             first.append(b)
+            _, p = _timed([py, "-c", FIRST_STEPS], _env(warm))
+            steps.append(float(p.stdout.split()[1]))
     res = {
         "repeats": repeats,
         "reference_s": statistics.median(ref),
@@ -130,6 +152,7 @@ def measure(repeats: int, cold: bool, progress=print, first_calls: bool = True) 
     if first_calls:
         res["import_steerlab_s"] = statistics.median(imports)
         res["first_sim_and_batch_beyond_import_s"] = statistics.median(first)
+        res["first_controller_steps_beyond_import_s"] = statistics.median(steps)
     res["run_default_warm_vs_reference"] = res["run_default_warm_s"] / res["reference_s"]
     res["run_default_warm_vs_reference_cpu"] = res["run_default_warm_cpu_s"] / res["reference_cpu_s"]
     load = os.getloadavg() if hasattr(os, "getloadavg") else None
