@@ -100,3 +100,26 @@ def test_a_module_whose_source_cannot_be_read_makes_the_kernel_unkeyable(tmp_pat
     (tmp_path / "broken.py").write_bytes(b"x = '\xff\xfe'\n")                # not UTF-8
     monkeypatch.syspath_prepend(str(tmp_path))
     assert source_digests([("ref", "broken:rhs")]) is None                 # -> built in memory
+
+
+def test_an_installed_package_that_provides_the_kernel_is_followed_and_no_other(tmp_path, monkeypatch):
+    """A ship kernel from an installed package: its upgrade changes its files, so they are
+    followed (within that package); numpy, numba and the standard library are not."""
+    from steerlab import kernel_sources
+
+    site = tmp_path / "site-packages"
+    (site / "shipkit").mkdir(parents=True)
+    (site / "shipkit" / "__init__.py").write_text("")
+    (site / "shipkit" / "model.py").write_text("import math\nimport numpy as np\nfrom .coefficients import N_R\n")
+    (site / "shipkit" / "coefficients.py").write_text("N_R = -0.05\n")
+    monkeypatch.syspath_prepend(str(site))
+    kernel_sources._installed_roots.cache_clear()
+    try:
+        assert str(site.resolve()) in kernel_sources._installed_roots()
+        digests = dict(source_digests([("ref", "shipkit.model:rhs"), ("ref", "steerlab.control.pid:pid_update")]))
+        assert sorted(digests) == ["shipkit", "shipkit.coefficients", "shipkit.model"]
+        (site / "shipkit" / "coefficients.py").write_text("N_R = -0.06\n")        # "an upgrade"
+        assert dict(source_digests([("ref", "shipkit.model:rhs")]))["shipkit.coefficients"] != \
+            digests["shipkit.coefficients"]
+    finally:
+        kernel_sources._installed_roots.cache_clear()

@@ -8,13 +8,14 @@ and ran again was served the machine code of the old equation, with the old numb
 word (numba's own cache has the same blind spot for the functions a cached function calls).
 
 :func:`source_digests` lists, for every kernel a reference names outside steerlab, the
-contents' digest of its module's file and of every module of the same project that module
-imports (followed through their imports, read from the source with :mod:`ast`). A driver
+contents' digest of its module's file, of its parent packages' and of every module of the same
+project that module imports (followed through their imports, read from the source with
+:mod:`ast`). A driver
 writes them into its text, so an edit to any of them gives another driver, compiled afresh;
 steerlab's own kernels add nothing (the fingerprint directory covers them), so the drivers of
-steerlab's catalogue are unchanged. Installed packages (``site-packages``, the standard
-library) are not followed: their files change with their version, on an upgrade, after which
-``steerlab cache clear`` drops the old machine code.
+steerlab's catalogue are unchanged. An installed package (``site-packages``) is followed when
+it provides one of the kernels (an upgrade changes its files); the others (numpy, numba, the
+standard library, ...) are not.
 
 A module whose source cannot be read (a compiled extension, a zip import) makes the kernel
 unkeyable: :func:`source_digests` returns None and the driver is built in memory, never from a
@@ -62,31 +63,40 @@ def _origin(spec) -> Optional[str]:
     return locations[0] if locations else None
 
 
-def _outside_the_project(path: Path) -> bool:
-    """steerlab itself (the fingerprint covers it) or installed code (not followed)."""
+def _steerlab(path: Path) -> bool:
     try:
         path.relative_to(PACKAGE_ROOT)
         return True
     except ValueError:
-        return str(path).startswith(_installed_roots())
+        return False
 
 
-def _project_file(module: str) -> Optional[Path]:
-    """The source file of ``module`` when it is a user's (not steerlab, not installed, not
-    built in); None otherwise. Never imports an installed package to find out."""
+def _followed(path: Path, top: str, own: frozenset) -> bool:
+    """Whether a module's file is followed: not steerlab's (the fingerprint covers it), and
+    either not installed, or of an installed package that provides one of the kernels
+    (``own``: the top-level packages of the kernels' modules; an upgrade of such a package
+    changes its files)."""
+    if _steerlab(path):
+        return False
+    return top in own or not str(path).startswith(_installed_roots())
+
+
+def _project_file(module: str, own: frozenset = frozenset()) -> Optional[Path]:
+    """The source file of ``module`` when it is followed (:func:`_followed`); None otherwise.
+    Never imports a package that is not followed to find out."""
+    top = module.partition(".")[0]
     loaded = sys.modules.get(module)
     if loaded is not None:
         origin = getattr(loaded, "__file__", None)
     else:
-        top = module.partition(".")[0]
         top_origin = _origin(_spec(top))                   # a top-level name: nothing imported
-        if top_origin is None or _outside_the_project(Path(top_origin).resolve()):
+        if top_origin is None or not _followed(Path(top_origin).resolve(), top, own):
             return None
         origin = top_origin if top == module else _origin(_spec(module))
     if not origin:
         return None
     path = Path(origin).resolve()
-    return None if _outside_the_project(path) or path.suffix != ".py" else path
+    return path if path.suffix == ".py" and _followed(path, top, own) else None
 
 
 def _imports(path: Path, module: str, text: str) -> set[str]:
@@ -130,11 +140,12 @@ def source_digests(refs) -> Optional[list[tuple[str, str]]]:
     kernels; None when a user module's source cannot be read."""
     seen: dict[str, str] = {}
     todo = [m for kref in refs for m in _module_of_ref(kref)]
+    own = frozenset(m.partition(".")[0] for m in todo) - {"steerlab"}
     while todo:
         module = todo.pop()
         if module in seen:
             continue
-        path = _project_file(module)
+        path = _project_file(module, own)
         if path is None:
             seen[module] = ""
             continue
@@ -145,5 +156,6 @@ def source_digests(refs) -> Optional[list[tuple[str, str]]]:
         except (OSError, UnicodeDecodeError, SyntaxError, ValueError):
             return None
         seen[module] = hashlib.sha256(data).hexdigest()[:16]
-        todo += sorted(imported - seen.keys())
+        parents = {module.rsplit(".", k)[0] for k in range(1, module.count(".") + 1)}   # run on import
+        todo += sorted((imported | parents) - seen.keys())
     return sorted((m, d) for m, d in seen.items() if d)
