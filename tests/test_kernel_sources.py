@@ -123,3 +123,59 @@ def test_an_installed_package_that_provides_the_kernel_is_followed_and_no_other(
             digests["shipkit.coefficients"]
     finally:
         kernel_sources._installed_roots.cache_clear()
+
+
+def test_cache_clear_stale_drops_the_drivers_of_edited_code_and_keeps_the_rest(tmp_path, monkeypatch):
+    """``steerlab cache clear --stale``: after an edit, the drivers compiled from the old source
+    will never load again; they go, with their machine code; a driver of unchanged code, of
+    steerlab's own kernels, or of a module this process cannot find stays."""
+    from steerlab.control.pid import pid_update
+    from steerlab.ships.nomoto1 import nomoto1_rhs
+    from steerlab.sim import drivers
+
+    project = _project(tmp_path / "project", "1.0")
+    monkeypatch.setenv("STEERLAB_CACHE_DIR", str(tmp_path / "cache"))
+    monkeypatch.delenv("STEERLAB_DRIVER_CACHE", raising=False)
+    monkeypatch.syspath_prepend(str(project))
+    for name in ("usership", "helpers"):                   # this test's modules, not another's
+        sys.modules.pop(name, None)
+    try:
+        _clear_stale_checks(project, drivers, pid_update, nomoto1_rhs)
+    finally:
+        for name in ("usership", "helpers"):
+            sys.modules.pop(name, None)
+
+
+def _clear_stale_checks(project, drivers, pid_update, nomoto1_rhs):
+    import usership
+
+    user = drivers.driver(usership.rhs, pid_update, None, 7)          # written, not compiled
+    own = drivers.driver(nomoto1_rhs, pid_update, None, 7)
+    here = drivers.drivers_dir()
+    away = here / "d_0123456789abcdef0123.py"                         # another project's driver
+    away.write_text(drivers.SOURCE_LINE.format(module="not_on_this_path", digest="0" * 16) + "\n")
+    user_file = Path(user.__file__)
+    (here / "__pycache__").mkdir(exist_ok=True)
+    machine_code = here / "__pycache__" / f"{user_file.stem}.run-1.py311.nbi"
+    machine_code.write_bytes(b"index")
+    assert drivers.cache_clear(stale_only=True) == 0                  # nothing edited yet
+    (project / "helpers.py").write_text(HELPERS.format(gain="2.0"))
+    assert drivers.cache_clear(stale_only=True) > 0
+    assert not user_file.exists() and not machine_code.exists()
+    assert Path(own.__file__).exists() and away.exists()
+
+
+def test_finding_the_sources_imports_nothing(tmp_path, monkeypatch):
+    """Reading which files a kernel is compiled from never runs the user's code (``from X import
+    y`` once imported X to learn whether y is a submodule)."""
+    project = _project(tmp_path / "q", "1.0")
+    (project / "usership.py").write_text(SHIP.replace("from helpers import gain", "from helpers import gain\n"
+                                                                                   "from pkgq.sub import thing"))
+    (project / "pkgq").mkdir()
+    (project / "pkgq" / "__init__.py").write_text("raise RuntimeError('imported')\n")
+    (project / "pkgq" / "sub.py").write_text("thing = 1\n")
+    monkeypatch.syspath_prepend(str(project))
+    before = set(sys.modules)
+    names = [m for m, _ in source_digests([("ref", "usership:rhs")])]
+    assert names == ["helpers", "pkgq", "pkgq.sub", "usership"]
+    assert not {"helpers", "pkgq", "pkgq.sub", "usership"} & (set(sys.modules) - before)

@@ -26,7 +26,9 @@ from __future__ import annotations
 
 import ast
 import hashlib
+import importlib.machinery
 import importlib.util
+import re
 import sys
 import sysconfig
 from functools import lru_cache
@@ -46,11 +48,22 @@ def _installed_roots() -> tuple[str, ...]:
 
 
 def _spec(name: str):
-    """``importlib.util.find_spec(name)``, or None when it cannot be found (a dotted name's
-    parents are imported to find it: only asked of a user's own packages)."""
+    """The module spec of ``name`` without importing anything: a top-level name through the
+    import system's finders (which import nothing for it), a submodule through its parent
+    package's folders; None when there is no such module (``from X import function``)."""
+    loaded = sys.modules.get(name)
+    if loaded is not None:
+        return getattr(loaded, "__spec__", None)
+    top, _, rest = name.partition(".")
     try:
-        return importlib.util.find_spec(name)
-    except Exception:  # noqa: BLE001 - a name that is no module (``from X import function``)
+        spec = importlib.util.find_spec(top)
+        for part in rest.split(".") if rest else ():
+            locations = list(spec.submodule_search_locations or []) if spec is not None else []
+            if not locations:
+                return None                                # a plain module has no submodules
+            spec = importlib.machinery.PathFinder.find_spec(f"{spec.name}.{part}", locations)
+        return spec
+    except Exception:  # noqa: BLE001 - a name that cannot be looked up is no module of the project
         return None
 
 
@@ -83,13 +96,13 @@ def _followed(path: Path, top: str, own: frozenset) -> bool:
 
 def _project_file(module: str, own: frozenset = frozenset()) -> Optional[Path]:
     """The source file of ``module`` when it is followed (:func:`_followed`); None otherwise.
-    Never imports a package that is not followed to find out."""
+    Imports nothing to find out (:func:`_spec`)."""
     top = module.partition(".")[0]
     loaded = sys.modules.get(module)
     if loaded is not None:
         origin = getattr(loaded, "__file__", None)
     else:
-        top_origin = _origin(_spec(top))                   # a top-level name: nothing imported
+        top_origin = _origin(_spec(top))
         if top_origin is None or not _followed(Path(top_origin).resolve(), top, own):
             return None
         origin = top_origin if top == module else _origin(_spec(module))
@@ -159,3 +172,26 @@ def source_digests(refs) -> Optional[list[tuple[str, str]]]:
         parents = {module.rsplit(".", k)[0] for k in range(1, module.count(".") + 1)}   # run on import
         todo += sorted((imported | parents) - seen.keys())
     return sorted((m, d) for m, d in seen.items() if d)
+
+
+#: how a driver's text records one of them (:func:`steerlab.sim.drivers._bindings` writes it)
+LINE = "# compiled from {module} (sha256 {digest})"
+_LINE = re.compile(r"^# compiled from (\S+) \(sha256 ([0-9a-f]{16})\)$", re.M)
+
+
+def outdated(driver_text: str) -> bool:
+    """Whether a generated driver was compiled from a user source file that has changed since
+    (a recorded module whose file is found now with other contents). A module that cannot be
+    found from this process (another project, a plug-in not on ``sys.path``) does not count:
+    its driver is kept."""
+    for module, digest in _LINE.findall(driver_text):
+        path = _project_file(module, frozenset({module.partition(".")[0]}))
+        if path is None:
+            continue
+        try:
+            now = hashlib.sha256(path.read_bytes()).hexdigest()[:16]
+        except OSError:
+            continue
+        if now != digest:
+            return True
+    return False

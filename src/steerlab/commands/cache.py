@@ -5,7 +5,7 @@ the cache (:mod:`steerlab.sim.drivers`), so later processes load it in milliseco
 ``warm`` compiles the common catalogue combinations ahead of time (e.g. once per CI run,
 or after installing steerlab), and on request the ships' plant steps and trial loops, the
 combinations of scenario files and the Gymnasium environments; ``clear`` deletes the cache (``--stale`` only the entries of
-other steerlab versions).
+other steerlab versions, and the drivers compiled from plug-in code that has been edited since).
 """
 
 from __future__ import annotations
@@ -20,7 +20,7 @@ EXAMPLES = """examples:
   steerlab cache warm --gym           # also the Gymnasium environments' step and reset
   steerlab cache warm --ships all --controllers pid --plants --trials   # + plant steps, trials
   steerlab cache warm --scenario examples/scenarios/los-route.toml --batch   # what a file uses
-  steerlab cache clear --stale        # drop the entries of other steerlab versions
+  steerlab cache clear --stale        # drop the entries of other steerlab versions and of edited plug-ins
   STEERLAB_CACHE_DIR=/tmp/slc steerlab cache info"""
 
 COMMON_SHIPS = ("esso", "nomoto1", "de-keizer", "kosoko")
@@ -32,7 +32,9 @@ def register(sub, formatter_class):
                        description=__doc__.split("\n\n", 1)[1], epilog=EXAMPLES,
                        formatter_class=formatter_class)
     p.add_argument("action", choices=("info", "clear", "warm"))
-    p.add_argument("--stale", action="store_true", help="clear: only other steerlab versions' entries")
+    p.add_argument("--stale", action="store_true",
+                   help="clear: only what will not load again: other steerlab versions' entries, "
+                        "and drivers compiled from plug-in code edited since")
     p.add_argument("--ships", nargs="+", default=None, metavar="ID",
                    help=f"warm: ship ids, or 'all' (default: {' '.join(COMMON_SHIPS)})")
     p.add_argument("--controllers", nargs="+", default=list(COMMON_CONTROLLERS), metavar="TYPE",

@@ -55,7 +55,8 @@ from pathlib import Path
 from typing import Callable, Optional
 
 from steerlab.kernel_refs import describe, kernel_ref
-from steerlab.kernel_sources import source_digests
+from steerlab.kernel_sources import LINE as SOURCE_LINE
+from steerlab.kernel_sources import outdated, source_digests
 from steerlab.numba_cache import _fingerprint
 
 TEMPLATE = Path(__file__).with_name("driver_template.py")
@@ -128,7 +129,7 @@ def _bindings(refs: dict, nx: int, lanes: int, cache: bool, sources=()) -> str:
     lines = [BEGIN, "from steerlab.kernel_refs import resolve as _resolve"]
     for name in ("SHIP_RHS", "CTRL_UPDATE", "GUIDE"):
         lines.append(f"{name} = _resolve({refs[name]!r})")
-    lines += [f"# compiled from {module} (sha256 {digest})" for module, digest in sources]
+    lines += [SOURCE_LINE.format(module=module, digest=digest) for module, digest in sources]
     lines += [f"NX = {int(nx)}", f"LANES = {int(lanes)}", f"CACHE = {bool(cache)}", END]
     return "\n".join(lines)
 
@@ -331,7 +332,10 @@ def cache_info() -> dict:
 
 
 def cache_clear(stale_only: bool = False) -> int:
-    """Delete the driver cache (or only other steerlab versions'); returns bytes freed."""
+    """Delete the driver cache, or (``stale_only``) what no process will load again: other
+    steerlab versions' directories and, in this version's, the drivers compiled from a user
+    source file that has changed since (:func:`steerlab.kernel_sources.outdated`); returns
+    bytes freed."""
     root = cache_root() / "drivers"
     if not root.exists():
         return 0
@@ -339,9 +343,30 @@ def cache_clear(stale_only: bool = False) -> int:
     freed = 0
     for p in root.iterdir():
         if stale_only and p == here:
+            freed += _clear_outdated(here)
             continue
         freed += sum(f.stat().st_size for f in p.rglob("*") if f.is_file())
         shutil.rmtree(p, ignore_errors=True)
     with _LOCK:
         _LOADED.clear()
+    return freed
+
+
+def _clear_outdated(here: Path) -> int:
+    """Delete the drivers of ``here`` compiled from changed user sources, with their machine
+    code and kept reports; returns bytes freed."""
+    freed = 0
+    for module in here.glob("d_*.py"):
+        try:
+            if not outdated(module.read_text(encoding="utf-8", errors="replace")):
+                continue
+        except OSError:
+            continue
+        for f in [module, *here.glob(f"{module.stem}.*"), *(here / "__pycache__").glob(f"{module.stem}.*")]:
+            try:
+                size = f.stat().st_size
+                f.unlink()
+                freed += size
+            except OSError:
+                pass
     return freed
