@@ -159,8 +159,11 @@ def _clear_stale_checks(project, drivers, pid_update, nomoto1_rhs):
     machine_code = here / "__pycache__" / f"{user_file.stem}.run-1.py311.nbi"
     machine_code.write_bytes(b"index")
     assert drivers.cache_clear(stale_only=True) == 0                  # nothing edited yet
+    assert drivers.cache_info()["outdated_drivers"] == 0
     (project / "helpers.py").write_text(HELPERS.format(gain="2.0"))
-    assert drivers.cache_clear(stale_only=True) > 0
+    info = drivers.cache_info()                                       # what `steerlab cache info` says
+    assert info["outdated_drivers"] == 1 and info["outdated_bytes"] > user_file.stat().st_size
+    assert drivers.cache_clear(stale_only=True) == info["outdated_bytes"]
     assert not user_file.exists() and not machine_code.exists()
     assert Path(own.__file__).exists() and away.exists()
 

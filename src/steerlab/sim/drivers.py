@@ -323,10 +323,13 @@ def cache_info() -> dict:
     def size(p: Path) -> int:
         return sum(f.stat().st_size for f in p.rglob("*") if f.is_file())
 
+    outdated_files = _outdated_files(here) if here.exists() else []
     return {"root": str(root), "current": str(here),
             "drivers": len(list(here.glob("d_*.py"))) if here.exists() else 0,
             "compiled_files": len(list((here / "__pycache__").glob("*.nbc"))) if here.exists() else 0,
             "bytes": size(here) if here.exists() else 0,
+            "outdated_drivers": sum(f.parent == here and f.name.endswith(".py") for f in outdated_files),
+            "outdated_bytes": sum(f.stat().st_size for f in outdated_files if f.exists()),
             "stale_versions": [p.name for p in dirs if p != here],
             "stale_bytes": sum(size(p) for p in dirs if p != here)}
 
@@ -352,21 +355,30 @@ def cache_clear(stale_only: bool = False) -> int:
     return freed
 
 
-def _clear_outdated(here: Path) -> int:
-    """Delete the drivers of ``here`` compiled from changed user sources, with their machine
-    code and kept reports; returns bytes freed."""
-    freed = 0
+def _outdated_files(here: Path) -> list[Path]:
+    """The files of the drivers of ``here`` compiled from user sources that have changed since
+    (:func:`steerlab.kernel_sources.outdated`): each module, its kept reports, its machine code."""
+    files: list[Path] = []
     for module in here.glob("d_*.py"):
         try:
             if not outdated(module.read_text(encoding="utf-8", errors="replace")):
                 continue
         except OSError:
             continue
-        for f in [module, *here.glob(f"{module.stem}.*"), *(here / "__pycache__").glob(f"{module.stem}.*")]:
-            try:
-                size = f.stat().st_size
-                f.unlink()
-                freed += size
-            except OSError:
-                pass
+        files += [module, *(f for f in here.glob(f"{module.stem}.*") if f != module),
+                  *(here / "__pycache__").glob(f"{module.stem}.*")]
+    return files
+
+
+def _clear_outdated(here: Path) -> int:
+    """Delete the drivers of ``here`` compiled from changed user sources, with their machine
+    code and kept reports; returns bytes freed."""
+    freed = 0
+    for f in _outdated_files(here):
+        try:
+            size = f.stat().st_size
+            f.unlink()
+            freed += size
+        except OSError:
+            pass
     return freed
