@@ -166,8 +166,8 @@ def source_digests(refs) -> Optional[list[tuple[str, str]]]:
             data = path.read_bytes()
             text = data.decode("utf-8")
             imported = _imports(path, module, text)
-        except (OSError, UnicodeDecodeError, SyntaxError, ValueError):
-            return None
+        except (OSError, UnicodeDecodeError, SyntaxError, ValueError, RecursionError):
+            return None                                   # unkeyable: the driver is built in memory
         seen[module] = hashlib.sha256(data).hexdigest()[:16]
         parents = {module.rsplit(".", k)[0] for k in range(1, module.count(".") + 1)}   # run on import
         todo += sorted((imported | parents) - seen.keys())
