@@ -78,8 +78,8 @@ def run(args) -> int:
                 ("this steerlab", info["current"]),
                 ("drivers", f"{info['drivers']} ({info['compiled_files']} compiled entry points, "
                             f"{_mb(info['bytes'])})"),
-                ("edited plug-ins", f"{info['outdated_drivers']} drivers of code edited since "
-                                    f"({_mb(info['outdated_bytes'])}; never loaded again)"),
+                ("edited plug-ins", f"{info['outdated_drivers']} (drivers of code edited since, "
+                                    f"{_mb(info['outdated_bytes'])}; never loaded again)"),
                 ("other versions", f"{len(info['stale_versions'])} ({_mb(info['stale_bytes'])}; "
                                    "'steerlab cache clear --stale' removes them and those above)")]))
         return 0
