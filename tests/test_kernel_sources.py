@@ -10,6 +10,8 @@ import sys
 import textwrap
 from pathlib import Path
 
+import pytest
+
 from steerlab.kernel_sources import source_digests
 
 SRC = Path(__file__).resolve().parent.parent / "src"
@@ -125,7 +127,19 @@ def test_an_installed_package_that_provides_the_kernel_is_followed_and_no_other(
         kernel_sources._installed_roots.cache_clear()
 
 
-def test_cache_clear_stale_drops_the_drivers_of_edited_code_and_keeps_the_rest(tmp_path, monkeypatch):
+@pytest.fixture
+def own_user_modules():
+    """``usership`` and ``helpers`` imported by the test from its own project, not another
+    test's: dropped from ``sys.modules`` before and after."""
+    for name in ("usership", "helpers"):
+        sys.modules.pop(name, None)
+    yield
+    for name in ("usership", "helpers"):
+        sys.modules.pop(name, None)
+
+
+def test_cache_clear_stale_drops_the_drivers_of_edited_code_and_keeps_the_rest(tmp_path, monkeypatch,
+                                                                                 own_user_modules):
     """``steerlab cache clear --stale``: after an edit, the drivers compiled from the old source
     will never load again; they go, with their machine code; a driver of unchanged code, of
     steerlab's own kernels, or of a module this process cannot find stays."""
@@ -137,16 +151,6 @@ def test_cache_clear_stale_drops_the_drivers_of_edited_code_and_keeps_the_rest(t
     monkeypatch.setenv("STEERLAB_CACHE_DIR", str(tmp_path / "cache"))
     monkeypatch.delenv("STEERLAB_DRIVER_CACHE", raising=False)
     monkeypatch.syspath_prepend(str(project))
-    for name in ("usership", "helpers"):                   # this test's modules, not another's
-        sys.modules.pop(name, None)
-    try:
-        _clear_stale_checks(project, drivers, pid_update, nomoto1_rhs)
-    finally:
-        for name in ("usership", "helpers"):
-            sys.modules.pop(name, None)
-
-
-def _clear_stale_checks(project, drivers, pid_update, nomoto1_rhs):
     import usership
 
     user = drivers.driver(usership.rhs, pid_update, None, 7)          # written, not compiled
