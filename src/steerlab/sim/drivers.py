@@ -24,9 +24,10 @@ Cache layout and guarantees
   once both succeed (each compiles; the last rename wins; both results are identical).
 * **A user's edited kernel is compiled afresh.** A kernel of a plug-in or of the user's own
   package is named in the module by reference, and the module's text also carries the digest
-  of every user source file that kernel is compiled from (its module and the project modules
-  it imports: :mod:`steerlab.kernel_sources`): an edit to any of them gives another module,
-  never the old machine code.
+  of every user source file that kernel is compiled from (its module, its parent packages and
+  the project modules it imports: :mod:`steerlab.kernel_sources`): an edit to any of them
+  gives another module, never the old machine code; ``steerlab cache clear --stale`` drops
+  the modules of code edited since.
 * **Corrupt entries are rebuilt.** Before the first use in a process, the driver's module
   text and numba's index and data files are read back; a truncated or unreadable file is
   deleted and the driver recompiled, never a crash.
