@@ -27,7 +27,7 @@ an autoreset round costs).
 Threads: the native env spreads a step (and a reset) of ``THREADS_FROM`` = 512 ships or more
 over ``numba.get_num_threads()`` threads (the cores, or ``--threads``) with numba's
 ``prange`` (:meth:`steerlab.gym.episodes.Episodes.step_autoreset`) on the threading layer
-steerlab asks for (:mod:`steerlab.threading_layer`: TBB, else workqueue, unless
+steerlab asks for (:mod:`steerlab.jit.threading_layer`: TBB, else workqueue, unless
 ``NUMBA_THREADING_LAYER`` says otherwise; ``layer`` in the output); ``threads`` in the table
 is the number it used at that N (1 below 512, and on workqueue, where threads do not pay).
 ``SyncVectorEnv`` steps its envs one after the other in one thread. So the **wall** ratio is
@@ -123,7 +123,7 @@ def main(argv=None) -> int:
     a = ap.parse_args(argv)
     import numba
 
-    from steerlab.threading_layer import num_threads
+    from steerlab.jit.threading_layer import num_threads
 
     num_threads()                        # numba's threads on steerlab's layer, before set_num_threads
     if a.threads is not None:

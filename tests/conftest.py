@@ -14,7 +14,7 @@ from pathlib import Path
 
 import pytest
 
-# numpy's OpenBLAS on one thread, as in the steerlab command (steerlab.blas_threads): the commands
+# numpy's OpenBLAS on one thread, as in the steerlab command (steerlab.jit.blas_threads): the commands
 # the tests run in this process fork (figure children, pools), and OpenBLAS restarts its
 # busy-waiting threads after every fork (7-8 % of the CPU of the command tests, measured
 # alternately under pytest-xdist). Set before numpy is first imported (the line below); a value
@@ -85,7 +85,7 @@ def batch_parity_and_vectorisation(setup):
 
 def unnamed_ship(rhs):
     """A ship kernel that calls ``rhs`` from a closure: the same numbers, but no importable name
-    (:func:`steerlab.kernel_refs.kernel_ref` gives None), so drivers are built in memory."""
+    (:func:`steerlab.jit.kernel_refs.kernel_ref` gives None), so drivers are built in memory."""
     import numba
 
     @numba.njit

@@ -1,4 +1,4 @@
-"""The ``steerlab`` command runs numpy's OpenBLAS on one thread (:mod:`steerlab.blas_threads`);
+"""The ``steerlab`` command runs numpy's OpenBLAS on one thread (:mod:`steerlab.jit.blas_threads`);
 a user's own program that imports steerlab keeps numpy's threads, and a user's setting wins."""
 
 from __future__ import annotations
@@ -12,7 +12,7 @@ from pathlib import Path
 
 import pytest
 
-from steerlab.blas_threads import is_command_process
+from steerlab.jit.blas_threads import is_command_process
 
 SRC = Path(__file__).resolve().parent.parent / "src"
 #: a plug-in file (STEERLAB_PLUGINS) that reports, from inside the command's process, the

@@ -211,7 +211,7 @@ print(json.dumps({"u": u.tolist(), "hits": sum(run.stats.cache_hits.values()),
 
 def test_the_vector_step_is_loaded_by_a_fresh_process_instead_of_compiled(tmp_path):
     """``Controller.vector`` steps through a generated driver module
-    (``sim/controller_step_template.py``): the first process compiles and saves its
+    (``jit/controller_step_template.py``): the first process compiles and saves its
     step, the next one loads it, with the same orders."""
     import json
     import os

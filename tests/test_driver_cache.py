@@ -1,4 +1,4 @@
-"""Compiled drivers cached across processes (steerlab.sim.drivers): loaded, never stale,
+"""Compiled drivers cached across processes (steerlab.jit.drivers): loaded, never stale,
 safe under concurrent writers, rebuilt when corrupt; kernels named for a fresh process."""
 
 from __future__ import annotations
@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from steerlab import kernel_refs
+from steerlab.jit import kernel_refs
 from steerlab.control.registry import get_controller
 from steerlab.control.wave_filtered import wave_filtered
 from steerlab.sensors.wrapper import sensed_spec
@@ -25,7 +25,7 @@ SRC = Path(__file__).resolve().parent.parent / "src"
 SCRIPT = textwrap.dedent("""
     import json, sys
     from steerlab.guidance.reference_models import course_guide
-    from steerlab.sim import drivers
+    from steerlab.jit import drivers
     from steerlab.sim.engine import simulate
     from steerlab.sim.scenario import scenario_from_dict
     from steerlab.sim.setup import build
@@ -145,7 +145,7 @@ def test_kernels_that_cannot_be_named_run_from_an_in_memory_driver(tmp_path, mon
     and gives the same numbers as the named kernel through the cached driver."""
     from conftest import make_scenario, unnamed_ship
 
-    from steerlab.sim import drivers
+    from steerlab.jit import drivers
     from steerlab.sim.engine import simulate
     from steerlab.sim.setup import build
 
@@ -162,8 +162,8 @@ def test_kernels_that_cannot_be_named_run_from_an_in_memory_driver(tmp_path, mon
 
 UNPICKLE = textwrap.dedent("""
     import json, pickle, sys
-    from steerlab.kernel_refs import kernel_ref
-    from steerlab.sim.drivers import driver
+    from steerlab.jit.kernel_refs import kernel_ref
+    from steerlab.jit.drivers import driver
     import kmod
     rhs, upd = pickle.loads(open(sys.argv[1], "rb").read())
     mod = driver(rhs, upd, None, 7)

@@ -186,7 +186,7 @@ def _in_process(argv, workdir):
     import os
 
     from steerlab.cli import main
-    from steerlab.sim import drivers
+    from steerlab.jit import drivers
 
     out, err = io.StringIO(), io.StringIO()
     cwd, on_compile = os.getcwd(), drivers.on_compile

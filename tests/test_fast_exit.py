@@ -1,4 +1,4 @@
-"""A finished ``steerlab run`` skips the interpreter's teardown (steerlab.fast_exit): the same
+"""A finished ``steerlab run`` skips the interpreter's teardown (steerlab.jit.fast_exit): the same
 files, output and exit codes as the normal way out, atexit handlers still run; never under a
 tracer, with another thread, or when switched off."""
 
@@ -9,7 +9,7 @@ import subprocess
 import sys
 import threading
 
-from steerlab import fast_exit
+from steerlab.jit import fast_exit
 
 # a plug-in module (STEERLAB_PLUGINS) that watches the way out: an atexit handler, and an object
 # whose finaliser only the interpreter's teardown runs

@@ -1,6 +1,6 @@
 """The Gymnasium environments' compiled step and reset are compiled once ever (issues 13/14):
-generated from :mod:`steerlab.gym.env_template` into the driver cache like the engines'
-drivers (:mod:`steerlab.sim.drivers`), loaded by a fresh process instead of compiled, with the
+generated from :mod:`steerlab.jit.env_template` into the driver cache like the engines'
+drivers (:mod:`steerlab.jit.drivers`), loaded by a fresh process instead of compiled, with the
 same numbers; kernels that cannot be named get the same module built in memory."""
 
 from __future__ import annotations
@@ -84,7 +84,7 @@ def _seed_without_the_env_module(cache: Path) -> int:
     that module and nothing else the test does not need (the Esso + PID loops, the route
     task's module, ...). Returns how many modules were left out (0 if the suite's cache had
     none: then it is compiled anyway)."""
-    from steerlab.sim import drivers
+    from steerlab.jit import drivers
 
     source = drivers.drivers_dir()
     if not source.is_dir():
@@ -136,7 +136,7 @@ def test_kernels_that_cannot_be_named_step_and_reset_from_an_in_memory_module():
     the cache the rest of the suite uses, which ``.ci/warm-cache`` fills)."""
     from conftest import unnamed_ship
 
-    from steerlab import kernel_refs
+    from steerlab.jit import kernel_refs
     from steerlab.gym.episodes import Episodes
     from steerlab.gym.plant_batch import env_kernels
 

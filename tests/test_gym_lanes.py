@@ -123,7 +123,7 @@ def test_plain_seas_are_the_scenario_wave_model_driven_by_each_lanes_philox_norm
     from steerlab.environment.disturbance import N_CHANNELS, W_RUDDER, _fill
     from steerlab.environment.iir_filter import _padded
     from steerlab.environment.waves import band_pass_eq39
-    from steerlab.gym.philox import seed_key
+    from steerlab.jit.philox import seed_key
     from steerlab.sim.setup import realise
 
     venv = _vec("steerlab/CourseKeeping-v0", n=5, environment={"waves": True, "current_speed": 0.4,
@@ -167,7 +167,7 @@ def _ziggurat_normals(k0, k1, episode, n):
     (b, episode, 1, 0), b = 0, 1, ...)."""
     import math
 
-    from steerlab.gym.philox import _FI, _KI, _WI, ZIG_R
+    from steerlab.jit.philox import _FI, _KI, _WI, ZIG_R
 
     c = (episode << 64) + (1 << 128) - 1                  # numpy increments the counter before a block
     bg = np.random.Philox(key=np.array([k0, k1], dtype=np.uint64),
@@ -193,7 +193,7 @@ def _ziggurat_normals(k0, k1, episode, n):
 
 
 def test_the_lane_normals_are_standard_normal():
-    from steerlab.gym.philox import normals
+    from steerlab.jit.philox import normals
 
     import math
 
@@ -238,7 +238,7 @@ def test_build_disturbances_equals_build_disturbance_per_seed():
 
 
 def test_philox_blocks_equal_numpys_philox():
-    from steerlab.gym.philox import philox4x64
+    from steerlab.jit.philox import philox4x64
 
     out = np.empty(4, dtype=np.uint64)
     for key, ctr in (((0, 0), (1, 0, 0, 0)), ((123, 2**64 - 1), (5, 7, 1, 0)), ((2**63 + 11, 9), (0, 3, 0, 2**64 - 1))):

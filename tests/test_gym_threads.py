@@ -1,5 +1,5 @@
 """The vector environment's threaded step on numba's threads (``step_parallel``, ``prange``) and the
-process-wide threading layer steerlab asks for (:mod:`steerlab.threading_layer`): fork-safe, a
+process-wide threading layer steerlab asks for (:mod:`steerlab.jit.threading_layer`): fork-safe, a
 forked child steps its own environments; steerlab's parallel calls from several Python threads
 take turns; a user's explicit layer is kept. Each case runs in a fresh interpreter (the layer is
 chosen once per process, and a wrong one aborts the process)."""
@@ -79,7 +79,7 @@ LAYER = textwrap.dedent("""
     if len(sys.argv) > 1:
         numba.config.THREADING_LAYER = sys.argv[1]     # chosen in code before importing steerlab
     import steerlab
-    from steerlab.threading_layer import num_threads, tbb_library, threads_pay
+    from steerlab.jit.threading_layer import num_threads, tbb_library, threads_pay
     num_threads()                                      # starts numba's threads, as steerlab does
     print(json.dumps({"layer": numba.threading_layer(), "config": numba.config.THREADING_LAYER,
                       "tbb": tbb_library() is not None, "pay": threads_pay()}))
@@ -133,7 +133,7 @@ def test_the_vector_env_threads_only_where_threads_pay(monkeypatch):
     """From THREADS_FROM ships numba's threads, unless the layer is one where a threaded step is
     slower than one call (workqueue); an explicit ``threads`` is kept either way."""
     from steerlab.gym import episodes
-    from steerlab.threading_layer import num_threads
+    from steerlab.jit.threading_layer import num_threads
 
     core = episodes.Episodes(2, episode_s=4.0, vectorised=True)
     big = episodes.THREADS_FROM

@@ -1,4 +1,4 @@
-"""A user's edited kernel is never served from the driver cache as it was (steerlab.kernel_sources):
+"""A user's edited kernel is never served from the driver cache as it was (steerlab.jit.kernel_sources):
 the drivers' text carries the digests of the user source files their kernels are compiled from."""
 
 from __future__ import annotations
@@ -12,7 +12,7 @@ from pathlib import Path
 
 import pytest
 
-from steerlab.kernel_sources import source_digests
+from steerlab.jit.kernel_sources import source_digests
 
 SRC = Path(__file__).resolve().parent.parent / "src"
 
@@ -36,7 +36,7 @@ STEP = textwrap.dedent("""
     import numpy as np
     import usership
     from steerlab.environment.channels import N_CHANNELS
-    from steerlab.sim.drivers import driver
+    from steerlab.jit.drivers import driver
     mod = driver(usership.rhs, None, None, 7)
     x = np.zeros(7)
     x[5] = 0.1
@@ -107,7 +107,7 @@ def test_a_module_whose_source_cannot_be_read_makes_the_kernel_unkeyable(tmp_pat
 def test_an_installed_package_that_provides_the_kernel_is_followed_and_no_other(tmp_path, monkeypatch):
     """A ship kernel from an installed package: its upgrade changes its files, so they are
     followed (within that package); numpy, numba and the standard library are not."""
-    from steerlab import kernel_sources
+    from steerlab.jit import kernel_sources
 
     site = tmp_path / "site-packages"
     (site / "shipkit").mkdir(parents=True)
@@ -145,7 +145,7 @@ def test_cache_clear_stale_drops_the_drivers_of_edited_code_and_keeps_the_rest(t
     steerlab's own kernels, or of a module this process cannot find stays."""
     from steerlab.control.pid import pid_update
     from steerlab.ships.nomoto1 import nomoto1_rhs
-    from steerlab.sim import drivers
+    from steerlab.jit import drivers
 
     project = _project(tmp_path / "project", "1.0")
     monkeypatch.setenv("STEERLAB_CACHE_DIR", str(tmp_path / "cache"))

@@ -87,7 +87,7 @@ print("ok")
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc/self/maps")
 @pytest.mark.parametrize("script", [BLAS_SCRIPT, BLAS_SCIPY_FIRST_SCRIPT], ids=["numba-uses-blas", "scipy-first"])
 def test_numbas_blas_probe_skips_the_scipy_linalg_import_and_blas_still_works(script):
-    """steerlab.numba_blas_probe: the first kernel call neither imports scipy.linalg (0.16 s)
+    """steerlab.jit.numba_blas_probe: the first kernel call neither imports scipy.linalg (0.16 s)
     nor loads scipy's own BLAS (its threads' start-up spin); numba's BLAS-backed ``@`` loads it
     and gives numpy's result; ``import scipy.linalg`` is whole (``cython_blas`` attribute set
     to the real module), whether numba used BLAS first or not."""

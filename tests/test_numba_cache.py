@@ -1,4 +1,4 @@
-"""steerlab.numba_cache: cached kernels are keyed on the whole package, not one file.
+"""steerlab.jit.numba_cache: cached kernels are keyed on the whole package, not one file.
 
 A kernel bakes in constants of other modules (channel indices ...). Numba alone would keep
 serving a cached kernel whose *own* file did not change; with the package fingerprint in its
@@ -15,7 +15,7 @@ import textwrap
 import numba
 import pytest
 
-from steerlab import numba_cache
+from steerlab.jit import numba_cache
 from steerlab.ships.esso_3dof import esso_rhs
 
 
@@ -60,7 +60,7 @@ def test_a_change_elsewhere_in_steerlab_recompiles_the_cached_kernel(tmp_path):
     script = textwrap.dedent("""
         import sys
         import numpy as np
-        from steerlab import numba_cache
+        from steerlab.jit import numba_cache
         if sys.argv[1] == "other":
             numba_cache._fingerprint.cache_clear()
             numba_cache._fingerprint = lambda: "a changed steerlab"
@@ -85,7 +85,7 @@ def test_a_change_elsewhere_in_steerlab_recompiles_the_cached_kernel(tmp_path):
 
 @pytest.mark.parametrize("value", ["0"])
 def test_can_be_switched_off(value):
-    out = subprocess.run([sys.executable, "-c", "from steerlab import numba_cache; print(numba_cache.INSTALLED)"],
+    out = subprocess.run([sys.executable, "-c", "from steerlab.jit import numba_cache; print(numba_cache.INSTALLED)"],
                          env={**os.environ, "STEERLAB_NUMBA_CACHE_STAMP": value}, capture_output=True,
                          text=True, timeout=120)
     assert out.stdout.strip() == "False"

@@ -1,4 +1,4 @@
-"""Cached kernels load without numba's compile-time registries (steerlab.numba_cache_load), give
+"""Cached kernels load without numba's compile-time registries (steerlab.jit.numba_cache_load), give
 the same numbers, and a later compilation in the same process still gets the registries."""
 
 from __future__ import annotations
@@ -34,7 +34,7 @@ SCRIPT = '''
 import json, sys
 import numpy as np
 import steerlab
-from steerlab import numba_cache_load
+from steerlab.jit import numba_cache_load
 import kmod
 value = kmod.everything(6)
 from steerlab.environment.iir_filter import lfilter

@@ -1,4 +1,4 @@
-"""steerlab.numba_call_at: a compiled caller runs another compiled function through its address
+"""steerlab.jit.numba_call_at: a compiled caller runs another compiled function through its address
 (the gym's threaded step and reset, issues 13/14): the same numbers as a direct call, no copy of
 the callee compiled into the caller, exceptions passed on, and a wrong return type refused."""
 
@@ -8,7 +8,7 @@ import numba
 import numpy as np
 import pytest
 
-from steerlab.numba_call_at import address_of, call_at
+from steerlab.jit.numba_call_at import address_of, call_at
 
 
 @numba.njit

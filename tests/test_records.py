@@ -345,8 +345,8 @@ def test_controllers_guidance_and_loops_read_plant_state_and_reference_by_name()
 
     src = Path(__file__).resolve().parent.parent / "src" / "steerlab"
     paths = [*sorted((src / "control").glob("*.py")), *sorted((src / "guidance").glob("*.py")),
-             src / "sim" / "driver_template.py", src / "trials" / "rate_hold.py",
-             src / "trials" / "zigzag_logic.py", src / "gym" / "env_template.py"]
+             src / "jit" / "driver_template.py", src / "trials" / "rate_hold.py",
+             src / "trials" / "zigzag_logic.py", src / "jit" / "env_template.py"]
     found = [hit for p in paths for hit in _literal_state_or_reference_indices(p)]
     assert not found, found
 

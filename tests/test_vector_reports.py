@@ -11,7 +11,7 @@ import pytest
 from steerlab.guidance.reference_models import course_guide
 from steerlab.sim import vector_reports
 from steerlab.sim.batch import simulate_batch
-from steerlab.sim.drivers import cached_signatures, driver, in_memory_twin
+from steerlab.jit.drivers import cached_signatures, driver, in_memory_twin
 from steerlab.sim.lanes import vectorisation_report
 from steerlab.sim.setup import build
 from steerlab.sim.warm import warm_scenario

@@ -20,19 +20,19 @@ from typing import TYPE_CHECKING, Any
 __version__ = "0.1.0"
 
 # the steerlab command's numpy on one OpenBLAS thread: before numpy is imported (blas_threads)
-from steerlab import blas_threads  # noqa: E402  (isort: skip)
+from steerlab.jit import blas_threads  # noqa: E402  (isort: skip)
 
 blas_threads.one_thread_for_commands()
 # before any kernel is defined: cached kernels are keyed on the whole package, not one file
-from steerlab import numba_cache  # noqa: F401,E402  (isort: skip)
+from steerlab.jit import numba_cache  # noqa: F401,E402  (isort: skip)
 # a cached kernel is loaded without numba's compile-time registries (numba_cache_load)
-from steerlab import numba_cache_load  # noqa: F401,E402  (isort: skip)
+from steerlab.jit import numba_cache_load  # noqa: F401,E402  (isort: skip)
 # numba's first-use BLAS probe without the scipy.linalg package import (numba_blas_probe)
-from steerlab import numba_blas_probe  # noqa: E402  (isort: skip)
+from steerlab.jit import numba_blas_probe  # noqa: E402  (isort: skip)
 
 numba_blas_probe.preload()
 # numba's fork-safe threading layer for the parallel entry points, unless the user chose one
-from steerlab import threading_layer  # noqa: E402  (isort: skip)
+from steerlab.jit import threading_layer  # noqa: E402  (isort: skip)
 
 threading_layer.prefer_fork_safe()
 from steerlab.angles import wrap_to_pi  # noqa: F401

@@ -270,7 +270,7 @@ def main(argv=None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     if not getattr(args, "quiet", False):
-        from steerlab.sim import drivers
+        from steerlab.jit import drivers
 
         drivers.on_compile = _say_compiling
     restore = None
@@ -309,11 +309,11 @@ def main(argv=None) -> int:
 
 def console_main() -> None:
     """The ``steerlab`` command and ``python -m steerlab``: :func:`main`, then the exit (a
-    finished ``run`` skips the interpreter's teardown: :mod:`steerlab.fast_exit`)."""
+    finished ``run`` skips the interpreter's teardown: :mod:`steerlab.jit.fast_exit`)."""
     argv = sys.argv[1:]
     code = main(argv)
     if argv[:1] == ["run"]:
-        from steerlab.fast_exit import exit_now
+        from steerlab.jit.fast_exit import exit_now
 
         exit_now(code)
     sys.exit(code)

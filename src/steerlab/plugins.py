@@ -109,7 +109,7 @@ class PicklesByName:
     plug-in of an entry point or of ``STEERLAB_PLUGINS``, and what is derived from them) pickles
     as that name, and the process that unpickles it (a ``spawn`` multiprocessing child, a Dask
     worker) takes its own: kernels there are module-level ones, which the compiled drivers
-    name and load from the disk cache (:mod:`steerlab.sim.drivers`) instead of compiling them,
+    name and load from the disk cache (:mod:`steerlab.jit.drivers`) instead of compiling them,
     and specs whose functions are closures (a catalogue entry made by a factory, the
     ``"<name>+wf"`` variants) pickle at all. A spec made from another one (``recipe =
     (function, args)``: a controller behind the sensors or the wave filter, a ship's kernel

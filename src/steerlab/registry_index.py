@@ -7,7 +7,7 @@ a run of one controller on one ship does not need. After a full discovery
 of the specs the package's own modules declare (``base``: the spec a derived one, such as
 ``"adrc+wf"``, is made from; ``None`` otherwise) to ``<driver cache>/registry-<package>.json``;
 the driver directory is named after steerlab's package fingerprint
-(:func:`steerlab.sim.drivers.drivers_dir`), so an edited steerlab never reads another
+(:func:`steerlab.jit.drivers.drivers_dir`), so an edited steerlab never reads another
 version's index, and ``steerlab cache clear`` removes it with the drivers.
 
 :meth:`~steerlab.plugins.Registry.get_spec` then imports only the module the index names. A
@@ -33,7 +33,7 @@ def enabled() -> bool:
 
 def index_path(package: str) -> Path:
     """The index file of the registry that scans ``package`` (``"steerlab.control"``)."""
-    from steerlab.sim.drivers import drivers_dir
+    from steerlab.jit.drivers import drivers_dir
 
     return drivers_dir() / f"registry-{package}.json"
 
@@ -49,7 +49,7 @@ def read_index(package: str) -> Optional[dict]:
 
 def write_index(package: str, names: dict) -> None:
     """Store ``name -> (module, base or None)`` atomically (an unwritable cache is ignored)."""
-    from steerlab.disk_memo import store_text
+    from steerlab.jit.disk_memo import store_text
 
     store_text(index_path(package),
                json.dumps({"package": package, "names": {k: list(v) for k, v in sorted(names.items())}}, indent=0))

@@ -1,7 +1,7 @@
 """``steerlab cache info|clear|warm``: the on-disk cache of compiled drivers.
 
 Each (ship, controller, guidance) combination's closed loop is compiled once and kept in
-the cache (:mod:`steerlab.sim.drivers`), so later processes load it in milliseconds.
+the cache (:mod:`steerlab.jit.drivers`), so later processes load it in milliseconds.
 ``warm`` compiles the common catalogue combinations ahead of time (e.g. once per CI run,
 or after installing steerlab), and on request the ships' plant steps and trial loops, the
 combinations of scenario files and the Gymnasium environments; ``clear`` deletes the cache (``--stale`` only the entries of
@@ -62,7 +62,7 @@ def _mb(n: int) -> str:
 
 
 def run(args) -> int:
-    from steerlab.sim import drivers
+    from steerlab.jit import drivers
 
     if args.action == "info":
         info = drivers.cache_info()
@@ -106,7 +106,7 @@ def _lanes(args):
 def _warm(args) -> int:
     from steerlab.control.registry import get_controller
     from steerlab.ships.registry import get_ship
-    from steerlab.sim import drivers
+    from steerlab.jit import drivers
     from steerlab.sim.scenario import load_scenario
     from steerlab.sim.warm import warm_gym, warm_pair, warm_plant, warm_scenario_file, warm_trial
 

@@ -164,7 +164,7 @@ class Controller:
         ref[REF_R] = _finite("yaw_rate_ref", yaw_rate_ref)
         call = self.__dict__.get("_call")
         if call is None:      # the law's kernel as Python calls it (a wrapped law: from the driver cache)
-            from steerlab.sim.controller_calls import controller_step
+            from steerlab.jit.controller_calls import controller_step
 
             call = self._call = controller_step(self.spec.update)
         u = float(call(self.state, self.params, _finite("t", t), x, ref, self.sample_time))

@@ -24,8 +24,8 @@ if TYPE_CHECKING:
 
 def vector_kernel(update: Callable[..., float]) -> Callable[..., None]:
     """``run(Z, P, t, X, R, h, out)``: ``out[i] = update(Z[i], P[i], t, X[i], R[i], h)`` for each i
-    (:func:`steerlab.sim.controller_calls.vector_step`: compiled once ever)."""
-    from steerlab.sim.controller_calls import vector_step
+    (:func:`steerlab.jit.controller_calls.vector_step`: compiled once ever)."""
+    from steerlab.jit.controller_calls import vector_step
 
     return vector_step(update)
 

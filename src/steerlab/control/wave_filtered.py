@@ -20,10 +20,10 @@ Layouts (declared once, :mod:`steerlab.records`): ``z = [filter (N_WF) | x copy 
 is addressable through the wrapper (``"inner.Kp"``). Nothing is allocated
 (the copy lives in ``z``; slices are views), so the kernel obeys the engine's rules. The
 kernel is a copy of one template function whose module globals bind ``_inner`` to the inner
-kernel (:func:`steerlab.kernel_refs.bound_kernel`), so the engine's fusing (which follows
+kernel (:func:`steerlab.jit.kernel_refs.bound_kernel`), so the engine's fusing (which follows
 kernels called through module globals) inlines the filter and the inner controller like any
 other kernel, and a generated driver can name it (its machine code is cached on disk with the
-driver, :mod:`steerlab.sim.drivers`).
+driver, :mod:`steerlab.jit.drivers`).
 
 The filter's K, T come from ``ctx.nomoto()`` (the ship's first-order Nomoto model at the
 design speed) unless ``filter_K``, ``filter_T`` are given; ASA itself uses the same filter
@@ -55,7 +55,7 @@ from steerlab.control.wave_filter import STATE as WF_STATE
 from steerlab.control.wave_filter import (F_PSI, F_R, WaveFilterConfig, WaveFilterParams, wave_filter_init,
                                           wave_filter_step)
 from steerlab.errors import InputError
-from steerlab.kernel_refs import bound_kernel
+from steerlab.jit.kernel_refs import bound_kernel
 from steerlab.records import Field as RecordField
 from steerlab.records import Layout
 from steerlab.ships.state import IPSI, IR

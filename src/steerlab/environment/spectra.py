@@ -110,10 +110,10 @@ def jonswap_normaliser(gamma: float) -> float:
     """``c(gamma)`` making ``m0 = H^2/16`` (independent of ``Tp``; computed at ``w_p = 1``).
 
     Integrated by ``scipy.integrate.quad`` once and kept in steerlab's cache across processes
-    (:func:`steerlab.disk_memo.disk_memo`: the same bits, without importing ``scipy.integrate``,
+    (:func:`steerlab.jit.disk_memo.disk_memo`: the same bits, without importing ``scipy.integrate``,
     about 0.5 s, in every run of a JONSWAP sea such as the default scenario's).
     """
-    from steerlab.disk_memo import disk_memo
+    from steerlab.jit.disk_memo import disk_memo
 
     (c,) = disk_memo("jonswap_normaliser", (float(gamma),), lambda: [np.array([_jonswap_normaliser(gamma)])],
                      packages=("scipy", "numpy"))

@@ -25,7 +25,7 @@ from functools import lru_cache
 
 import numpy as np
 
-from steerlab.disk_memo import disk_memo
+from steerlab.jit.disk_memo import disk_memo
 from steerlab.environment.iir_filter import lfilter
 from steerlab.errors import InputError, require_finite_range
 
@@ -58,7 +58,7 @@ def band_pass_eq39(dt: float, num=EQ39_NUM, den=EQ39_DEN):
     """ZOH discretisation of eq (39) at step ``dt``: returns ``(b, a)`` for ``lfilter``.
 
     Computed by python-control's ``c2d`` once and kept in steerlab's cache across processes
-    (:func:`steerlab.disk_memo.disk_memo`: the same bits, without importing python-control in
+    (:func:`steerlab.jit.disk_memo.disk_memo`: the same bits, without importing python-control in
     every run); memoised in the process too (a Monte-Carlo builds thousands of seas with the
     same filter). The arrays are read-only.
     """

@@ -42,7 +42,7 @@ from steerlab.environment.waves import _hold, band_pass_eq39
 
 from steerlab.errors import InputError, require_finite_range
 from steerlab.sim.lanes import LANES, range_cuts
-from steerlab.threading_layer import launch, num_threads, threads_pay
+from steerlab.jit.threading_layer import launch, num_threads, threads_pay
 from steerlab.units import rad
 from steerlab.ships.state import IPSI
 from steerlab.steering_gear import G_DMAX
@@ -54,7 +54,7 @@ TRACK_GUIDANCE = {"type": "los", "start": [0.0, 200.0], "route": [[0.0, 0.0], [1
                   "lookahead_L": 5.0}
 THREADS_FROM = 512
 """Least number of lanes whose vectorised step (or reset) is spread over the threads (numba's
-``prange``, ``step_parallel`` / ``reset_parallel`` of :mod:`steerlab.gym.env_template`); below
+``prange``, ``step_parallel`` / ``reset_parallel`` of :mod:`steerlab.jit.env_template`); below
 it, one call in the calling thread. A step of 1024 ships at the default ``control_dt`` takes
 some 165-175 us on one core of the 2-core development VM (0.17 us per ship; 260-285 us before
 the step was made cheaper, 2026-11-26), about 100 us on two TBB threads with a core free; see
@@ -148,7 +148,7 @@ class Episodes:
         # the vectorised step of at least threads_from lanes runs on `threads` threads (None: numba's
         # number, numba.get_num_threads(), read at each step); the numbers do not depend on either
         self.threads_from, self.threads = THREADS_FROM, None
-        from steerlab.sim.drivers import entry
+        from steerlab.jit.drivers import entry
 
         kernels = env_kernels(s0.ship.rhs, self.guide, nx)      # compiled once ever (disk cache)
         if self.vectorised:
@@ -197,16 +197,16 @@ class Episodes:
 
     def _parallel(self, name: str, one: Any, one_args: tuple) -> tuple[Any, int]:
         """The compiled threaded entry point ``name`` and the address of the one-call entry point
-        ``one`` it runs on each range (:mod:`steerlab.numba_call_at`), for a call ``one(*one_args)``
+        ``one`` it runs on each range (:mod:`steerlab.jit.numba_call_at`), for a call ``one(*one_args)``
         (the types of these arguments do not change over the life of an ``Episodes``: its own
         arrays, and contiguous actions, lanes and flags). Taken on first use, so that the compile
-        message of :func:`steerlab.sim.drivers.entry` comes only when it is compiled."""
+        message of :func:`steerlab.jit.drivers.entry` comes only when it is compiled."""
         got = self._par.get(name)
         if got is None:
             import numba
 
-            from steerlab.numba_call_at import address_of
-            from steerlab.sim.drivers import entry
+            from steerlab.jit.numba_call_at import address_of
+            from steerlab.jit.drivers import entry
 
             at = address_of(one, tuple(numba.typeof(v) for v in one_args))
             got = self._par[name] = (entry(self._kernels, name), at)
@@ -215,7 +215,7 @@ class Episodes:
     def _threads(self, m: int) -> int:
         """Threads for a compiled call over ``m`` lanes: 1 below ``threads_from``, else
         ``threads``; None: ``numba.get_num_threads()`` on a threading layer where threads pay,
-        else 1 (:func:`steerlab.threading_layer.threads_pay`: not on workqueue)."""
+        else 1 (:func:`steerlab.jit.threading_layer.threads_pay`: not on workqueue)."""
         if m < self.threads_from:
             return 1
         if self.threads is not None:
@@ -230,7 +230,7 @@ class Episodes:
         the operating system's entropy. Returns one info dict per lane. From ``threads_from``
         distinct lanes on, the compiled resets are spread over the threads as the step's
         (:meth:`step_autoreset`), with the same numbers."""
-        from steerlab.gym.philox import seed_key
+        from steerlab.jit.philox import seed_key
 
         lanes = np.ascontiguousarray(lanes, dtype=np.int64).reshape(-1)
         if seeds is not None or not self.keyed[lanes].all():
@@ -296,7 +296,7 @@ class Episodes:
         from ``threads_from`` lanes (:data:`THREADS_FROM`) on, ``step_parallel``: all actions
         checked first, then ``threads`` contiguous ranges of whole groups
         (:func:`steerlab.sim.lanes.range_cuts`) spread over numba's threads (a ``prange``,
-        :mod:`steerlab.threading_layer`). A lane's numbers do not depend on the split."""
+        :mod:`steerlab.jit.threading_layer`). A lane's numbers do not depend on the split."""
         a = np.ascontiguousarray(actions, dtype=np.float64).reshape(self.n)
         again = None if self.lazy else redo.copy()
         args = (a, redo, self.X, self.K, self.J, self.cmd, self.W, self.w_index, self.PS, self.PG, self.dt,

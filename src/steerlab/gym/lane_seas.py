@@ -1,9 +1,9 @@
 r"""The seas and initial offsets of the Gymnasium environments' episodes, drawn per lane in compiled code.
 
 An episode of lane ``i`` is numbered ``e`` (0 after ``reset(seed=s)``, then 1, 2, ... at each
-reset without a seed) and its lane is keyed with its seed (:func:`steerlab.gym.philox.seed_key`).
+reset without a seed) and its lane is keyed with its seed (:func:`steerlab.jit.philox.seed_key`).
 All its random numbers come from Philox4x64-10 blocks of key ``KEY[i]`` and counters
-``(b, e, stream, 0)`` (:mod:`steerlab.gym.philox`), so they depend on (seed, e) only:
+``(b, e, stream, 0)`` (:mod:`steerlab.jit.philox`), so they depend on (seed, e) only:
 
 * header (``stream`` 0, block 0): ``u = uniform(x0)`` gives the initial heading offset
   ``-m + 2 m u`` [rad] (``m``: the task's ``initial_offset_deg``; 0 but for course keeping)
@@ -32,7 +32,7 @@ import numpy as np
 
 from steerlab.environment.channels import N_CHANNELS
 from steerlab.environment.iir_filter import df2_step2
-from steerlab.gym.philox import STREAM_HEADER, STREAM_NORMAL, normals, philox_block, uniform
+from steerlab.jit.philox import STREAM_HEADER, STREAM_NORMAL, normals, philox_block, uniform
 
 _S33 = np.uint64(33)
 SEA_SEED_MOD = np.uint64(2 ** 31 - 1)

@@ -1,7 +1,7 @@
 """A model's heading and yaw-rate response to a recorded rudder angle.
 
 Uses the engine's own RK4 plant step (the ``replay_rudder`` loop of the ship's driver,
-:mod:`steerlab.sim.driver_template`) and the ship
+:mod:`steerlab.jit.driver_template`) and the ship
 kernels, so the model identified is exactly the model simulated. The recorded rudder is the
 input: before the step from sample k to k+1 the plant's rudder state is set to the mean of the
 two samples and the gear is ordered to the same angle, so it holds it over the step (with the
@@ -22,8 +22,8 @@ _PG = SteeringGear(delta_max=np.pi / 2, rate_max=100.0, T_sg=1.0, dead_zone=0.0)
 
 
 def _loop(ship_rhs):
-    """The plant-only driver's rudder replay (:mod:`steerlab.sim.driver_template`)."""
-    from steerlab.sim.drivers import driver, entry
+    """The plant-only driver's rudder replay (:mod:`steerlab.jit.driver_template`)."""
+    from steerlab.jit.drivers import driver, entry
 
     return entry(driver(ship_rhs, None, None, 0), "replay_rudder")
 

@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from steerlab.errors import InputError
-from steerlab.sim.controller_calls import controller_step
+from steerlab.jit.controller_calls import controller_step
 from steerlab.ships.state import IPSI, IR, IU, IV, IX, IY
 from steerlab.guidance.reference_vector import REF_PSI, REF_R
 

@@ -36,7 +36,7 @@ import numpy as np
 
 from steerlab.control.registry import ControllerSpec
 from steerlab.errors import InputError
-from steerlab.kernel_refs import bound_kernel
+from steerlab.jit.kernel_refs import bound_kernel
 from steerlab.records import Field as RecordField
 from steerlab.records import Layout
 from steerlab.sensors.counter_rng import make_key, normal, split_seed, uniform

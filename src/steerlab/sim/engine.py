@@ -15,7 +15,7 @@ from steerlab.angles import wrap_to_pi_array
 from steerlab.guidance.reference_models import course_guide
 from steerlab.guidance.reference_vector import N_REF, REF_NAMES, REF_PSI, REF_R, REF_RPM, initial_reference
 from steerlab.metrics_online import accumulate, new_accumulator
-from steerlab.sim.controller_calls import controller_step
+from steerlab.jit.controller_calls import controller_step
 from steerlab.sim.kernels import closed_loop, plant_step
 from steerlab.sim.result import Result
 from steerlab.sim.setup import SimSetup, build

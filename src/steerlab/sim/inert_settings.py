@@ -27,7 +27,7 @@ from typing import Any
 import numpy as np
 
 from steerlab.errors import InertSettingWarning
-from steerlab.numba_cache import PACKAGE_ROOT
+from steerlab.jit.numba_cache import PACKAGE_ROOT
 
 #: [environment.wave] fields each wave model reads (besides ``model``; the eq (39) waves read
 #: ``environment.wave_power`` and ``wave_sample_time`` instead)

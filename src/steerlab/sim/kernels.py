@@ -5,8 +5,8 @@ One definition, two speeds: :func:`plant_step` is the RK4 step of ship + steerin
 (:mod:`steerlab.sim.lanes`) calls the same fused ship + gear kernel, vectorised across runs.
 The readable engine (:mod:`steerlab.sim.engine`) calls the very same ``plant_step`` and
 controller/guidance kernels from Python. The loops themselves are written once, in
-:mod:`steerlab.sim.driver_template`; each combination's copy (its *driver*) is generated as a
-module and its machine code cached on disk (:mod:`steerlab.sim.drivers`), so a combination
+:mod:`steerlab.jit.driver_template`; each combination's copy (its *driver*) is generated as a
+module and its machine code cached on disk (:mod:`steerlab.jit.drivers`), so a combination
 compiles once, ever, not once per process.
 
 Every loop takes one kind of guidance kernel, ``guide(t, x, gd, gz, ref, h)`` with a
@@ -104,7 +104,7 @@ def rk4_update(x, s6, k1, k2, k3, k4):
 def _plant_kernels(ship_rhs, nx: int = 0):
     """``(rk4, rk4_step, plant_rhs, clamp)`` for a ship model (its plant-only driver);
     ``nx > 0`` specialises on the plant state size."""
-    from steerlab.sim.drivers import driver
+    from steerlab.jit.drivers import driver
 
     d = driver(ship_rhs, None, None, int(nx))
     return d.rk4, d.rk4_step, d.plant_rhs, d.clamp
@@ -150,14 +150,14 @@ def guided_closed_loop(ship_rhs, ctrl_update, guide, nx: int | None = None):
     ``nx`` (the plant state size, ship states + rudder), when given, specialises the loop on
     it (faster); ``run`` then raises ``ValueError`` for a state of another size.
     """
-    from steerlab.sim.drivers import driver
+    from steerlab.jit.drivers import driver
 
     d = driver(ship_rhs, ctrl_update, guide, 0 if nx is None else int(nx))
     return _Announced(d, "run")
 
 
 class _Announced:
-    """A driver's entry point that says (through :data:`steerlab.sim.drivers.on_compile`)
+    """A driver's entry point that says (through :data:`steerlab.jit.drivers.on_compile`)
     when its first call compiles, then calls the compiled kernel directly."""
 
     __slots__ = ("_mod", "_name", "_fn")
@@ -168,7 +168,7 @@ class _Announced:
     def __call__(self, *args):
         fn = self._fn
         if fn is None:
-            from steerlab.sim.drivers import entry
+            from steerlab.jit.drivers import entry
 
             fn = self._fn = entry(self._mod, self._name)
         return fn(*args)

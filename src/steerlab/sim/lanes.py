@@ -35,7 +35,7 @@ from functools import lru_cache
 import numpy as np
 
 from steerlab.guidance.reference_models import course_guide
-from steerlab.threading_layer import num_threads
+from steerlab.jit.threading_layer import num_threads
 
 LANES = 16
 """Runs advanced together by one thread of the batch engine (two AVX-512 vectors of float64;
@@ -62,7 +62,7 @@ def lane_loop(ship_rhs, ctrl_update, guide, nx: int, lanes: int = LANES):
     :func:`~steerlab.sim.kernels.guided_closed_loop` (so each run's numbers are bit-identical
     to its single run); only the schedule and the memory layout differ (module docstring).
     It is the ``group`` entry point of the combination's driver
-    (:mod:`steerlab.sim.driver_template`, cached on disk by :mod:`steerlab.sim.drivers`).
+    (:mod:`steerlab.jit.driver_template`, cached on disk by :mod:`steerlab.jit.drivers`).
 
     ``group(X, Z, PS, PG, PC, GD, GZ, W, w_index, i0, n_act, dt, nc, n_steps, rec_every,
     out_x, out_cmd, out_ref, ACC, rpm_slot)`` advances runs ``i0 .. i0 + n_act - 1`` of the
@@ -71,7 +71,7 @@ def lane_loop(ship_rhs, ctrl_update, guide, nx: int, lanes: int = LANES):
     as a function of its own, called once per group: its scratch arrays are allocated inside
     it, with shapes the compiler sees (which the vectoriser needs).
     """
-    from steerlab.sim.drivers import driver
+    from steerlab.jit.drivers import driver
 
     return driver(ship_rhs, ctrl_update, guide, int(nx), int(lanes)).group
 
@@ -118,7 +118,7 @@ def range_cuts(n: int, lanes: int, ranges: int) -> np.ndarray:
     ranges ``cuts[j] .. cuts[j + 1] - 1`` covering ``0 .. n - 1``: multiples of ``lanes`` (every
     group of ``lanes`` stays whole), as equal as whole groups allow, none empty (fewer ranges
     when there are fewer groups). The ranges of the Gymnasium vector environment's threaded
-    step (``step_parallel`` of :mod:`steerlab.gym.env_template`)."""
+    step (``step_parallel`` of :mod:`steerlab.jit.env_template`)."""
     groups = -(-int(n) // int(lanes))
     m = max(1, min(int(ranges), groups))
     return np.array([min(n, lanes * (groups * j // m)) for j in range(m + 1)], dtype=np.int64)
@@ -162,7 +162,7 @@ def batch_loop(ship_rhs, ctrl_update, nx: int, lanes: int = LANES, guide=None):
     runs in the same sea store it once); ``PS`` (at ``rpm_slot``, when >= 0) and ``GZ`` are
     modified in place; ``progress(done, n)``: see :func:`_run_groups`.
     """
-    from steerlab.sim.drivers import driver, entry
+    from steerlab.jit.drivers import driver, entry
 
     mod = driver(ship_rhs, ctrl_update, course_guide if guide is None else guide, int(nx), int(lanes))
     G = int(lanes)
@@ -193,7 +193,7 @@ def vectorisation_report(ship_rhs, ctrl_update, nx: int, guide=None, lanes: int 
     Machine code loaded from the disk cache has no IR to show: its report is the one read from
     the IR when it was compiled and kept beside the driver (:mod:`steerlab.sim.vector_reports`);
     without it, the same driver is compiled once in this process for the inspection
-    (:func:`steerlab.sim.drivers.in_memory_twin`).
+    (:func:`steerlab.jit.drivers.in_memory_twin`).
     """
     g = course_guide if guide is None else guide
     return _report(ship_rhs, ctrl_update, g, int(nx), int(lanes), "group",
@@ -212,7 +212,7 @@ def plant_lanes_report(ship_rhs, nx: int, lanes: int = LANES) -> dict:
 
 
 def _report(ship_rhs, ctrl_update, guide, nx: int, lanes: int, name: str, not_compiled: str) -> dict:
-    from steerlab.sim.drivers import cached_signatures, driver, in_memory_twin
+    from steerlab.jit.drivers import cached_signatures, driver, in_memory_twin
     from steerlab.sim.vector_reports import report_from_ir, stored
 
     disp = getattr(driver(ship_rhs, ctrl_update, guide, nx, lanes), name)

@@ -4,13 +4,13 @@ compile time, and kept beside the driver in the cache.
 numba cannot show the IR of machine code it loaded from its disk cache, so reading the
 vectorisation of a cached driver (:func:`steerlab.sim.lanes.vectorisation_report`, ``steerlab
 bench``, :mod:`steerlab.testing`'s kernel checks) used to compile the whole driver once more
-in memory (:func:`steerlab.sim.drivers.in_memory_twin`), seconds per combination in every
+in memory (:func:`steerlab.jit.drivers.in_memory_twin`), seconds per combination in every
 process. Instead, when a cached driver's ``group`` or ``step_lanes`` is compiled (in any
 process: a run, ``steerlab cache warm``), :func:`on_compiled` reads the IR of the code just
 compiled - the very code numba then saves - and writes its report to
 ``d_<hash>.<entry>.vec.json`` beside the driver module; a later process reads it
 (:func:`stored`). The cache directory is per steerlab fingerprint and the file per module
-text (:mod:`steerlab.sim.drivers`), so a report is never stale; an unreadable file is ignored
+text (:mod:`steerlab.jit.drivers`), so a report is never stale; an unreadable file is ignored
 (the twin is compiled, as before).
 
 A report is ``{"vectorised_stages": n, "per_run_library_calls": [...]}``
@@ -59,7 +59,7 @@ def combined(reports: list) -> dict:
 def _path(dispatcher) -> Optional[Path]:
     """``d_<hash>.<entry>.vec.json`` beside the cached driver module of ``dispatcher`` (None for
     a driver built in memory or another function)."""
-    from steerlab.sim.drivers import MODULE_PREFIX
+    from steerlab.jit.drivers import MODULE_PREFIX
 
     func = getattr(dispatcher, "py_func", None)
     module = getattr(func, "__module__", "") or ""

@@ -1,9 +1,9 @@
 r"""The compiled step and reset of the Gymnasium environments for one (ship, guidance) pair: template.
 
-:mod:`steerlab.sim.drivers` turns this file into a small module per (ship, guidance kernel,
+:mod:`steerlab.jit.drivers` turns this file into a small module per (ship, guidance kernel,
 plant size) combination in the driver cache directory, as it does the simulation engines'
-drivers (:mod:`steerlab.sim.driver_template`): the *bindings* block below is replaced by the
-combination's kernels (named by :mod:`steerlab.kernel_refs`) and sizes, every kernel is a
+drivers (:mod:`steerlab.jit.driver_template`): the *bindings* block below is replaced by the
+combination's kernels (named by :mod:`steerlab.jit.kernel_refs`) and sizes, every kernel is a
 module global, and the entry points (:data:`ENTRY_POINTS`) are compiled with numba's disk
 cache, so a fresh process loads their machine code instead of compiling for seconds. Kernels
 that cannot be named get the same module built and compiled in memory.
@@ -21,8 +21,8 @@ Entry points:
 * ``first_refused``: the first action out of [-1, 1];
 * ``step_parallel``, ``reset_parallel``: ``step`` and ``reset`` on contiguous ranges of lanes
   spread over numba's threads (``parallel=True``, one ``prange`` iteration per range; the
-  threading layer: :mod:`steerlab.threading_layer`), calling the compiled ``step`` and ``reset``
-  through their addresses (:mod:`steerlab.numba_call_at`), so they compile in a fraction of a
+  threading layer: :mod:`steerlab.jit.threading_layer`), calling the compiled ``step`` and ``reset``
+  through their addresses (:mod:`steerlab.jit.numba_call_at`), so they compile in a fraction of a
   second instead of compiling the step again.
 
 Per ship ``step`` and ``step_serial`` perform the same IEEE operations in the same order
@@ -42,7 +42,7 @@ from steerlab.angles import wrap_to_pi
 from steerlab.guidance.reference_vector import REF_PSI, REF_RPM
 from steerlab.gym.lane_seas import draw_episode, fill_rows
 from steerlab.gym.plant_batch import OBS_DELTA, OBS_E, OBS_R, R_MAX, REWARD_ITAE, REWARD_SPEED_LOSS
-from steerlab.numba_call_at import call_at
+from steerlab.jit.numba_call_at import call_at
 from steerlab.sim.kernels import _fused, _jit_fused, plant_step
 from steerlab.ships.state import IPSI, IR
 
@@ -59,10 +59,10 @@ ENTRY_POINTS = {"step": "vector environment's step", "step_serial": "environment
                 "reset": "environment's reset", "first_refused": "action check",
                 "step_parallel": "vector environment's threaded step",
                 "reset_parallel": "vector environment's threaded reset"}
-"""The compiled entry points and what they are (for :data:`steerlab.sim.drivers.on_compile`)."""
+"""The compiled entry points and what they are (for :data:`steerlab.jit.drivers.on_compile`)."""
 
 if SHIP_RHS is not None:
-    from steerlab.sim.drivers import driver as _driver
+    from steerlab.jit.drivers import driver as _driver
 
     plants = _driver(SHIP_RHS, None, None, NX, LANES).step_lanes   # the vectorised plant step
     rk4_step = plant_step(SHIP_RHS)                                 # the engines' scalar step
@@ -212,15 +212,15 @@ def step_parallel(step_at, cuts, A, redo, X, K, J, cmd, W, w_index, PS, PG, dt, 
     (int64, increasing; multiples of ``LANES`` but the last, so every group stays whole), one
     range per ``prange`` iteration, spread over numba's threads; returns -1, or the first refused
     lane. ``step_at`` is the address of :func:`step`'s machine code for these arguments
-    (:func:`steerlab.numba_call_at.address_of`), called through
-    :func:`steerlab.numba_call_at.call_at`: this entry point does not compile a second copy of the
+    (:func:`steerlab.jit.numba_call_at.address_of`), called through
+    :func:`steerlab.jit.numba_call_at.call_at`: this entry point does not compile a second copy of the
     step (seconds per ship), and its ranges run the very code of a one-call step. Every action of
     all the ranges is checked first (:func:`first_refused`), so nothing moves when one is refused.
     A range reads and writes only its lanes' rows and a lane's numbers do not depend on the range
     it is in: the numbers are those of one ``step`` call, bit for bit, whatever the ranges and the
     threads. Not ``nogil``: the caller keeps the GIL for the whole call, so two Python threads
     never launch it (or ``reset_parallel``) at once (the workqueue threading layer aborts on
-    concurrent launches, :mod:`steerlab.threading_layer`).
+    concurrent launches, :mod:`steerlab.jit.threading_layer`).
     """
     bad_lane = first_refused(A, redo, cuts[0], cuts[cuts.shape[0] - 1])
     if bad_lane >= 0:
@@ -279,7 +279,7 @@ def reset(idx, KEY, EP, S, Z, scale, offset_max, X, K, J, cmd, PS, GZ, REF, x0, 
           rpm_slot, obs, rew, bad, sea_seeds):
     """:func:`reset_one` for the lanes ``idx``, their sea seeds into ``sea_seeds``; one compiled
     call for all of them; returns the number of lanes (int64, as :func:`step` returns one: what
-    :func:`steerlab.numba_call_at.call_at` reads). Calls on disjoint lanes may run in parallel
+    :func:`steerlab.jit.numba_call_at.call_at` reads). Calls on disjoint lanes may run in parallel
     threads (:func:`reset_parallel`)."""
     for q in range(idx.shape[0]):
         sea_seeds[q] = reset_one(idx[q], KEY, EP, S, Z, scale, offset_max, X, K, J, cmd, PS, GZ, REF, x0, ps,

@@ -8,7 +8,7 @@ would load the old machine code, which then reads the wrong channels, silently. 
 module adds the fingerprint of the whole steerlab package (every ``.py`` file's path and
 contents) to the stamp of every steerlab kernel, so any change to steerlab
 recompiles its cached kernels once. Functions outside steerlab are left to numba as they are,
-except the generated drivers (:mod:`steerlab.sim.drivers`), whose stamp is their file name:
+except the generated drivers (:mod:`steerlab.jit.drivers`), whose stamp is their file name:
 the hash of their text, in a directory named after the fingerprint.
 
 It plugs into numba's cache locators (``numba.core.caching.CacheImpl._locator_classes``, an
@@ -25,7 +25,7 @@ import warnings
 from functools import lru_cache
 from pathlib import Path
 
-PACKAGE_ROOT = Path(__file__).resolve().parent
+PACKAGE_ROOT = Path(__file__).resolve().parent.parent
 
 
 def package_fingerprint(root: Path = PACKAGE_ROOT) -> str:
@@ -59,7 +59,7 @@ _DRIVER_NAME = re.compile(r"d_[0-9a-f]{20}\.py")
 
 
 def _is_driver(py_file: str) -> bool:
-    """A generated driver module (:mod:`steerlab.sim.drivers`): ``.../drivers/<fp>/d_<hash>.py``."""
+    """A generated driver module (:mod:`steerlab.jit.drivers`): ``.../drivers/<fp>/d_<hash>.py``."""
     p = Path(py_file)
     return bool(_DRIVER_NAME.fullmatch(p.name)) and p.parent.parent.name == "drivers"
 

@@ -1,8 +1,8 @@
 """The compiled driver of one (ship, controller, guidance) combination: template source.
 
-:mod:`steerlab.sim.drivers` turns this file into a small module per combination, in the
+:mod:`steerlab.jit.drivers` turns this file into a small module per combination, in the
 driver cache directory, by replacing the *bindings* block below with the combination's
-kernels (named by :mod:`steerlab.kernel_refs`) and sizes. Every kernel of the driver is then
+kernels (named by :mod:`steerlab.jit.kernel_refs`) and sizes. Every kernel of the driver is then
 a module global, so numba's disk cache (``cache=True`` on the entry points) keeps the fused
 machine code across processes: a fresh process loads it instead of compiling for seconds.
 The package fingerprint is part of the cache directory, so a changed steerlab never serves
@@ -57,7 +57,7 @@ CACHE = False         # numba disk cache for the entry points
 
 ENTRY_POINTS = {"run": "closed loop", "group": "batch loop", "rk4_step": "plant step",
                 "replay_rudder": "rudder replay", "step_lanes": "vectorised plant step"}
-"""The compiled entry points and what they are (for :data:`steerlab.sim.drivers.on_compile`)."""
+"""The compiled entry points and what they are (for :data:`steerlab.jit.drivers.on_compile`)."""
 
 ship = _fused(SHIP_RHS)
 rate = _fused(gear_rate)

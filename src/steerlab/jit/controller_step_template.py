@@ -1,11 +1,11 @@
 r"""A controller's kernel called from Python, one controller or N of one type: template.
 
-:mod:`steerlab.sim.drivers` turns this file into a small module per controller kernel in the
-driver cache directory, as it does the engines' drivers (:mod:`steerlab.sim.driver_template`):
+:mod:`steerlab.jit.drivers` turns this file into a small module per controller kernel in the
+driver cache directory, as it does the engines' drivers (:mod:`steerlab.jit.driver_template`):
 the *bindings* block below is replaced by the controller's kernel (named by
-:mod:`steerlab.kernel_refs`), and the entry points are compiled with numba's disk cache, so a
+:mod:`steerlab.jit.kernel_refs`), and the entry points are compiled with numba's disk cache, so a
 fresh process loads their machine code instead of compiling it
-(:mod:`steerlab.sim.controller_calls` says when they are used).
+(:mod:`steerlab.jit.controller_calls` says when they are used).
 
 Entry points:
 

@@ -1,6 +1,6 @@
 """Names for compiled kernels that a fresh Python process can turn back into the kernel.
 
-The compiled drivers (:mod:`steerlab.sim.drivers`) are generated as small modules on disk so
+The compiled drivers (:mod:`steerlab.jit.drivers`) are generated as small modules on disk so
 that numba can cache their machine code across processes. Such a module must name the ship,
 controller and guidance kernels it binds in a way that re-importing it finds the same
 kernels. A *kernel reference* is that name, a plain tuple (``repr`` gives valid Python):

@@ -2,7 +2,7 @@
 
 The native Gymnasium vector environment spreads a step (and a reset) of many ships over the
 cores with numba's ``prange`` (``step_parallel`` and ``reset_parallel`` of
-:mod:`steerlab.gym.env_template`), which runs on numba's *threading layer*: one per process,
+:mod:`steerlab.jit.env_template`), which runs on numba's *threading layer*: one per process,
 chosen by numba when its threads are first started (the first ``parallel=True`` call or the
 first ``numba.get_num_threads()``), from ``numba.config.THREADING_LAYER`` (the
 ``NUMBA_THREADING_LAYER`` environment variable, default ``"default"``: TBB if it can be

@@ -3,7 +3,7 @@
 Some set-up numbers need a heavy library only to be computed once: the exact ZOH
 discretisation of the eq (39) wave filter needs python-control (about 1.5 s to import) for
 six coefficients. :func:`disk_memo` stores such results, exactly (``float.hex``), in the
-steerlab cache (:func:`steerlab.sim.drivers.cache_root`), in a directory named after
+steerlab cache (:func:`steerlab.jit.drivers.cache_root`), in a directory named after
 steerlab's package fingerprint, under a key that also names the versions of the libraries
 that computed them. A missing, partial or unreadable entry is recomputed (and rewritten
 atomically); a read-only cache just means computing every time.
@@ -33,8 +33,8 @@ def _versions(packages: Sequence[str]) -> list:
 
 
 def _directory() -> Path:
-    from steerlab.numba_cache import _fingerprint
-    from steerlab.sim.drivers import cache_root
+    from steerlab.jit.numba_cache import _fingerprint
+    from steerlab.jit.drivers import cache_root
 
     return cache_root() / "memo" / _fingerprint()[:20]
 

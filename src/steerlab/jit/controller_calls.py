@@ -5,9 +5,9 @@ controller itself (:class:`~steerlab.components.controller.Controller`, the runt
 autopilot, the readable engine, :class:`~steerlab.components.controller_vector.ControllerVector`)
 calls the kernel's dispatcher. A registered law is compiled with numba's disk cache and loads
 in a fresh process; a law wrapped at run time (``"pid+wf"``, a controller behind ``[sensors]``:
-:func:`steerlab.kernel_refs.bound_kernel`) has no disk cache of its own and compiled again in
+:func:`steerlab.jit.kernel_refs.bound_kernel`) has no disk cache of its own and compiled again in
 every process (0.6-1.9 s before the first order). :func:`controller_step` returns, for such a
-kernel, the ``step`` entry of :mod:`steerlab.sim.controller_step_template` bound to it,
+kernel, the ``step`` entry of :mod:`steerlab.jit.controller_step_template` bound to it,
 which a fresh process loads from the driver cache; any other kernel is returned as it is.
 """
 
@@ -21,7 +21,7 @@ TEMPLATE = Path(__file__).with_name("controller_step_template.py")
 
 
 def _module(update: Callable[..., float]) -> types.ModuleType:
-    from steerlab.sim import drivers
+    from steerlab.jit import drivers
 
     return drivers.driver(None, update, None, template=TEMPLATE)
 
@@ -41,7 +41,7 @@ def controller_step(update: Callable[..., float]) -> Callable[..., float]:
     mod = _module(update)
     if not mod._steerlab_cached:
         return update                         # built in memory: the kernel itself compiles as fast
-    from steerlab.sim import drivers
+    from steerlab.jit import drivers
 
     return drivers.entry(mod, "step")
 
@@ -49,7 +49,7 @@ def controller_step(update: Callable[..., float]) -> Callable[..., float]:
 def vector_step(update: Callable[..., float]) -> Callable[..., None]:
     """``vector_step(Z, P, t, X, R, h, out)``: ``out[i] = update(Z[i], P[i], t, X[i], R[i], h)``
     for each i, from the driver cache (a fresh process loads it; a kernel that cannot be named
-    gets it built in memory: :func:`steerlab.sim.drivers.driver`)."""
-    from steerlab.sim import drivers
+    gets it built in memory: :func:`steerlab.jit.drivers.driver`)."""
+    from steerlab.jit import drivers
 
     return drivers.entry(_module(update), "vector_step")

@@ -3,7 +3,7 @@ r"""Call a compiled numba function through its machine-code address, from compil
 Why: a numba function that calls another compiled function links a copy of the callee's LLVM
 IR into its own module and optimises and compiles that copy again. For a small wrapper around a
 big kernel (the Gymnasium environments' threaded step, a ``prange`` over ranges of lanes, each
-running the one-call step of :mod:`steerlab.gym.env_template`) that repeats the kernel's whole
+running the one-call step of :mod:`steerlab.jit.env_template`) that repeats the kernel's whole
 compile: seconds per (ship, guidance) pair. Calling the callee's machine code through its
 address instead, the wrapper compiles in a fraction of a second and the callee's code is the
 one already compiled (or loaded from the cache), so the numbers are those of a direct call.

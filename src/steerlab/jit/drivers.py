@@ -3,7 +3,7 @@
 A *driver* is the compiled closed loop of one (ship, controller, guidance, plant size,
 lanes) combination: the single run, the batch group, the plant step and the vectorised
 plant step of N ships
-(:mod:`steerlab.sim.driver_template`). Numba cannot cache closures across processes, so
+(:mod:`steerlab.jit.driver_template`). Numba cannot cache closures across processes, so
 instead of building the loops as closures this module writes each combination's driver as
 a small Python module in the driver cache directory, whose kernels are module globals, and
 compiles its entry points with numba's disk cache. A fresh process imports the module and
@@ -14,7 +14,7 @@ Cache layout and guarantees
 ``<cache root>/drivers/<steerlab fingerprint>/d_<hash>.py`` (+ numba's ``__pycache__``):
 
 * **Never stale.** The directory is named after the fingerprint of the whole steerlab
-  package (:func:`steerlab.numba_cache.package_fingerprint`): any change to steerlab's source
+  package (:func:`steerlab.jit.numba_cache.package_fingerprint`): any change to steerlab's source
   uses a new directory. Inside it the file name is the hash of the module's text, and numba's
   stamp of a driver is that name (not the file's modification time), so rewriting a file
   with the same text never invalidates its machine code.
@@ -25,14 +25,14 @@ Cache layout and guarantees
 * **A user's edited kernel is compiled afresh.** A kernel of a plug-in or of the user's own
   package is named in the module by reference, and the module's text also carries the digest
   of every user source file that kernel is compiled from (its module, its parent packages and
-  the project modules it imports: :mod:`steerlab.kernel_sources`): an edit to any of them
+  the project modules it imports: :mod:`steerlab.jit.kernel_sources`): an edit to any of them
   gives another module, never the old machine code; ``steerlab cache clear --stale`` drops
   the modules of code edited since.
 * **Corrupt entries are rebuilt.** Before the first use in a process, the driver's module
   text and numba's index and data files are read back; a truncated or unreadable file is
   deleted and the driver recompiled, never a crash.
 
-Kernels that cannot be named by :mod:`steerlab.kernel_refs` (defined in ``__main__``, a
+Kernels that cannot be named by :mod:`steerlab.jit.kernel_refs` (defined in ``__main__``, a
 notebook, a closure) get the same driver built in memory and compiled in the process, as
 before. ``STEERLAB_DRIVER_CACHE=0`` forces that for everything.
 
@@ -55,10 +55,10 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable, Optional
 
-from steerlab.kernel_refs import describe, kernel_ref
-from steerlab.kernel_sources import LINE as SOURCE_LINE
-from steerlab.kernel_sources import outdated, source_digests
-from steerlab.numba_cache import _fingerprint
+from steerlab.jit.kernel_refs import describe, kernel_ref
+from steerlab.jit.kernel_sources import LINE as SOURCE_LINE
+from steerlab.jit.kernel_sources import outdated, source_digests
+from steerlab.jit.numba_cache import _fingerprint
 
 TEMPLATE = Path(__file__).with_name("driver_template.py")
 BEGIN = "# ---- bindings: replaced in every generated driver ----"
@@ -106,9 +106,9 @@ def driver(ship_rhs, ctrl_update=None, guide=None, nx: int = 0, lanes: int = 16,
     """The driver module of a combination (loaded, generated or built in memory; memoised).
 
     ``ctrl_update``/``guide`` may be None for a plant-only driver (``rk4_step``). The module
-    has the kernels of ``template`` as attributes: by default :mod:`steerlab.sim.driver_template`;
+    has the kernels of ``template`` as attributes: by default :mod:`steerlab.jit.driver_template`;
     any template with the same bindings block and an ``ENTRY_POINTS`` dict (entry point name:
-    what it is) works the same way (:mod:`steerlab.gym.env_template`).
+    what it is) works the same way (:mod:`steerlab.jit.env_template`).
     """
     key = _Key(ship_rhs, ctrl_update, guide, int(nx), int(lanes), Path(template))
     mod = _LOADED.get(key)
@@ -125,9 +125,9 @@ def driver(ship_rhs, ctrl_update=None, guide=None, nx: int = 0, lanes: int = 16,
 def _bindings(refs: dict, nx: int, lanes: int, cache: bool, sources=()) -> str:
     """The bindings block of a generated driver: its kernels by reference, its sizes, and the
     digests of the user source files its kernels are compiled from (``sources``,
-    :func:`steerlab.kernel_sources.source_digests`: an edit to one of them gives another
+    :func:`steerlab.jit.kernel_sources.source_digests`: an edit to one of them gives another
     text, hence another module and machine code)."""
-    lines = [BEGIN, "from steerlab.kernel_refs import resolve as _resolve"]
+    lines = [BEGIN, "from steerlab.jit.kernel_refs import resolve as _resolve"]
     for name in ("SHIP_RHS", "CTRL_UPDATE", "GUIDE"):
         lines.append(f"{name} = _resolve({refs[name]!r})")
     lines += [SOURCE_LINE.format(module=module, digest=digest) for module, digest in sources]
@@ -261,7 +261,7 @@ def _cache_files(dispatcher) -> tuple[Optional[str], list[str]]:
 def cached_signatures(dispatcher) -> list:
     """The signatures whose machine code numba's disk cache holds for ``dispatcher`` (numba
     internals, guarded: [] if unreadable). A caller loaded from the cache (e.g. the Gymnasium
-    environment's step, :mod:`steerlab.gym.env_template`) links the code of the entry points it
+    environment's step, :mod:`steerlab.jit.env_template`) links the code of the entry points it
     calls without loading them, so their ``signatures`` stay empty in that process."""
     try:
         return [key[0] for key in dispatcher._cache._cache_file._load_index()]
@@ -338,7 +338,7 @@ def cache_info() -> dict:
 def cache_clear(stale_only: bool = False) -> int:
     """Delete the driver cache, or (``stale_only``) what no process will load again: other
     steerlab versions' directories and, in this version's, the drivers compiled from a user
-    source file that has changed since (:func:`steerlab.kernel_sources.outdated`); returns
+    source file that has changed since (:func:`steerlab.jit.kernel_sources.outdated`); returns
     bytes freed."""
     root = cache_root() / "drivers"
     if not root.exists():
@@ -358,7 +358,7 @@ def cache_clear(stale_only: bool = False) -> int:
 
 def _outdated_files(here: Path) -> list[Path]:
     """The files of the drivers of ``here`` compiled from user sources that have changed since
-    (:func:`steerlab.kernel_sources.outdated`): each module, its kept reports, its machine code."""
+    (:func:`steerlab.jit.kernel_sources.outdated`): each module, its kept reports, its machine code."""
     files: list[Path] = []
     for module in here.glob("d_*.py"):
         try:

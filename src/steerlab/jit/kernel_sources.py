@@ -1,6 +1,6 @@
 """The source files a user's kernel is compiled from, for keying cached machine code on them.
 
-A generated driver (:mod:`steerlab.sim.drivers`) fuses the ship, controller and guidance
+A generated driver (:mod:`steerlab.jit.drivers`) fuses the ship, controller and guidance
 kernels it binds into one piece of machine code, cached on disk under the hash of the module's
 text, in a directory named after steerlab's own fingerprint. That text names the kernels
 (``("ref", "my_ship:my_rhs")``), not their code: a user who edited the ``my_rhs`` of a plug-in
@@ -35,7 +35,7 @@ from functools import lru_cache
 from pathlib import Path
 from typing import Optional
 
-from steerlab.numba_cache import PACKAGE_ROOT
+from steerlab.jit.numba_cache import PACKAGE_ROOT
 
 
 @lru_cache(maxsize=1)
@@ -148,7 +148,7 @@ def _module_of_ref(kref) -> list[str]:
 
 def source_digests(refs) -> Optional[list[tuple[str, str]]]:
     """``[(module, sha256 of its file[:16]), ...]`` (sorted) of the user modules the kernels of
-    ``refs`` (kernel references, :mod:`steerlab.kernel_refs`; None entries skipped) are
+    ``refs`` (kernel references, :mod:`steerlab.jit.kernel_refs`; None entries skipped) are
     compiled from, followed through the modules they import; ``[]`` for steerlab's own
     kernels; None when a user module's source cannot be read."""
     seen: dict[str, str] = {}
@@ -174,7 +174,7 @@ def source_digests(refs) -> Optional[list[tuple[str, str]]]:
     return sorted((m, d) for m, d in seen.items() if d)
 
 
-#: how a driver's text records one of them (:func:`steerlab.sim.drivers._bindings` writes it)
+#: how a driver's text records one of them (:func:`steerlab.jit.drivers._bindings` writes it)
 LINE = "# compiled from {module} (sha256 {digest})"
 _LINE = re.compile(r"^# compiled from (\S+) \(sha256 ([0-9a-f]{16})\)$", re.M)
 
