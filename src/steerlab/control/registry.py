@@ -35,6 +35,9 @@ class ControllerSpec(PicklesByName):
     build: Callable
     source: str = ""
     params: Optional[object] = field(default=None, compare=False)   #: records.Layout of the record
+    #: the rule the default gains come from, with its source (``steerlab design``,
+    #: ``Controller.describe()``); empty for a law without a stated rule
+    design_rule: str = field(default="", compare=False)
     #: ``(function, args)`` that made this spec from another one, e.g. ``(sensed_spec, (inner,))``:
     #: it pickles as that (:class:`steerlab.plugins.PicklesByName`)
     recipe: Optional[tuple] = field(default=None, compare=False, repr=False)
