@@ -103,6 +103,11 @@ def _run(args, figures) -> int:
         write_run_report(stage, result, metrics, scenario, figures=[stage / name for name in FIGURE_NAMES])
         figures.wait()                        # the report names the figures; they are complete here
     print(format_metrics_table(metrics))
+    if metrics.get("step_lowpass_s"):           # in waves: say on what the step metrics were judged
+        for line in textwrap.wrap(f"step metrics judged on the heading low-passed over {metrics['step_lowpass_s']:g}"
+                                  f" s: the sea's wave-frequency yaw (std {metrics['wave_yaw_std_deg']:.2f} deg) is "
+                                  "not the autopilot's to take out (docs/environment.md)", 86):
+            say(line)
     hint = ro.tracking_hint(metrics, setup.ship.name)
     for line in textwrap.wrap(hint or "", 86):    # within the output width with the time prefix
         say(line)

@@ -9,7 +9,8 @@ cost field. The expression is evaluated element-wise over numpy arrays of metric
 value per run) by walking the tree, never by ``eval``.
 
 Metric names (one definition: :func:`steerlab.metrics.integral_metrics` on the batch
-engine's on-line accumulator, and :func:`steerlab.metrics.step_metrics` on a recorded log):
+engine's on-line accumulator, and :func:`steerlab.metrics.step_metrics_in_waves` on a recorded log,
+which judges the step on the heading low-passed over 60 s when the run is in waves):
 
 =============  ==========  ==========================================================
 name           unit        meaning
@@ -49,7 +50,7 @@ import numpy as np
 from steerlab.errors import InputError
 from steerlab.guidance.reference_vector import REF_PSI
 from steerlab.ships.state import IPSI
-from steerlab.metrics import integral_metrics, step_metrics
+from steerlab.metrics import integral_metrics, step_metrics_in_waves
 from steerlab.metrics_online import M_D2_DEG, M_E2_DEG
 
 PENALTY = 1e12
@@ -188,7 +189,7 @@ def metric_arrays(acc: np.ndarray, lam: float, names, time=None, states=None, re
         st = np.empty(n)
         mr = np.empty(n)
         for i in range(n):
-            sm = step_metrics(time, states[i, :, IPSI], ref[i, :, REF_PSI])
+            sm = step_metrics_in_waves(time, states[i, :, IPSI], ref[i, :, REF_PSI])
             if sm["overshoot_pct"] is None and names & {"overshoot", "settling"}:
                 raise InputError("--cost", "'overshoot' and 'settling' are measured from a set-point change; "
                                  "the scenario's [guidance] has none (add changes = [...])")

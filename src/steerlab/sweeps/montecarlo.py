@@ -4,7 +4,8 @@ The scenario is run ``n_runs`` times with seeds ``scenario.seed + i`` (each seed
 realisation of the sampled disturbances, e.g. the eq-39 coloured noise), in compiled batches
 of up to :data:`CHUNK_RUNS` runs (:class:`~steerlab.sim.batch.PackedBatch`). For every metric of
 :func:`steerlab.metrics.integral_metrics` (exact, from the on-line accumulator) and of
-:func:`steerlab.metrics.step_metrics` plus the final error and the largest rudder angle
+:func:`steerlab.metrics.step_metrics_in_waves` (judged on the low-passed heading in waves) plus
+the final error and the largest rudder angle
 (from the recorded log, every ``record_every`` steps) it reports
 
 * mean, standard deviation, min, max, the 5/25/50/75/95 % percentiles, and
@@ -25,7 +26,7 @@ import numpy as np
 from steerlab.angles import wrap_to_pi_array
 from steerlab.errors import InputError
 from steerlab.guidance.reference_vector import REF_PSI
-from steerlab.metrics import METRIC_UNITS, R2D, integral_metrics, step_metrics
+from steerlab.metrics import METRIC_UNITS, R2D, integral_metrics, step_metrics_in_waves
 from steerlab.progress import runs_progress
 from steerlab.ships.state import IPSI
 from steerlab.sweeps.conditions import condition_set
@@ -183,7 +184,7 @@ def run_montecarlo(scenario, n_runs: int, lam: float = 0.1, record_every: int | 
         for i in range(m):
             mt = integral_metrics(out.acc[i], lam)
             mt.pop("lambda")
-            mt.update(step_metrics(out.time, out.states[i, :, IPSI], out.ref[i, :, REF_PSI]))
+            mt.update(step_metrics_in_waves(out.time, out.states[i, :, IPSI], out.ref[i, :, REF_PSI]))
             mt["final_error_deg"] = float(err[start + i, -1])
             mt["max_abs_rudder_deg"] = float(np.max(np.abs(rud[start + i])))
             for k, v in mt.items():
