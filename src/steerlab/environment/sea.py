@@ -114,17 +114,18 @@ def spectrum_components(cfg, speed: float, seed: int):
 def yaw_gain(cfg, ship) -> tuple[float, float]:
     """``(L [m], yaw acceleration per unit slope [1/s^2])``: configured, or Daidola-Graham's estimate.
 
-    A ship without beam or block coefficient (the thesis catalogue's Nomoto and Norrbin
-    entries) has no estimate: that is one error on the setting that replaces it.
+    A ship without beam or block coefficient (the thesis catalogue's Nomoto, Norrbin and Bech
+    entries) gets the estimate of a typical hull of its length (``80/L``,
+    :mod:`steerlab.environment.typical_hull`, warned about by :func:`steerlab.sim.sanity.scenario_warnings`);
+    a ship without a length is one error on the setting that replaces it.
     """
+    from steerlab.environment.typical_hull import hull_gain
+
     c_B, L, B = ship.dims
     if cfg.yaw_accel_per_slope is not None:
         return L, cfg.yaw_accel_per_slope
-    if not (math.isfinite(B) and math.isfinite(c_B)):
-        raise InputError(f"{F}.yaw_accel_per_slope",
-                         f"ship {ship.name!r} has no beam and block coefficient, so the waves' yaw gain cannot be "
-                         "estimated (Daidola-Graham); set it [1/s^2], allowed range [0, 100], or turn the waves off")
-    return L, daidola_gain(L, B, c_B)
+    L, gain, _ = hull_gain(ship.name, ship.dims)
+    return L, gain
 
 
 _CODES = {"yaw_rate": W_YAW_RATE, "yaw_moment": W_YAW_MOMENT, "rudder": W_RUDDER}

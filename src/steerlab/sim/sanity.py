@@ -13,10 +13,14 @@ Field ranges (pydantic) cannot see combinations or units typed wrong. Here:
     check of :mod:`steerlab.sim.divergence` then reports);
   - a rudder limit below :data:`MIN_RUDDER_DEG` degrees or a rudder rate below
     :data:`MIN_RUDDER_RATE_DEG_S` deg/s in a degree field: "did you type radians?"
-    (35 deg = 0.61 rad; 2.33 deg/s = 0.041 rad/s).
+    (35 deg = 0.61 rad; 2.33 deg/s = 0.041 rad/s);
+  - spectrum waves on a ship without beam and block coefficient: the waves' yaw gain is a
+    typical hull's of its length (:mod:`steerlab.environment.typical_hull`).
 """
 
 from __future__ import annotations
+
+import math
 
 from steerlab.errors import InputError
 from steerlab.units import KNOT, knots_to_ms
@@ -56,4 +60,11 @@ def scenario_warnings(s) -> list[str]:
         val = s.gear.rate_max_deg_s
         out.append(f"gear.rate_max_deg_s: a rudder rate of {val:g} deg/s is below {MIN_RUDDER_RATE_DEG_S:g} deg/s; "
                    f"did you type radians? ({val:g} rad/s = {val * 57.29577951308232:.3g} deg/s)")
+    wave = getattr(s.environment, "wave", None)
+    if wave is not None and wave.model == "spectrum" and wave.yaw_accel_per_slope is None:
+        from steerlab.environment.typical_hull import has_hull_data, typical_hull_warning
+
+        L = ship.dims[1]
+        if not has_hull_data(ship.dims) and math.isfinite(L) and L > 0.0:
+            out.append(typical_hull_warning(ship.name, L))
     return out
