@@ -29,7 +29,7 @@ def test_default_scenario():
     sc = default_scenario()
     assert isinstance(sc, Scenario)
     assert default_scenario_path().name == "default.toml"
-    assert sc.controller.type == "adrc" and sc.ship.model == "esso"
+    assert sc.controller.type == "adrc+wf" and sc.ship.model == "esso"
     assert sc.n_steps == 15000
     # a sea that moves the ship: JONSWAP, sea state 6, 45 deg off the bow (the eq (39) noise of
     # the default up to 0.1.0 is examples/scenarios/calm_default.toml)
@@ -37,8 +37,20 @@ def test_default_scenario():
     assert (wave.model, wave.spectrum, wave.sea_state, wave.wave_angle_deg) == ("spectrum", "jonswap", 6, 45.0)
     assert sc.environment.waves is False
     s = build(sc)
-    assert s.w.shape == (15001, N_CHANNELS) and s.nc == 1
-    assert s.pc[A_C0] == pytest.approx(9.18e-4, rel=5e-3)      # c0 by eq (29), steerlab sign
+    assert s.w.shape == (15001, N_CHANNELS) and s.nc == 10      # the autopilot samples every 1 s
+    # every ADRC setting is given in the file, equal to what the ship gives today: c0 by eq (29)
+    # (steerlab sign) and the filter's Nomoto model of the linearisation at 16 kn
+    from steerlab.control.wave_filtered import OFF_P, P_K, P_T
+    from steerlab.ships.registry import get_ship
+
+    esso = get_ship("esso")
+    v = knots_to_ms(16.0)
+    assert set(sc.controller.model_fields_set) >= {"T_settle", "c0", "L", "law", "kd_rule", "u_max_deg",
+                                                   "sample_time", "filter_K", "filter_T", "wave_filter"}
+    assert s.pc[OFF_P + A_C0] == pytest.approx(esso.b2(v, "estimate"), rel=1e-4)
+    K, T = esso.nomoto(v)
+    assert (s.pc[P_K], s.pc[P_T]) == (pytest.approx(K, rel=1e-4), pytest.approx(T, rel=1e-4))
+    assert s.pc[OFF_P + A_UMAX] == pytest.approx(rad(20.0))
 
 
 def test_defaults_and_frozen():

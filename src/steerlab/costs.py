@@ -10,7 +10,7 @@ value per run) by walking the tree, never by ``eval``.
 
 Metric names (one definition: :func:`steerlab.metrics.integral_metrics` on the batch
 engine's on-line accumulator, and :func:`steerlab.metrics.step_metrics_in_waves` on a recorded log,
-which judges the step on the heading low-passed over 60 s when the run is in waves):
+which judges the step on the heading low-passed over 90 s when the run is in waves):
 
 =============  ==========  ==========================================================
 name           unit        meaning

@@ -14,10 +14,11 @@ psi), delta the actual rudder angle; rectangle rule on the simulation grid):
   has no step metrics (``None``, printed "n/a"); to time the rejection of a disturbance use
   :func:`settling_time` with ``t0`` = its onset.
 * in waves (the wave-frequency yaw after the change has a std of 0.05 deg or more) the step
-  metrics of a recorded run are judged on the heading low-passed by a centred 60 s mean
-  (:func:`step_metrics_in_waves`, :mod:`steerlab.metrics_waves`); ``wave_yaw_std_deg`` and
-  ``step_lowpass_s`` (60 in waves, 0 otherwise) say which. :func:`step_metrics` itself, which
-  the paper experiments and the tuning costs call, always judges the raw heading.
+  metrics of ``steerlab run``, Monte-Carlo and the tuning costs are judged on the heading
+  low-passed by a 90 s zero-phase Savitzky-Golay smoother (:func:`step_metrics_in_waves`,
+  :mod:`steerlab.metrics_waves`); ``wave_yaw_std_deg`` and ``step_lowpass_s`` (90 in waves,
+  0 otherwise) say which. :func:`step_metrics` itself, which the paper experiments call,
+  always judges the raw heading.
 """
 
 from __future__ import annotations
@@ -160,10 +161,11 @@ def step_metrics_in_waves(time, psi, psi_ref) -> dict:
     Returns
     -------
     dict
-        The keys of :func:`step_metrics` plus ``wave_yaw_std_deg`` (std of the heading about its
-        centred 60 s mean after the last change [deg]) and ``step_lowpass_s`` (the mean's length
-        [s] when the step metrics were judged on the low-passed heading, i.e. when
-        ``wave_yaw_std_deg >= 0.05``; else 0 and the step metrics are :func:`step_metrics`'s).
+        The keys of :func:`step_metrics` plus ``wave_yaw_std_deg`` (std of the heading about
+        its 90 s zero-phase low-pass in the second half of the record after the last change
+        [deg]) and ``step_lowpass_s`` (the low-pass' window [s] when the step metrics were
+        judged on the low-passed heading, i.e. when ``wave_yaw_std_deg >= 0.05``; else 0 and
+        the step metrics are :func:`step_metrics`'s).
         Both are ``None`` without a set-point change. Definitions and the threshold's reason:
         :mod:`steerlab.metrics_waves`.
     """
