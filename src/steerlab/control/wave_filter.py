@@ -44,6 +44,15 @@ phase lag. ``k_r = k_psi^2/(2 - k_psi)`` is the steady-state relation of the alp
 (Kalman) tracker of Benedict and Bordner (1962). ``xi`` is also the noise level used for gain
 scheduling of ASA (eqs 4.5, 4.86, 4.87, 4.91).
 
+Tuning for a sea (the settings are not scaled by the sample time ``h``): the innovation is a
+*one-sample* prediction error, so its powers and the floor ``P0`` depend on ``h``; at
+``h = 0.1 s`` in sea state 6 on the Esso the high-frequency power is about 2e-9 rad^2, below
+the default ``P0 = 1e-8``, and the filter passes the heading through (``xi ~ 0.9``). The LF/HF
+split lets ``1 / (1 + (w_e T_lf)^2)`` of the wave power (encounter frequency ``w_e``) into
+``P_L``, a floor on ``xi``: ``T_lf`` must be many encounter periods. The default scenario
+samples at 1 s with ``P0 = 1e-10``, ``T_lf = 60 s``, ``xi_min = 0.002`` (docs/controllers-asa.md,
+"Tuning the filter for a sea"). The defaults below are kept: ASA and the experiments use them.
+
 State record ``zf`` (:data:`STATE`: ``N_WF`` floats, ``F_*`` indices) and parameter record
 ``pf`` (:data:`PARAMS`: ``N_WF_PARAMS`` floats, ``WF_*`` indices; :class:`WaveFilterParams`), both
 declared once (:mod:`steerlab.records`); the parameters' bounds, defaults and units also give
