@@ -222,19 +222,26 @@ def test_b2_estimate_needs_dimensions_exact_is_k_over_t():
     assert get_ship("tanker-176k-model-norrbin").b2(knots_to_ms(3.1), "estimate") > 0
 
 
-def test_spectrum_waves_on_a_ship_without_beam_name_the_yaw_gain_setting():
+def test_spectrum_waves_on_a_ship_without_beam_take_the_typical_hull_and_say_so():
     """The waves' yaw gain is Daidola-Graham's estimate from beam and block coefficient, which
-    the thesis entries do not give: the error names the setting that replaces it (it named
-    ``ship.dims B``, which no scenario can set); with the setting given, the waves run."""
+    the thesis entries do not give: they take a typical hull of their length (80/L 1/s^2,
+    steerlab.environment.typical_hull), and the run warns naming the setting that replaces it;
+    with the setting given, the sea scales with it and nothing is warned."""
+    from steerlab.environment.typical_hull import typical_gain
+    from steerlab.sim.sanity import scenario_warnings
+
     sea = {"model": "spectrum", "sea_state": 5}
     scenario = {"ship": {"model": "capella-nomoto-10deg", "speed_kn": 12.0}, "controller": {"type": "pid"},
                 "environment": {"wave": sea}}
-    with pytest.raises(InputError, match=r"^environment\.wave\.yaw_accel_per_slope: ship 'capella-nomoto-10deg' "
-                                         r"has no beam and block coefficient.*allowed range \[0, 100\]"):
-        build(scenario_from_dict(scenario))
+    sc = scenario_from_dict(scenario)
+    (line,) = [w for w in scenario_warnings(sc) if w.startswith("environment.wave.yaw_accel_per_slope: ")]
+    assert "ship 'capella-nomoto-10deg' has no beam and block coefficient" in line and "L 60 m" in line
+    typical = build(sc).w
     scenario["environment"]["wave"] = {**sea, "yaw_accel_per_slope": 0.02}
-    s = build(scenario_from_dict(scenario))
-    assert np.abs(s.w).max() > 0.0                     # the sea is there
+    given = build(scenario_from_dict(scenario)).w
+    assert not [w for w in scenario_warnings(scenario_from_dict(scenario)) if "yaw_accel_per_slope" in w]
+    assert np.abs(given).max() > 0.0                     # the sea is there
+    np.testing.assert_allclose(given, typical * (0.02 / typical_gain(60.0)), rtol=1e-9, atol=1e-9 * np.abs(given).max())
 
 
 # ------------------------------------------------------------------ CLI
