@@ -1,5 +1,5 @@
-"""First run: the bundled default scenario (Esso tanker + ADRC, 20 deg course change,
-then course keeping in a JONSWAP sea of sea state 6).
+"""First run: the bundled default scenario (Esso tanker + ADRC behind the wave filter, 20 deg
+course change, then course keeping in a JONSWAP sea of sea state 6).
 
 Teaches: load a scenario, simulate it, compute the metrics, plot heading and rudder.
 Equivalent command: ``steerlab run --out out/default``.
