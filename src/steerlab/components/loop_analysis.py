@@ -26,7 +26,8 @@ that reads the yaw acceleration ``r'`` (a model state) gets the plant's.
 :func:`loop_margins` breaks the loop at the plant input (the rudder order): the loop transfer
 function is ``L(z) = -C_y(z) P(z)`` with ``C_y`` the controller from ``[psi, r, delta]`` (for a
 PID law on Nomoto, ``L(s) ~ (Kp + Ki/s + Kd s) K / (s (T s + 1) (T_sg s + 1))``), and gives
-python-control's gain and phase margins (``control.stability_margins``), the delay margin
+python-control's gain and phase margins (``control.stability_margins`` of the loop's frequency
+response on a dense grid up to Nyquist, ``control.frd``), the delay margin
 ``PM / omega_gc`` [s] (the smallest over the gain crossovers), and the closed loop's
 ``-3 dB`` bandwidth from ``psi_ref`` to ``psi`` (``control.bandwidth``), all in rad/s and s.
 
@@ -58,6 +59,8 @@ if TYPE_CHECKING:
 INPUTS = ("psi", "r", "delta", "psi_ref")
 #: relative step of the central differences (an absolute step for values below 1)
 REL_STEP = 1e-6
+#: points of the frequency grid [1e-6 rad/s, Nyquist) the margins are searched on
+N_GRID = 6000
 #: margin floors: gain margin [-] (6 dB), phase margin [deg], delay margin [s] (module docstring)
 FLOORS = {"gain_margin": 2.0, "phase_margin_deg": 30.0, "delay_margin_s": 1.0}
 
@@ -297,11 +300,14 @@ def loop_margins(ctrl: Controller, m: DesignModel, second: Optional[dict] = None
     poles_cl = np.linalg.eigvals(np.asarray(closed.A))
     stable = bool(np.all(np.abs(poles_cl) < 1.0 - 1e-12))
     n_unstable = int(np.sum(np.abs(np.linalg.eigvals(np.asarray(L.A))) > 1.0 + 1e-12))
-    with warnings.catch_warnings():   # python-control's note that it fell back to its 'frd' method
+    nyq = math.pi / h
+    # on the frequency response (a dense grid up to Nyquist, crossings interpolated): the
+    # polynomial method finds spurious roots for a loop of ten or more states
+    grid = np.logspace(-6, math.log10(0.999 * nyq), N_GRID)
+    with warnings.catch_warnings():
         warnings.simplefilter("ignore", UserWarning)
         gms, pms, _, wpcs, wgcs, _ = (np.atleast_1d(np.asarray(v, dtype=float))
-                                      for v in control.stability_margins(L, returnall=True))
-    nyq = math.pi / h
+                                      for v in control.stability_margins(control.frd(L, grid), returnall=True))
     gm_pairs = [(g, w) for g, w in zip(gms, wpcs) if math.isfinite(g) and g > 0.0 and 0.0 < w < nyq]
     pm_pairs = [(p, w) for p, w in zip(pms, wgcs) if math.isfinite(p) and 0.0 < w < nyq]
     up = [gw for gw in gm_pairs if gw[0] >= 1.0]
