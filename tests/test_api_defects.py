@@ -116,3 +116,12 @@ def test_ships_show_gives_the_design_speed(capsys):
     assert main(["ships", "show", "kvlcc2", "--json"]) == 0
     d = json.loads(capsys.readouterr().out)
     assert math.isclose(d["design_speed_kn"], 15.5, abs_tol=1e-6)
+
+
+def test_linearize_command_defaults_to_the_design_speed(capsys):
+    assert main(["linearize", "kosoko", "--json"]) == 0          # 16 kn is outside its range
+    assert json.loads(capsys.readouterr().out)["speed_m_s"] == pytest.approx(0.5)
+    assert main(["linearize", "esso", "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["speed_kn"] == 16.0
+    assert main(["linearize", "esso", "--speed-kn", "-3"]) == 2
+    assert capsys.readouterr().err.count("\n") == 1
