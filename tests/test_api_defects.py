@@ -125,3 +125,10 @@ def test_linearize_command_defaults_to_the_design_speed(capsys):
     assert json.loads(capsys.readouterr().out)["speed_kn"] == 16.0
     assert main(["linearize", "esso", "--speed-kn", "-3"]) == 2
     assert capsys.readouterr().err.count("\n") == 1
+
+
+def test_controller_for_a_ship_without_speed_uses_the_design_speed():
+    assert sl.controller("pid", ship="kosoko").speed == pytest.approx(0.5)
+    assert sl.controller("pid", ship="esso").speed == knots_to_ms(16.0)
+    with pytest.raises(InputError, match="speed_kn"):
+        sl.controller("pid", ship="kosoko", speed_kn=16.0)        # outside its validity range

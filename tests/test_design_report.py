@@ -12,8 +12,8 @@ pytestmark = pytest.mark.skipif(importlib.util.find_spec("control") is None, rea
 
 from steerlab.cli import main  # noqa: E402
 from steerlab.components.controller import controller  # noqa: E402
-from steerlab.components.loop_analysis import (FLOORS, linearise_law, loop_margins, loop_systems,  # noqa: E402
-                                               margin_warnings, minimal_law)
+from steerlab.components.loop_analysis import FLOORS, linearise_law, loop_margins  # noqa: E402
+from steerlab.components.loop_analysis import loop_systems, margin_warnings, minimal_law  # noqa: E402
 from steerlab.control.design_model import design_model  # noqa: E402
 from steerlab.errors import InputError  # noqa: E402
 
