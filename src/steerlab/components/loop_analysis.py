@@ -10,7 +10,7 @@ the discrete state-space controller (sample time ``h``)::
     z_{k+1} = A z_k + B y_k,     delta_c,k = C z_k + D y_k,     y = [psi, r, delta, psi_ref]
 
 (``delta`` the rudder angle the gear has, which observer-based laws read; a law that does not
-read an input has a zero column). Plant states other than heading, yaw rate, surge speed and
+read an input has a zero column; :func:`fold_other_states` adds ``r'`` before ``psi_ref``). Plant states other than heading, yaw rate, surge speed and
 rudder are held at straight running (zero sway): the report says the loop is that of the
 design model, not of the ship's full model.
 
@@ -29,12 +29,13 @@ PID law on Nomoto, ``L(s) ~ (Kp + Ki/s + Kd s) K / (s (T s + 1) (T_sg s + 1))``)
 python-control's gain and phase margins (``control.stability_margins`` of the loop's frequency
 response on a dense grid up to Nyquist, ``control.frd``), the delay margin
 ``PM / omega_gc`` [s] (the smallest over the gain crossovers), and the closed loop's
-``-3 dB`` bandwidth from ``psi_ref`` to ``psi`` (``control.bandwidth``), all in rad/s and s.
+``-3 dB`` bandwidth from ``psi_ref`` to ``psi`` (as ``control.bandwidth`` defines it:
+:func:`discrete_bandwidth`), all in rad/s and s.
 
 Floors (:data:`FLOORS`): gain margin >= 2 (6 dB) and phase margin >= 30 deg, the usual
 minimum robustness of a single loop (Skogestad & Postlethwaite, Multivariable Feedback
-Control, 2nd ed. 2005, Sec. 2.4.3; Astrom & Murray, Feedback Systems, 2008, Sec. 9.3:
-"gm 2-5, pm 30-60 deg"); delay margin >= 1 s, steerlab's floor (no standard states one): a
+Control, 2nd ed. 2005, Sec. 2.4.3; Astrom & Murray, Feedback Systems, 2008, on typical gain
+margins of 2-5 and phase margins of 30-60 deg); delay margin >= 1 s, steerlab's floor (no standard states one): a
 heading sensor's filtering and a rudder order's transport on a bridge take a fraction of a
 second, and a loop that stands less than a second of delay it was not designed for is fragile.
 """
