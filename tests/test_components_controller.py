@@ -113,7 +113,7 @@ def test_designed_from_K_T_only_steers_a_plain_python_plant(law, cfg):
     ("sliding_mode", {"nomoto": (0.05, 80.0)}, "speed_kn"),    # mu = U/L
     ("sliding_mode", {"ship": "esso", "speed_kn": 16.0}, "nomoto"),   # course-unstable
     ("asa", {"ship": "esso", "speed_kn": 16.0}, "K_star0"),
-    ("pid", {"ship": "esso"}, "speed_kn"),
+    ("pid", {"ship": "kosoko", "speed_kn": 16.0}, "speed_kn"),      # outside its range (no speed: design speed)
     ("pid", {"ship": "esso", "speed_kn": 16.0, "nomoto": (0.1, 50.0)}, "nomoto"),
     ("pid", {"Kp": -1.0}, "Kp"),
     ("pid", {"Kq": 1.0}, "Kq"),

@@ -136,10 +136,14 @@ def cmd_linearize(args) -> int:
     from steerlab.ships.linear_analysis import linear_summary
     from steerlab.units import knots_to_ms
 
-    if not (math.isfinite(args.speed_kn) and 0.0 < args.speed_kn <= 40.0):
-        raise InputError("--speed-kn", f"must be in (0, 40] kn, got {args.speed_kn}")
     from steerlab.ships.registry import get_ship
 
+    if args.speed_kn is None:                   # the ship's design speed
+        from steerlab.components.linear import default_speed_kn
+
+        args.speed_kn = default_speed_kn(get_ship(args.ship))
+    if not (math.isfinite(args.speed_kn) and 0.0 < args.speed_kn <= 40.0):
+        raise InputError("--speed-kn", f"must be in (0, 40] kn, got {args.speed_kn}")
     if get_ship(args.ship).linearise is None:   # Nomoto/Norrbin/Bech ...: the model's own linear form
         from steerlab.components.linear import print_summary, summary
 
@@ -245,7 +249,8 @@ def build_parser() -> argparse.ArgumentParser:
                         description="Linearise a ship at a speed (Zwierzewicz et al. 2021, eqs 16-18, 29, 36).",
                         epilog=EXAMPLES["linearize"], formatter_class=fmt)
     lz.add_argument("ship", help="ship name, e.g. esso")
-    lz.add_argument("--speed-kn", type=float, default=16.0, help="speed [kn] (default 16)")
+    lz.add_argument("--speed-kn", type=float, default=None,
+                    help="speed [kn] (default: the ship's design speed, 16 kn for esso)")
     lz.add_argument("--json", action="store_true", help="print JSON")
     lz.set_defaults(func=cmd_linearize)
 

@@ -43,6 +43,13 @@ def _range(spec) -> str:
     return f"{ms_to_knots(lo):.3g}-{ms_to_knots(hi):.3g} kn"
 
 
+def _design_speed_kn(spec) -> float:
+    """The ship's design speed [kn] (:attr:`steerlab.ships.registry.ShipSpec.design_speed`)."""
+    from steerlab.units import ms_to_knots
+
+    return float(ms_to_knots(spec.design_speed))
+
+
 def list_rows() -> list[dict]:
     """One row per registered ship: id, model, validity range, source."""
     from steerlab.ships.registry import SHIPS
@@ -57,7 +64,7 @@ def show(ship_id: str) -> dict:
 
     spec = get_ship(ship_id)
     d = {"id": spec.name, "model": _kind(spec), "description": spec.description,
-         "source": spec.source, "range": _range(spec),
+         "source": spec.source, "range": _range(spec), "design_speed_kn": _design_speed_kn(spec),
          "states": [{"name": n, "unit": u} for n, u in zip(spec.state_names, spec.state_units)]}
     cat = getattr(spec, "catalogue", None)
     if cat:
@@ -90,6 +97,7 @@ def _print_show(d):
     print(textwrap.fill(f"{d['id']}: {d['description']}", width, subsequent_indent="  "))
     say("model", d["model"])
     say("range", d["range"])
+    say("design speed", f"{d['design_speed_kn']:.4g} kn (a scenario without speed_kn runs at it)")
     say("source", d["source"])
     say("states", ", ".join(f"{s['name']} [{s['unit']}]" for s in d["states"]))
     cat = d.get("catalogue")

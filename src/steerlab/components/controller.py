@@ -177,6 +177,23 @@ class Controller:
 
         return transfer_function(self)
 
+    def design_report(self) -> dict:
+        """The design report as a JSON-able dict (SI): design model, rule, gains, the linearised
+        loop's margins and bandwidth, warnings (:func:`steerlab.components.design_report.design_report`)."""
+        from steerlab.components.design_report import design_report
+
+        return design_report(self)
+
+    def describe(self, as_dict: bool = False) -> Union[str, dict]:
+        """The design report (docs/design-report.md): text, or with ``as_dict`` the dict of
+        :meth:`design_report`. A margin under its floor is a ``WARNING:`` line of the text."""
+        d = self.design_report()
+        if as_dict:
+            return d
+        from steerlab.components.design_report import format_report
+
+        return format_report(d)
+
     def vector(self, n: int) -> ControllerVector:
         """``n`` copies of this controller (same design, same state) stepped in one compiled call."""
         from steerlab.components.controller_vector import ControllerVector
@@ -189,7 +206,10 @@ def controller(type: str, *, ship: Optional[str] = None, speed_kn: Optional[floa
                gear: Union[SteeringGear, Mapping[str, float], None] = None, dt: float = 0.1,
                ship_options: Optional[Mapping[str, Any]] = None, length_m: Optional[float] = None,
                **cfg: Any) -> Controller:
-    """Design a registered controller (``steerlab controllers``) for a loop outside steerlab.
+    """Design a registered controller (``steerlab controllers`` lists them) for a loop outside steerlab.
+
+    ``describe()`` on the result shows its design model, rule, gains and the linearised loop's
+    margins (docs/design-report.md).
 
     Parameters
     ----------
@@ -198,7 +218,7 @@ def controller(type: str, *, ship: Optional[str] = None, speed_kn: Optional[floa
     ship : str, optional
         Design from catalogue ship ``ship`` (``steerlab ships``) at ``speed_kn`` ...
     speed_kn : float, optional
-        ... the ship's speed [kn] ...
+        ... the ship's speed [kn] (default: its design speed, ``ShipSpec.design_speed``) ...
     nomoto : tuple of float, optional
         ``(K [1/s], T [s])``: ... or from a first-order Nomoto model alone (``b2`` defaults
         to K/T [1/s^2]) ... (or neither, for laws that need no model, e.g. a fixed-gain ``pid``).

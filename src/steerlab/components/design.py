@@ -4,7 +4,8 @@ A controller's design rule (``ControllerSpec.build(cfg, ctx)``) reads the loop i
 from a :class:`~steerlab.control.design_context.DesignContext`. Outside a scenario that
 context is made here from one of:
 
-* ``ship=ID, speed_kn=U`` - a catalogue ship (``steerlab ships``) at its approach speed;
+* ``ship=ID, speed_kn=U`` - a catalogue ship (``steerlab ships``) at its approach speed (default:
+  the ship's design speed);
 * ``nomoto=(K, T)`` - a first-order Nomoto model alone (``T r' + r = K delta``, Nomoto 1957),
   realised as the ``nomoto1`` ship with those K [1/s], T [s] (and ``length_m``, default 100 m,
   for laws written in non-dimensional form). The rudder efficiency is ``b2 = K / T``
@@ -98,7 +99,7 @@ def design_context(ship: Optional[str] = None, speed_kn: Optional[float] = None,
     ship : str, optional
         Catalogue ship id (``steerlab ships``); exclusive with ``nomoto``.
     speed_kn : float, optional
-        Approach speed [kn]; required with ``ship``.
+        Approach speed [kn] (with ``ship``; default: the ship's design speed ``ShipSpec.design_speed``).
     nomoto : (float, float), optional
         First-order Nomoto ``(K [1/s], T [s])``; ``T < 0`` is a course-unstable model.
     b2 : float, optional
@@ -126,10 +127,14 @@ def design_context(ship: Optional[str] = None, speed_kn: Optional[float] = None,
     if ship is not None:
         spec = get_ship(ship) if isinstance(ship, str) else ship
         if speed_kn is None:
-            raise InputError("speed_kn", f"give the approach speed [kn] of ship {getattr(spec, 'name', ship)!r}")
+            design_speed = getattr(spec, "design_speed", None)
+            if design_speed is None:
+                raise InputError("speed_kn", f"give the approach speed [kn] of ship {getattr(spec, 'name', ship)!r}")
+            speed = float(design_speed)          # the ship's design speed (ShipSpec.design_speed)
         lo, hi = getattr(spec, "speed_range", (0.0, math.inf))
         if not lo <= speed <= hi:
-            raise InputError("speed_kn", f"{speed_kn} kn is outside ship {spec.name!r}'s validity range "
+            kn = speed_kn if speed_kn is not None else speed / knots_to_ms(1.0)
+            raise InputError("speed_kn", f"{kn:g} kn is outside ship {spec.name!r}'s validity range "
                                          f"[{lo / knots_to_ms(1.0):.4g}, {hi / knots_to_ms(1.0):.4g}] kn")
         opts = spec.options(ship_options) if hasattr(spec, "options") else ship_options
         if b2 is not None:

@@ -24,7 +24,6 @@ reference response of the law as run (no derivative kick) is the two-degree-of-f
 
 from __future__ import annotations
 
-import math
 from typing import TYPE_CHECKING, Any, Callable, Mapping, Optional, Union
 
 import numpy as np
@@ -32,7 +31,7 @@ from numpy.typing import ArrayLike
 
 from steerlab.errors import InputError, require_finite_range
 from steerlab.ships.registry import get_ship
-from steerlab.units import knots_to_ms
+from steerlab.units import knots_to_ms, ms_to_knots
 from steerlab.ships.state import IU
 
 if TYPE_CHECKING:
@@ -43,16 +42,9 @@ _REL_STEP = 1e-7
 
 
 def default_speed_kn(spec: ShipSpec) -> float:
-    """A ship's design speed [kn]: its catalogue entry's nominal speed, else the middle of its
-    validity range, else 16 kn (the Esso tanker's speed in Zwierzewicz et al. 2021, the CLI default)."""
-    cat = getattr(spec, "catalogue", None)
-    lo, hi = spec.speed_range
-    if cat is not None and "speed_range_kn" in cat:
-        lo_kn, hi_kn = cat["speed_range_kn"]
-        return 0.5 * (lo_kn + hi_kn)
-    if math.isfinite(hi) and hi > 0.0:
-        return 0.5 * (lo + hi) / knots_to_ms(1.0)
-    return 16.0
+    """A ship's design speed [kn]: :attr:`ShipSpec.design_speed` (the speed its source states,
+    else the middle of its validity range, else 16 kn)."""
+    return ms_to_knots(spec.design_speed)
 
 
 def jacobian(rhs: Callable[..., None], x0: np.ndarray, delta0: float, ps: np.ndarray,
@@ -168,7 +160,13 @@ def linearize(ship: Union[str, ShipSpec], speed_kn: Optional[float] = None, ship
 
     m = linear_model(ship, speed_kn, ship_options)
     return control.ss(m["A"], m["B"], m["C"], m["D"], states=list(m["states"]), inputs=list(m["inputs"]),
-                      outputs=list(m["outputs"]), name=f"{m['ship']}@{m['speed_kn']:g}kn")
+                      outputs=list(m["outputs"]), name=system_name(m["ship"], m["speed_kn"]))
+
+
+def system_name(ship: str, speed_kn: float) -> str:
+    """The python-control name of a ship's linear model: ``"b481@15p0648kn"`` (python-control
+    allows no ``.`` in a system name, so the decimal point of the speed is written ``p``)."""
+    return f"{ship}@{speed_kn:g}kn".replace(".", "p")
 
 
 def pid_gains(ctrl: Controller) -> tuple[float, float, float]:
@@ -182,11 +180,42 @@ def pid_gains(ctrl: Controller) -> tuple[float, float, float]:
     return float(p[C_KP]), float(p[C_KI]), float(p[C_KD])
 
 
-def transfer_function(ctrl: Controller) -> Any:
-    """``C(s) = Kp + Ki/s + Kd s`` of a PID-family :class:`Controller` as ``control.TransferFunction``
-    (input ``e`` heading error [rad], output ``delta_c`` rudder order [rad]; unsaturated)."""
+def transfer_function(obj: Union[Controller, str, ShipSpec], speed_kn: Optional[float] = None,
+                      ship_options: Optional[Mapping[str, Any]] = None) -> Any:
+    """A controller's ``C(s)`` or a ship's rudder-to-heading model as a ``control.TransferFunction``.
+
+    Parameters
+    ----------
+    obj : Controller, str or ShipSpec
+        A PID-family :class:`Controller`: ``C(s) = Kp + Ki/s + Kd s`` (input ``e`` heading
+        error [rad], output ``delta_c`` rudder order [rad]; unsaturated). A ship id
+        (``steerlab ships``) or spec: :func:`linearize` of it as a transfer function, input
+        ``delta`` [rad], outputs ``psi`` [rad] and ``r`` [rad/s].
+    speed_kn : float, optional
+        The ship's speed [kn] (default: its design speed); only with a ship.
+    ship_options : dict, optional
+        The ship's ``[ship.options]``; only with a ship.
+
+    Raises
+    ------
+    InputError
+        ``speed_kn``/``ship_options`` given with a controller; an object that is neither;
+        a controller that is not PID-family (``type``); an unknown ship.
+    """
     import control
 
+    from steerlab.components.controller import Controller
+    from steerlab.ships.registry import ShipSpec
+
+    if isinstance(obj, (str, ShipSpec)):
+        ss = linearize(obj, speed_kn, ship_options)
+        return control.ss2tf(ss, name=ss.name)
+    if not isinstance(obj, Controller):
+        raise InputError("transfer_function", "takes a Controller (sl.controller) or a ship id "
+                                              f"(steerlab ships), got {type(obj).__name__}")
+    if speed_kn is not None or ship_options is not None:
+        raise InputError("speed_kn", "only with a ship id; a controller's C(s) has no speed")
+    ctrl = obj
     kp, ki, kd = pid_gains(ctrl)
     if ki == 0.0:
         return control.tf([kd, kp], [1.0], inputs="e", outputs="delta_c", name=ctrl.type)

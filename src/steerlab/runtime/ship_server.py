@@ -115,13 +115,12 @@ class ShipServer:
                  origin=None, signalk_ws=None, allow_origins=()):
         from steerlab.sim.kernels import plant_step
         from steerlab.sim.setup import build
-        from steerlab.units import knots_to_ms
 
         self.config = config.validate()
         self.scenario = scenario
         self.setup = s = build(scenario)
         self.rk4_step = plant_step(s.ship.rhs)
-        self.speed = knots_to_ms(scenario.ship.speed_kn)
+        self.speed = scenario.ship.speed()
         self.ship_options = s.ship.options(scenario.ship.options)
         self.ps = s.ps.copy()
         self.rpm = float(scenario.ship.rpm) if scenario.ship.rpm is not None else math.nan

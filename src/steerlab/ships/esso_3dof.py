@@ -42,6 +42,7 @@ import numpy as np
 
 from steerlab.records import Field, Layout
 from steerlab.ships.kinematics import planar_start
+from steerlab.units import knots_to_ms
 from steerlab.ships.state import IR, IU, IV, N_PLANAR, PLANAR_NAMES, PLANAR_UNITS
 
 
@@ -231,7 +232,7 @@ def _ship_specs():
         rhs=esso_rhs, n_states=N_PLANAR, state_names=PLANAR_NAMES, state_units=PLANAR_UNITS,
         pack=_spec_pack, b2_exact=_spec_b2, dims=(t.c_B, t.L, t.B),
         source="Zwierzewicz, Dorobczynski, Artyszuk, Energies 14 (2021) 7937, Sec. 3.1",
-        linearise=linearise)]
+        linearise=linearise, service_speed=knots_to_ms(16.0))]   # Table 1: 16 kn service speed
 
 
 SHIP_SPECS = _ship_specs

@@ -523,7 +523,7 @@ def _spec_for(data: MMGShipData):
         state_names=PLANAR_NAMES, state_units=PLANAR_UNITS, pack=spec_pack, b2_exact=b2_exact,
         dims=(data.hull.C_b, data.hull.L, data.hull.B), source=data.source, linearise=linearise,
         options_model=MMGOptions, nomoto_KT=nomoto_KT, speed_range=tuple(data.speed_range_m_s),
-        kernel_for_options=kernel_for_options)
+        service_speed=float(data.design.speed_m_s), kernel_for_options=kernel_for_options)
 
 
 def get_mmg_data(name: str) -> MMGShipData:

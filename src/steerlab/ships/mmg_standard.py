@@ -49,7 +49,7 @@ import math
 import tomllib
 from functools import lru_cache
 from importlib import resources  # noqa: F401 (the data folder; tests read it through this module)
-from typing import Literal
+from typing import Literal, Optional
 
 import numba
 import numpy as np
@@ -132,6 +132,8 @@ class MMGStdShipData(FrozenConfig):
     description: str
     source: str
     speed_range_m_s: tuple[float, float]
+    #: the speed the source states [m/s] (``ShipSpec.service_speed``; None: none stated)
+    service_speed_m_s: Optional[float] = Field(None, gt=0.0)
     hull: MMGStdHull
     propeller: MMGStdPropeller
     rudder: MMGStdRudder
@@ -156,6 +158,9 @@ def load_mmgstd_data(text: str, name: str = "ship data") -> MMGStdShipData:
     lo, hi = data.speed_range_m_s
     if not (math.isfinite(lo) and math.isfinite(hi) and 0.0 < lo < hi):
         raise InputError(f"{name}: speed_range_m_s", "must be [lo, hi] with 0 < lo < hi, finite")
+    v = data.service_speed_m_s
+    if v is not None and not lo <= v <= hi:
+        raise InputError(f"{name}: service_speed_m_s", f"{v} m/s is outside speed_range_m_s [{lo}, {hi}]")
     return data
 
 
@@ -422,7 +427,7 @@ def _spec_for(data: MMGStdShipData):
         state_names=PLANAR_NAMES, state_units=PLANAR_UNITS, pack=spec_pack, b2_exact=b2_exact,
         dims=(data.hull.volume / (data.hull.L * data.hull.B * data.hull.d), data.hull.L, data.hull.B),
         source=data.source, linearise=linearise, nomoto_KT=nomoto_KT, speed_range=(lo, hi),
-        equilibrium_rudder=lambda speed, options=None: 0.0,
+        service_speed=data.service_speed_m_s, equilibrium_rudder=lambda speed, options=None: 0.0,
         symmetric=lambda speed, options=None: data.rudder.gamma_R_plus == data.rudder.gamma_R_minus
         and data.propeller.C_2_plus == data.propeller.C_2_minus)
 

@@ -61,6 +61,7 @@ from steerlab.records import Layout
 from steerlab.ships.kinematics import planar_start
 from steerlab.ships.rpm_schedule import RATE, check_rpm_schedule, pack_with_rate, scheduled_rate
 from steerlab.ships.state import IR, IU, IV, ship_state
+from steerlab.units import knots_to_ms
 
 
 COEFFICIENTS = Layout("mss-tanker coefficients", "K_", [
@@ -335,6 +336,7 @@ def _spec():
         dims=(c.c_B, c.L, c.B),
         source="Van Berlekom & Goddard, Trans. SNAME 80 (1972) 264-298, as in Fossen's MSS VESSELS/tanker.m",
         linearise=linearise, options_model=TankerOptions, nomoto_KT=nomoto_KT, speed_range=(2.0, 8.5),
+        service_speed=knots_to_ms(16.0),   # the Esso Osaka's service speed: tanker.m's 80 rpm at 8.23 m/s
         equilibrium_rudder=lambda speed, options=None: straight_equilibrium(speed, getattr(options, "depth_m", None))[2],
         symmetric=lambda speed, options=None: False,
         equilibrium_sway=lambda speed, options=None: straight_equilibrium(speed, getattr(options, "depth_m", None))[1])

@@ -9,6 +9,7 @@ package: :func:`register_ship`, the entry-point group ``steerlab.ships`` or the
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING, Any, Callable, Mapping, Optional
 
@@ -17,6 +18,11 @@ from pydantic import ValidationError
 from steerlab.errors import InputError
 from steerlab.plugins import PicklesByName, Registry
 from steerlab.ships.b2_estimate import b2_estimate
+from steerlab.units import knots_to_ms
+
+#: speed [kn] of a ship whose source states none and whose model has no finite validity
+#: range (the Esso tanker's service speed, Zwierzewicz et al. 2021, Table 1)
+DEFAULT_SPEED_KN = 16.0
 
 if TYPE_CHECKING:
     from steerlab.config_base import FrozenConfig
@@ -37,6 +43,9 @@ class ShipSpec(PicklesByName):
       Nomoto model (default: from ``linearise``). Ships with an ``options_model`` take the
       validated options as a second argument: ``b2_exact(speed, options)``,
       ``nomoto_KT(speed, options)`` (``options`` may be ``None``: the defaults).
+    * ``service_speed`` [m/s]: the speed its source states (a service or design speed, the
+      speed of the captive tests); :attr:`design_speed` is the speed a scenario without
+      ``speed_kn`` and a design without a speed use.
     """
 
     name: str
@@ -53,6 +62,8 @@ class ShipSpec(PicklesByName):
     options_model: type[FrozenConfig] | None = None
     nomoto_KT: Callable | None = None
     speed_range: tuple = (0.0, float("inf"))   #: validity range of the model [m/s]
+    #: the speed the ship's source states [m/s] (None: none stated; :attr:`design_speed`)
+    service_speed: float | None = None
     #: ``(speed, options) -> delta0 [rad]`` holding a straight course (None: 0, a symmetric hull)
     equilibrium_rudder: Callable | None = None
     #: ``(speed, options) -> bool``: whether delta -> -delta mirrors the response (None: True)
@@ -71,6 +82,27 @@ class ShipSpec(PicklesByName):
             return self
         rhs = self.kernel_for_options(options)
         return self if rhs is self.rhs else replace(self, rhs=rhs, recipe=(ShipSpec.for_options, (self, options)))
+
+    @property
+    def design_speed(self) -> float:
+        """The ship's design speed [m/s]: the speed a scenario without ``speed_kn`` runs at.
+
+        The rule (docs/ships.md, "Design speed"):
+
+        1. the speed the source states (:attr:`service_speed`: the Esso tanker's and MSS
+           tanker's 16 kn service speed, KVLCC2's 15.5 kn, the L7 model's 1.179 m/s, Kosoko's
+           0.5 m/s design point, ...);
+        2. else the middle of a finite validity range :attr:`speed_range` (a ship identified
+           at several speeds: the middle one; at one speed: that speed);
+        3. else 16 kn (8.2311 m/s), the Esso tanker's service speed (Zwierzewicz et al. 2021,
+           Table 1) and the scenario default up to 0.1.0.
+        """
+        if self.service_speed is not None:
+            return float(self.service_speed)
+        lo, hi = self.speed_range
+        if math.isfinite(hi) and hi > 0.0:
+            return 0.5 * (lo + hi)
+        return knots_to_ms(DEFAULT_SPEED_KN)
 
     def b2(self, speed: float, method: str, options: Optional[FrozenConfig] = None) -> float:
         """Rudder efficiency [1/s^2], steerlab sign: ``exact`` (linearisation) or ``estimate`` (eq 29).

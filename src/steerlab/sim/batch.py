@@ -43,6 +43,7 @@ from steerlab.sim.lanes import LANES
 if TYPE_CHECKING:
     import pandas
 
+    from steerlab.sim.scenario import Scenario
     from steerlab.sim.setup import SimSetup
 
 
@@ -255,15 +256,17 @@ class PackedBatch:
         return BatchResult(acc, X, np.arange(n_rec) * rec * self.dt, out_x, out_cmd, out_ref, self.state_names)
 
 
-def simulate_batch(setups: list[SimSetup], record_every: int | None = None, lanes: int = LANES,
+def simulate_batch(setups: "list[SimSetup | Scenario]", record_every: int | None = None, lanes: int = LANES,
                    progress: Optional[Callable[[int, int], None]] = None) -> BatchResult:
     """Run every setup with the compiled engine, in parallel over the available cores.
 
     The one batch front end: ``PackedBatch.from_setups(setups).run(record_every, progress, lanes)``.
+    Scenarios (e.g. ``sl.vary(...)``'s) are built first, each through the one design path
+    :func:`steerlab.sim.setup.build`, as :func:`steerlab.sim.engine.simulate` does.
 
     Parameters
     ----------
-    setups : list of :class:`~steerlab.sim.setup.SimSetup`
+    setups : list of :class:`~steerlab.sim.setup.SimSetup` or :class:`~steerlab.sim.scenario.Scenario`
         Same ship model, controller, guidance kind, ``dt``, sample time and duration.
     record_every : int, optional
         Log interval in steps (None: no log beyond the initial row).
@@ -277,7 +280,26 @@ def simulate_batch(setups: list[SimSetup], record_every: int | None = None, lane
     BatchResult
         ``.metrics`` is a pandas DataFrame, one row per run.
     """
-    return PackedBatch.from_setups(setups, "setups").run(record_every, progress, lanes)
+    return PackedBatch.from_setups(as_setups(setups), "setups").run(record_every, progress, lanes)
+
+
+def as_setups(items: "Iterable[SimSetup | Scenario]", what: str = "setups") -> list:
+    """``items`` as :class:`~steerlab.sim.setup.SimSetup` objects: a scenario is built with
+    :func:`steerlab.sim.setup.build`; anything else is an :class:`InputError` naming ``what[i]``."""
+    from steerlab.sim.scenario import Scenario
+    from steerlab.sim.setup import SimSetup, build
+
+    if isinstance(items, (str, bytes)) or not hasattr(items, "__iter__"):
+        raise InputError(what, f"needs a list of scenarios or setups, got {type(items).__name__}")
+    out = []
+    for i, item in enumerate(items):
+        if isinstance(item, Scenario):
+            item = build(item)
+        elif not isinstance(item, SimSetup):
+            raise InputError(f"{what}[{i}]", f"must be a Scenario (sl.load_scenario, sl.vary) or a SimSetup, "
+                                             f"got {type(item).__name__}")
+        out.append(item)
+    return out
 
 
 def vary_controller(setup: SimSetup, pc_rows: ArrayLike) -> list[SimSetup]:

@@ -23,7 +23,7 @@ from __future__ import annotations
 import math
 
 from steerlab.errors import InputError
-from steerlab.units import KNOT, knots_to_ms
+from steerlab.units import KNOT
 
 MIN_RUDDER_DEG = 2.0          #: smaller rudder limits [deg] are probably radians
 MIN_RUDDER_RATE_DEG_S = 0.2   #: smaller rudder rates [deg/s] are probably radians per second
@@ -44,9 +44,9 @@ def scenario_warnings(s) -> list[str]:
     out = []
     ship = get_ship(s.ship.model)
     lo, hi = ship.speed_range
-    v = knots_to_ms(s.ship.speed_kn)
+    v = s.ship.speed()
     if not (lo <= v <= hi):
-        out.append(f"ship.speed_kn: {s.ship.speed_kn:g} kn is outside the validity range of {ship.name!r} "
+        out.append(f"ship.speed_kn: {s.ship.speed_in_kn():g} kn is outside the validity range of {ship.name!r} "
                    f"({lo / KNOT:.3g}-{hi / KNOT:.3g} kn); the model is extrapolated")
     limits = [("gear.delta_max_deg", s.gear.delta_max_deg)]
     u_max = getattr(s.controller, "u_max_deg", None)

@@ -52,11 +52,28 @@ _Frozen = FrozenConfig
 
 class ShipConfig(_Frozen):
     model: str = "esso"
-    speed_kn: float = Field(16.0, ge=0.01, le=40.0, description="approach speed [kn], 0.01-40 kn")
+    speed_kn: Optional[float] = Field(None, ge=0.01, le=40.0,
+                                      description="approach speed [kn], 0.01-40 kn; default: the ship's design speed")
     rpm: Optional[float] = Field(None, gt=0.0, le=1000.0,
                                  description="propeller rate [rpm]; default: the rate that holds speed_kn")
     options: dict[str, Any] = Field(
         default_factory=dict, description="ship-specific options, validated by the ship's options_model")
+
+    def speed(self) -> float:
+        """The approach speed [m/s]: ``speed_kn``, else the ship's design speed
+        (:attr:`steerlab.ships.registry.ShipSpec.design_speed`; 16 kn for the Esso tanker)."""
+        from steerlab.ships.registry import get_ship
+        from steerlab.units import knots_to_ms
+
+        if self.speed_kn is not None:
+            return knots_to_ms(self.speed_kn)
+        return float(get_ship(self.model).design_speed)
+
+    def speed_in_kn(self) -> float:
+        """:meth:`speed` in knots (``speed_kn`` itself when it is given)."""
+        from steerlab.units import ms_to_knots
+
+        return self.speed_kn if self.speed_kn is not None else ms_to_knots(self.speed())
 
 
 class GearConfig(_Frozen):

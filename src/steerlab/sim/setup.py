@@ -18,7 +18,7 @@ from steerlab.sensors.wrapper import SUFFIX as SENSORS_SUFFIX
 from steerlab.sensors.wrapper import sensed_spec, with_sensors
 from steerlab.ships.registry import ShipSpec, get_ship
 from steerlab.steering_gear import SteeringGear
-from steerlab.units import knots_to_ms, rad
+from steerlab.units import rad
 from steerlab.ships.state import IPSI, IU, IX, IY
 
 
@@ -137,7 +137,7 @@ class Design:
     @classmethod
     def of(cls, s) -> "Design":
         ship = get_ship(s.ship.model)
-        speed = knots_to_ms(s.ship.speed_kn)
+        speed = s.ship.speed()             # speed_kn, else the ship's design speed
         ship_options = ship.options(s.ship.options)
         ship = ship.for_options(ship_options)
         ps = ship.pack(speed, s.ship.rpm, ship_options)
