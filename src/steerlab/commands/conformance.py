@@ -10,7 +10,7 @@ from __future__ import annotations
 
 EXAMPLES = """examples:
   steerlab conformance                                  # the whole matrix (a few minutes)
-  steerlab conformance --ships esso nomoto1 --controllers pid adrc
+  steerlab conformance --ships esso --controllers adrc
   steerlab conformance --sea-points design --json       # sea state 5 at the design speed only
   steerlab conformance --out out/conformance            # matrix.json + conformance.md"""
 

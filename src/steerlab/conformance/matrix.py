@@ -98,8 +98,8 @@ def cases(ships: Iterable[str] | None = None, controllers: Iterable[str] | None 
     """Every case of the matrix, ship-major (see the module docstring)."""
     from steerlab.ships.registry import get_ship
 
-    ships = builtin_ships() if ships is None else list(ships)
-    controllers = builtin_controllers() if controllers is None else list(controllers)
+    ships = builtin_ships() if ships is None else list(dict.fromkeys(ships))
+    controllers = builtin_controllers() if controllers is None else list(dict.fromkeys(controllers))
     sea_points = set(sea_points)
     out = []
     for ship in ships:
