@@ -23,8 +23,9 @@ keeps a margin below it). The run lasts ``RUN_SCALES t_s`` after the change, at 
 :data:`MIN_AFTER` and at most :data:`MAX_AFTER` seconds; the hold window (where the heading
 must stay) is the last ``HOLD_SCALES t_s``, at least :data:`MIN_HOLD` s, at most half the time
 after the change. A ship without a finite first-order model (``K/T`` not finite or not > 0)
-gets :data:`DEFAULT_TIME_SCALE`. For the catalogue this gives 16-25 s (Kosoko) to 2 700 s (the
-B-481 at 0.97 kn); most ships 60-170 s, i.e. 1 050-1 750 s runs.
+gets :data:`DEFAULT_TIME_SCALE`. For the catalogue's 76 points this gives 14 s (Kosoko at
+2.9 kn) to 2 230 s (the B-481 at 0.97 kn), half of them 63-113 s: most runs are the shortest,
+1 050 s; the Esso tanker at 8 kn runs 5 540 s, the slowest points 8 050 s.
 """
 
 from __future__ import annotations

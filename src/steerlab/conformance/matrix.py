@@ -13,9 +13,11 @@ the on-disk driver cache (docs/compile-cache.md); the catalogue's 26 ships share
 kernels and the 11 laws 9 law kernels (``pid``, ``gain_shaping_pid`` and ``lq_pd`` are one
 kernel with other gains), so a cold cache compiles about 90 loops, and that, not the runs,
 is the matrix's cost. The matrix uses the compiled single-run loop (``sl.simulate``), whose
-compile took 4-12 s per combination where the batch engine's vectorised group loop took
-15-28 s (measured on the 2-core CI machine while other jobs ran); a combination has only 3-6
-runs, too few for the vectorised loop to pay back. The numbers are the same either way (the
+compile took 1.7-3.7 s of CPU per combination where the batch engine's vectorised group loop
+took 4.3-6.7 s (four combinations measured); a combination has 6-18 runs of 1-8 thousand
+simulated seconds, too few for the vectorised loop to pay its compile back. The whole matrix
+(1 672 cases) took 148 s of CPU from an empty driver cache (the kernels' own numba cache
+warm, as after CI's ``.ci/warm-cache``): about 75 s on two idle cores. The numbers are the same either way (the
 engines are bit-identical, tests/test_engine.py). Combinations are spread over ``workers``
 processes (default: 2, or the machine's cores if fewer), one combination per task, so no two
 processes compile the same loop.
