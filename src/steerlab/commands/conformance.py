@@ -1,8 +1,8 @@
 """``steerlab conformance``: every catalogue ship x every built-in law x calm and sea state 5.
 
-Runs the conformance matrix (:mod:`steerlab.conformance`): a 20 deg course change per case,
-judged steers / refused (one line naming a field) / fails (with the reason); prints the counts
-per law. ``--out DIR`` writes ``matrix.json`` (every case) and ``conformance.md`` (the page of
+Runs the conformance matrix (steerlab.conformance): a 20 deg course change per case, judged
+steers / refused (one line naming a field) / fails (with the reason); prints the counts per
+law. --out DIR writes matrix.json (every case) and conformance.md (the page of
 docs/conformance.md).
 """
 
