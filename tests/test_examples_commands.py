@@ -139,6 +139,8 @@ def _smaller(argv):
     if cmd == "serve-ship" and "--bind" not in argv:
         # the default 127.0.0.1:47110, made a free port by _ports: parallel test workers must not share it
         argv = argv + ["--bind", "127.0.0.1:47110"]
+    if cmd == "conformance":      # one ship, one law (a pair the CI cache warms), in this process
+        argv = _set(_set(_set(argv, "--ships", "nomoto1"), "--controllers", "pid"), "--workers", 1)
     if cmd == "cache" and "warm" in argv:
         argv = _set(_set(argv, "--ships", "nomoto1"), "--controllers", "pid")
     return argv

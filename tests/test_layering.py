@@ -21,7 +21,7 @@ def _package_imports(pkg: str) -> set:
 
 
 def test_library_does_not_import_the_cli():
-    for pkg in ("sim", "sweeps", "tuning", "control", "ships", "trials", "guidance", "environment"):
+    for pkg in ("sim", "sweeps", "tuning", "control", "ships", "trials", "guidance", "environment", "conformance"):
         bad = {m for m in _package_imports(pkg) if m == "steerlab.cli"}
         assert not bad, f"steerlab.{pkg} imports the CLI"
 

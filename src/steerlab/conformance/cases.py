@@ -1,0 +1,126 @@
+r"""One cell of the conformance matrix and the scenario it runs.
+
+A :class:`Case` is (ship, controller, operating point, sea). Its scenario is the one a new
+user would write: the ship at that point, the controller with its **default settings**
+(``[controller] type = ...`` and nothing else), the scenario's default steering gear
+(:data:`GEAR`: 35 deg, 2.33 deg/s, servo 1 s), ``dt`` = :data:`DT`, and a course change of
+:data:`~steerlab.conformance.judge.CHANGE_DEG` to starboard at :data:`T_CHANGE`. The sea is
+calm, or a JONSWAP spectrum of WMO sea state 5 (Hs 3.25 m, Tp 9.7 s) from 45 deg off the bow,
+seed :data:`SEA_SEED` (:data:`SEA`).
+
+How long it runs follows the ship, not the law (:func:`time_scale`): a heading loop on the
+first-order Nomoto model ``r' = -r/T + (K/T) delta`` cannot be much faster than the gear lets
+it turn the ship through the change, so the time scale is ``t_s = 2 pi / omega_g`` with
+
+.. math::
+
+    \omega_g = \min\Big(\sqrt{\delta_{max} b / \Delta\psi},\ (\dot\delta_{max} b / \Delta\psi)^{1/3}\Big),
+    \qquad b = |K / T|
+
+(the natural frequency at which a PD loop's step of ``Delta psi`` asks for the whole rudder,
+or for the rudder at its whole rate within ``1/omega``; cf. ``control/design_model.py``, which
+keeps a margin below it). The run lasts ``RUN_SCALES t_s`` after the change, at least
+:data:`MIN_AFTER` and at most :data:`MAX_AFTER` seconds; the hold window (where the heading
+must stay) is the last ``HOLD_SCALES t_s``, at least :data:`MIN_HOLD` s, at most half the time
+after the change. A ship without a finite first-order model (``K/T`` not finite or not > 0)
+gets :data:`DEFAULT_TIME_SCALE`. For the catalogue's 76 points this gives 14 s (Kosoko at
+2.9 kn) to 2 230 s (the B-481 at 0.97 kn), half of them 63-113 s: most runs are the shortest,
+1 050 s; the Esso tanker at 8 kn runs 5 540 s, the slowest points 8 050 s.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from steerlab.conformance.judge import CHANGE_DEG
+from steerlab.conformance.points import OperatingPoint
+
+DT = 0.1
+"""Integration step and controller sample time [s] (the scenario default)."""
+T_CHANGE = 50.0
+"""Time of the course change [s]."""
+RUN_SCALES = 10.0
+"""Run length after the change, in time scales ``t_s``."""
+HOLD_SCALES = 3.0
+"""Hold window, in time scales ``t_s``."""
+MIN_AFTER, MAX_AFTER = 1000.0, 8000.0
+"""Bounds of the run length after the change [s]."""
+MIN_HOLD = 300.0
+"""Shortest hold window [s]."""
+DEFAULT_TIME_SCALE = 300.0
+"""Time scale [s] of a ship without a finite first-order Nomoto model at the point."""
+CALM, SEA5 = "calm", "sea5"
+SEAS = (CALM, SEA5)
+SEA = {"model": "spectrum", "spectrum": "jonswap", "sea_state": 5, "wave_angle_deg": 45.0}
+"""``[environment.wave]`` of the sea leg."""
+SEA_SEED = 1
+"""Seed of the sea realisation (one realisation per case)."""
+
+
+def _default_gear() -> dict:
+    from steerlab.sim.scenario import GearConfig
+
+    return GearConfig().model_dump()
+
+
+GEAR = _default_gear()
+"""``[gear]``: the scenario's default steering gear (degrees at the edge)."""
+
+
+@dataclass(frozen=True)
+class Case:
+    """One cell: ship id, controller type, operating point and sea (``"calm"`` or ``"sea5"``)."""
+
+    ship: str
+    controller: str
+    point: OperatingPoint
+    sea: str
+
+    @property
+    def key(self) -> tuple:
+        """``(ship, controller, point label, sea)``."""
+        return (self.ship, self.controller, self.point.label, self.sea)
+
+
+def point_nomoto(spec, point: OperatingPoint) -> tuple[float, float]:
+    """First-order Nomoto ``(K [1/s], T [s])`` of ``spec`` at ``point`` (NaN if it has none)."""
+    try:
+        options = spec.options({"rpm": point.rpm} if point.rpm is not None else None)
+        return tuple(float(x) for x in spec.nomoto(point.speed, options))
+    except Exception:  # noqa: BLE001 - any ship without a model there: the default time scale
+        return math.nan, math.nan
+
+
+def time_scale(spec, point: OperatingPoint, gear: dict | None = None) -> float:
+    """``t_s = 2 pi / omega_g`` [s] of the ship at the point with the gear (module docstring)."""
+    g = GEAR if gear is None else gear
+    K, T = point_nomoto(spec, point)
+    b = abs(K / T) if (math.isfinite(K) and math.isfinite(T) and T != 0.0) else math.nan
+    if not (math.isfinite(b) and b > 0.0):
+        return DEFAULT_TIME_SCALE
+    turn = math.radians(CHANGE_DEG)
+    w = min(math.sqrt(math.radians(g["delta_max_deg"]) * b / turn),
+            (math.radians(g["rate_max_deg_s"]) * b / turn) ** (1.0 / 3.0))
+    return 2.0 * math.pi / w
+
+
+def run_length(t_s: float) -> tuple[float, float]:
+    """``(duration [s], hold [s])`` of a run with time scale ``t_s`` (module docstring)."""
+    after = min(max(RUN_SCALES * t_s, MIN_AFTER), MAX_AFTER)
+    hold = min(max(HOLD_SCALES * t_s, MIN_HOLD), 0.5 * after)
+    return T_CHANGE + after, hold
+
+
+def scenario_dict(case: Case, duration: float) -> dict:
+    """The scenario of ``case`` as a plain dict (the TOML shape; degrees and knots)."""
+    ship = {"model": case.ship, "speed_kn": case.point.speed_kn}
+    if case.point.rpm is not None:
+        ship["options"] = {"rpm": case.point.rpm}
+    d = {"name": f"conformance-{case.ship}-{case.controller}-{case.point.label}-{case.sea}",
+         "seed": SEA_SEED, "dt": DT, "duration": duration, "ship": ship, "gear": dict(GEAR),
+         "controller": {"type": case.controller},
+         "guidance": {"psi0_deg": 0.0, "changes": [{"t": T_CHANGE, "psi_deg": CHANGE_DEG}]}}
+    if case.sea == SEA5:
+        d["environment"] = {"wave": dict(SEA)}
+    return d
