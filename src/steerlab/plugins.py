@@ -230,14 +230,15 @@ class Registry(Mapping[str, S]):
 
     def _derive(self, spec) -> list[S]:
         """``derive(spec)``, made once per spec object (a derived spec is one object too)."""
-        if self.derive is None:
+        derive = self.derive
+        if derive is None:
             return []
-        if isinstance(self.derive, str):
-            module, _, name = self.derive.partition(":")
-            self.derive = getattr(importlib.import_module(module), name)
+        if isinstance(derive, str):
+            module, _, name = derive.partition(":")
+            derive = self.derive = getattr(importlib.import_module(module), name)
         known = self._derived.get(spec.name)
         if known is None or known[0] is not spec:
-            known = self._derived[spec.name] = (spec, list(self.derive(spec)))
+            known = self._derived[spec.name] = (spec, list(derive(spec)))
         return known[1]
 
     def _add(self, found: dict, spec, origin: str, replace: bool = False) -> None:
