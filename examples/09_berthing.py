@@ -13,6 +13,7 @@ PID gains, calm water; docs/guidance.md), built by
 import numpy as np
 
 from _common import figure, parse_args, save
+from steerlab.guidance.los import G_ACCEPT
 from steerlab.metrics import compute_metrics
 from steerlab.sim.engine import simulate
 from steerlab.sim.scenario import scenario_from_dict
@@ -48,7 +49,7 @@ gs = ax[0, 0].get_gridspec()
 ax[0, 0].remove()
 ax[1, 0].remove()
 trk = fig.add_subplot(gs[:, 0])
-draw_route(trk, plan.route, plan.gd[1], 1.0, plan.berth, plan.success_radius)
+draw_route(trk, plan.route, plan.gd[G_ACCEPT], 1.0, plan.berth, plan.success_radius)
 trk.plot(e, n, "C0", lw=1.2, label="track")
 L, B = res.meta["ship_dims"]
 draw_outlines(trk, n, e, res.psi, L, B, outline_interval(res, L, 10))

@@ -39,7 +39,7 @@ def test_plant_warm_covers_the_readable_loop_and_identifications_replay():
     from steerlab.identification.response import simulate_response
     from steerlab.sim.engine import simulate
     from steerlab.sim.setup import build
-    from steerlab.sim.warm import warm_plant, warm_scenario
+    from steerlab.warm import warm_plant, warm_scenario
     from steerlab.ships.registry import get_ship
 
     def use():
@@ -54,7 +54,7 @@ def test_plant_warm_covers_the_readable_loop_and_identifications_replay():
 
 
 def test_trial_warm_covers_a_zigzag_trial():
-    from steerlab.sim.warm import warm_trial
+    from steerlab.warm import warm_trial
     from steerlab.trials.api import run_trial
     from steerlab.trials.runner import TrialConditions
 
@@ -70,7 +70,7 @@ def test_scenario_warm_covers_its_single_run_and_batch():
     from steerlab.sim.batch import simulate_batch
     from steerlab.sim.scenario import load_scenario
     from steerlab.sim.setup import build
-    from steerlab.sim.warm import warm_scenario_file
+    from steerlab.warm import warm_scenario_file
 
     def use():
         setup = build(load_scenario(LOS_ROUTE))
@@ -88,7 +88,7 @@ from steerlab.control.registry import get_controller
 from steerlab.ships.registry import SHIPS, get_ship
 from steerlab.sim.engine import simulate
 from steerlab.sim.setup import build
-from steerlab.sim.warm import warm_pair, warm_plant, warm_scenario
+from steerlab.warm import warm_pair, warm_plant, warm_scenario
 
 ship = next(name for name in sorted(SHIPS) if get_ship(name).linearise is None)
 rhs, update = get_ship(ship).rhs, get_controller("adrc").update
@@ -123,7 +123,7 @@ from steerlab import fast_csv
 from steerlab.angles import wrap_to_pi
 from steerlab.cli import main
 from steerlab.ships.registry import get_ship
-from steerlab.sim.warm import warm_pair
+from steerlab.warm import warm_pair
 
 def signatures():
     kernels = [get_ship("esso").rhs, wrap_to_pi, *fast_csv._compile()]
@@ -157,7 +157,7 @@ def test_lanes_warm_covers_the_batch_at_that_group_size():
     more in this process (2 runs per group: a size .ci/warm-cache warms, so CI loads it)."""
     from steerlab.sim.batch import simulate_batch
     from steerlab.sim.setup import build
-    from steerlab.sim.warm import warm_pair, warm_scenario
+    from steerlab.warm import warm_pair, warm_scenario
 
     def use():
         setup = build(warm_scenario("nomoto1", "pid"))
@@ -190,7 +190,7 @@ def test_scenario_warm_with_plants_covers_the_plant_step_of_its_ships_options():
     from steerlab.sim.engine import simulate
     from steerlab.sim.scenario import load_scenario
     from steerlab.sim.setup import build
-    from steerlab.sim.warm import warm_scenario_file
+    from steerlab.warm import warm_scenario_file
 
     path = REPO / ".ci" / "warm" / "kosoko-rpm-schedule.toml"
 

@@ -5,8 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from steerlab.components.controller import controller
-from steerlab.components.controller_vector import controllers
+from steerlab.components.controller import controller, controllers
 from steerlab.errors import InputError
 from steerlab.sim.engine import simulate
 from steerlab.units import rad

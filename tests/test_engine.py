@@ -7,8 +7,8 @@ from steerlab.environment.channels import N_CHANNELS
 from steerlab.errors import InputError
 from steerlab.metrics_online import M_DURATION
 from steerlab.sim.batch import simulate_batch, vary_controller
-from steerlab.sim.engine import (online_metrics_from_result, simulate, simulate_compiled,
-                                 simulate_readable)
+from steerlab.metrics_online import online_metrics_from_result
+from steerlab.sim.engine import simulate, simulate_compiled, simulate_readable
 from steerlab.sim.setup import build
 from steerlab.units import knots_to_ms, rad
 

@@ -1,6 +1,8 @@
-"""Import layering: the library never imports the CLI; sweeps and tuning do not import each other both ways."""
+"""Import layering: the layers of the package (no import runs up a layer, no import circle), the library
+never imports the CLI, one design path."""
 
 import ast
+import re
 from pathlib import Path
 
 SRC = Path(__file__).resolve().parent.parent / "src" / "steerlab"
@@ -18,6 +20,254 @@ def _imports(path: Path) -> set:
 
 def _package_imports(pkg: str) -> set:
     return set().union(*(_imports(p) for p in (SRC / pkg).glob("*.py")))
+
+
+# ---------------------------------------------------------------- the house: layers and the import graph
+LAYERS = [
+    ("base", ["steerlab", "errors", "units", "angles", "records", "config_base", "sincos", "vecmath",
+              "textfile", "toml_input", "fast_csv", "arrow_table", "text_table", "progress", "messages",
+              "outputs", "plugins", "registry_index", "jit"]),
+    ("models", ["environment", "ships", "steering_gear", "metrics_online"]),
+    ("laws", ["guidance", "control", "sensors"]),
+    ("indices", ["metrics"]),
+    ("engine", ["sim"]),
+    ("analysis", ["costs", "report", "track_figures", "figure_worker", "sea_report", "resources", "trials",
+                  "identification", "sweeps", "tuning", "experiments"]),
+    ("front", ["components", "gym", "runtime", "testing", "bench"]),
+    ("commands", ["commands", "cli", "__main__", "warm"]),
+]
+"""steerlab's layers, lowest first, and the packages (or top-level modules) of each, named below
+``steerlab`` (``"steerlab"`` itself: the package's ``__init__``). A module may import its own
+layer and the layers below it, never a layer above; docs/architecture.md describes them."""
+
+TEMPLATES = {"steerlab.jit.driver_template": "engine", "steerlab.jit.env_template": "front"}
+"""Source files of generated modules, never imported by the library: :mod:`steerlab.jit.drivers`
+reads them as text and writes one module per combination, which imports the kernels it binds.
+They sit at the layer of what they bind (the engine's kernels; the gym's plant batch)."""
+
+
+def _module_names() -> dict:
+    """``{dotted name: path}`` of every module of the package."""
+    out = {}
+    for path in SRC.rglob("*.py"):
+        parts = list(path.relative_to(SRC.parent).with_suffix("").parts)
+        if parts[-1] == "__init__":
+            parts = parts[:-1]
+        out[".".join(parts)] = path
+    return out
+
+
+def _is_type_checking(node) -> bool:
+    return isinstance(node, ast.If) and "TYPE_CHECKING" in ast.unparse(node.test)
+
+
+def _steerlab_imports(path: Path, known: dict) -> list:
+    """``[(imported module, line, lazy)]``: every import of a steerlab module in ``path``, at
+    module level and inside functions (``lazy``) alike; an ``if TYPE_CHECKING:`` block is left
+    out (it never runs). ``from steerlab.x import y`` is an import of ``steerlab.x.y`` when that
+    is a module, of ``steerlab.x`` otherwise."""
+    out = []
+
+    def visit(node, lazy):
+        for ch in ast.iter_child_nodes(node):
+            if _is_type_checking(ch):
+                continue
+            inner = lazy or isinstance(ch, (ast.FunctionDef, ast.AsyncFunctionDef, ast.Lambda))
+            if isinstance(ch, ast.ImportFrom) and ch.module and ch.level == 0:
+                for a in ch.names:
+                    sub = f"{ch.module}.{a.name}"
+                    out.append((sub if sub in known else ch.module, ch.lineno, inner))
+            elif isinstance(ch, ast.Import):
+                out.extend((a.name, ch.lineno, inner) for a in ch.names)
+            assert not (isinstance(ch, ast.ImportFrom) and ch.level), f"{path}: relative import"
+            visit(ch, inner)
+
+    visit(ast.parse(path.read_text(encoding="utf-8")), False)
+    return [(m, n, lazy) for m, n, lazy in out if m == "steerlab" or m.startswith("steerlab.")]
+
+
+def import_graph() -> dict:
+    """``{module: {imported module: (line, lazy)}}`` over the modules of src/steerlab."""
+    known = _module_names()
+    graph: dict = {}
+    for mod, path in sorted(known.items()):
+        edges = graph.setdefault(mod, {})
+        for target, line, lazy in _steerlab_imports(path, known):
+            assert target in known, f"{mod}:{line} imports {target}, which is not a module of steerlab"
+            if target != mod and target not in edges:
+                edges[target] = (line, lazy)
+    return graph
+
+
+def unit(module: str) -> str:
+    """The package or top-level module a module belongs to (``steerlab.sim.engine`` -> ``sim``)."""
+    parts = module.split(".")
+    return parts[1] if len(parts) > 1 else "steerlab"
+
+
+LAYER_OF = {name: i for i, (_, names) in enumerate(LAYERS) for name in names}
+LAYER_NAMES = [name for name, _ in LAYERS]
+
+
+def layer(module: str) -> int:
+    if module in TEMPLATES:
+        return LAYER_NAMES.index(TEMPLATES[module])
+    return LAYER_OF[unit(module)]
+
+
+def circles(graph: dict) -> list:
+    """The strongly connected components of more than one node (Tarjan), each sorted."""
+    index: dict = {}
+    low: dict = {}
+    stack: list = []
+    on: set = set()
+    out = []
+
+    def strong(v):
+        index[v] = low[v] = len(index)
+        stack.append(v)
+        on.add(v)
+        for w in graph.get(v, ()):
+            if w not in index:
+                strong(w)
+                low[v] = min(low[v], low[w])
+            elif w in on:
+                low[v] = min(low[v], index[w])
+        if low[v] == index[v]:
+            comp = []
+            while True:
+                w = stack.pop()
+                on.discard(w)
+                comp.append(w)
+                if w == v:
+                    break
+            if len(comp) > 1:
+                out.append(sorted(comp))
+
+    for v in sorted(graph):
+        if v not in index:
+            strong(v)
+    return out
+
+
+COMMAND_LINE = {"cli", "commands", "__main__"}
+"""One unit in the package graph: the CLI loads its commands, the commands use its helpers
+(``staged_output``, ...); their modules still form no circle."""
+
+
+def _package(module: str) -> str:
+    if module in TEMPLATES:
+        return module                     # a template is its own node (it is never imported)
+    return "command line" if unit(module) in COMMAND_LINE else unit(module)
+
+
+def package_graph(graph: dict) -> dict:
+    """``{package: {packages it imports}}`` (top-level modules count as packages)."""
+    out: dict = {}
+    for mod, edges in graph.items():
+        for target in edges:
+            if _package(target) != _package(mod):
+                out.setdefault(_package(mod), set()).add(_package(target))
+    return out
+
+
+def upward_imports(graph: dict) -> list:
+    return [f"{mod}:{line} ({'in a function' if lazy else 'module level'}) imports {target}: "
+            f"{LAYER_NAMES[layer(mod)]} -> {LAYER_NAMES[layer(target)]}"
+            for mod, edges in sorted(graph.items()) for target, (line, lazy) in sorted(edges.items())
+            if layer(target) > layer(mod)]
+
+
+def test_every_package_and_top_level_module_has_one_layer():
+    names = [n for _, ns in LAYERS for n in ns]
+    assert len(names) == len(set(names)), "a package is in two layers"
+    units = {unit(m) for m in _module_names()}
+    assert units == set(names), f"not in a layer: {sorted(units - set(names))}; gone: {sorted(set(names) - units)}"
+
+
+def test_the_templates_are_never_imported():
+    graph = import_graph()
+    assert set(TEMPLATES) <= set(graph)
+    importers = [m for m, edges in graph.items() for t in edges if t in TEMPLATES]
+    assert not importers, importers
+
+
+def test_no_import_runs_up_a_layer():
+    """Counting imports inside functions too: a lazy import is still a dependency (it runs when
+    the function does); only ``if TYPE_CHECKING:`` blocks are left out."""
+    up = upward_imports(import_graph())
+    assert not up, "\n".join(up)
+
+
+def test_no_import_circles_between_modules_or_packages():
+    graph = import_graph()
+    assert not circles(graph), circles(graph)
+    assert not circles(package_graph(graph)), circles(package_graph(graph))
+
+
+def test_the_graph_sees_lazy_imports_circles_and_layers():
+    """The rules can fail: a function-level import is an edge, a circle is found, a step up is named."""
+    graph = import_graph()
+    assert graph["steerlab.metrics"]["steerlab.guidance.route_metrics"][1] is False
+    lazy = [(m, t) for m, edges in graph.items() for t, (_, is_lazy) in edges.items() if is_lazy]
+    assert len(lazy) > 50
+    assert circles({"a": {"b"}, "b": {"c"}, "c": {"a"}, "d": {"a"}}) == [["a", "b", "c"]]
+    probe = {"steerlab.metrics": {"steerlab.sim.engine": (147, True)}, "steerlab.sim.engine": {}}
+    assert upward_imports(probe) == ["steerlab.metrics:147 (in a function) imports steerlab.sim.engine: "
+                                     "indices -> engine"]
+    assert upward_imports({"steerlab.sim.engine": {"steerlab.metrics": (1, False)}}) == []
+    probe = {"steerlab.sim.result": {"steerlab.report": (101, True)}, "steerlab.report": {}}
+    assert upward_imports(probe) == ["steerlab.sim.result:101 (in a function) imports steerlab.report: "
+                                     "engine -> analysis"]
+    assert layer("steerlab.jit.drivers") == 0 and layer("steerlab.jit.driver_template") == LAYER_NAMES.index("engine")
+
+
+DOC = SRC.parent.parent / "docs" / "architecture.md"
+
+
+def _doc_sections() -> dict:
+    text = DOC.read_text(encoding="utf-8")
+    parts = re.split(r"^## ", text, flags=re.M)
+    return {p.split("\n", 1)[0].strip(): p for p in parts[1:]}
+
+
+def test_the_architecture_page_has_the_layers_of_the_code():
+    """docs/architecture.md's layer table is LAYERS, row by row, in order."""
+    table = [line for line in _doc_sections()["The layers"].splitlines() if line.startswith("| ")][1:]
+    rows = [(cells[0].strip(), re.findall(r"`([^`]+)`", cells[1]))
+            for cells in (line.strip("|").split("|") for line in table)]
+    assert rows == LAYERS
+
+
+def test_the_architecture_page_describes_every_package_once():
+    """Every package and top-level module of src/steerlab has one bullet in "What each package
+    does", and no bullet names a package that is gone."""
+    bullets = [line for line in _doc_sections()["What each package does"].splitlines() if line.startswith("* ")]
+    named = [n for line in bullets for n in re.findall(r"`([^`]+)`", line.split(":", 1)[0])]
+    assert len(named) == len(set(named)), sorted(n for n in named if named.count(n) > 1)
+    assert set(named) == {unit(m) for m in _module_names()}
+
+
+def test_every_file_and_name_on_the_architecture_page_exists():
+    """The files (``sim/setup.py``, ``environment/``) and the names beside them (``Design``,
+    ``realise``) the page points to are in the code."""
+    text = DOC.read_text(encoding="utf-8")
+    paths = set(re.findall(r"`([a-z_]+(?:/[a-z_]+)*(?:\.py|/))`", text))
+    assert len(paths) > 15
+    missing = [p for p in sorted(paths) if not ((SRC / p).exists() or (SRC.parent.parent / p).exists())]
+    assert not missing, missing
+    pairs = re.findall(r"`([a-z_/]+\.py)`, `(\w+)`", text)
+    assert len(pairs) >= 5
+    for path, name in pairs:
+        assert re.search(rf"^(class|def) {name}\b", (SRC / path).read_text(encoding="utf-8"), re.M), (path, name)
+    flow = _doc_sections()["One run: Scenario → Design → Realisation → Driver → Result"]
+    for stage in ("Scenario", "Design", "Realisation", "Driver", "Result"):
+        assert f"**{stage}**" in flow, stage
+
+
+def test_the_architecture_page_is_in_the_site_navigation():
+    nav = (SRC.parent.parent / "mkdocs.yml").read_text(encoding="utf-8")
+    assert re.search(r"^\s+- Architecture: architecture\.md$", nav, re.M)
 
 
 def test_library_does_not_import_the_cli():

@@ -9,8 +9,9 @@ import pytest
 from steerlab.metrics import (compute_metrics, integral_metrics, last_setpoint_change, settling_time,
                               speed_loss_J, step_metrics)
 from steerlab.metrics_online import (M_ABS_DELTA, M_D2_DEG, M_DURATION, M_E2_DEG, M_IAE, M_ISE, M_ITAE,
-                                     M_MAX_ABS_E, M_REVERSALS, M_TRAVEL, accumulate, new_accumulator)
-from steerlab.sim.engine import online_metrics_from_result, simulate_compiled, simulate_readable
+                                     M_MAX_ABS_E, M_REVERSALS, M_TRAVEL, accumulate, new_accumulator,
+                                     online_metrics_from_result)
+from steerlab.sim.engine import simulate_compiled, simulate_readable
 from steerlab.sim.result import Result
 from steerlab.sim.setup import build
 

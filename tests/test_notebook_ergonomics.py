@@ -35,11 +35,13 @@ def test_draw_functions_draw_into_the_given_axes(res):
     assert len(axes[0, 1].get_lines()) >= 3                                          # order, actual, zero
 
 
-def test_result_plot_uses_given_axes(res):
+def test_plot_result_uses_given_axes(res):
     from matplotlib.figure import Figure
 
+    from steerlab.report import plot_result
+
     axes = Figure().subplots(3, 1)
-    assert list(res.plot(axes)) == list(axes)
+    assert list(plot_result(res, axes)) == list(axes)
     assert axes[2].get_ylabel() == "yaw rate [deg/s]"
 
 

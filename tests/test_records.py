@@ -45,6 +45,9 @@ DECLARED = {
     "steerlab.control.sliding_mode": [("PARAMS", "S_", "N_PARAMS"), ("STATE", "Z_", "N_STATE")],
     "steerlab.control.backstepping_a": [("PARAMS", "B_", "N_PARAMS"), ("STATE", "Z_", "N_STATE")],
     "steerlab.control.asa_layout": [("PARAMS", "P_", "N_PARAMS"), ("STATE", "Z_", "N_STATE")],
+    "steerlab.guidance.reference_models": ("SCHEDULE", "G_", "G_CHANGES"),
+    "steerlab.guidance.course_models": [("MODEL", "G_", "G_CHANGES"), ("STATE", "Z_", "N_STATE")],
+    "steerlab.guidance.los": [("ROUTE", "G_", "G_WP"), ("STATE", "Z_", "N_STATE")],
 }
 """module -> (layout attribute, constant prefix, length constant), or a list of them for a module
 with several layouts (the size name may be None where a record has a variable-length tail)."""
@@ -53,6 +56,7 @@ NOT_INDEX = {
     "steerlab.ships.mmg": {"N_STRIPS"},                # number of cross-flow strips, not a slot
     "steerlab.ships.rpm_schedule": {"MAX_SCHEDULE"},   # most schedule points a scenario may give
     "steerlab.control.wave_filtered": {"NX_MAX"},      # largest plant state the wrapper copies
+    "steerlab.guidance.course_models": {"KIND_RATE_LIMITED", "KIND_THIRD_ORDER"},   # codes of g[G_KIND]
 }
 """Integer constants of declared modules that are counts, not record slots."""
 
@@ -324,15 +328,21 @@ def test_config_fields_defaults_replace_the_declared_default_only():
     assert [m.gt for m in fields["T"][1].metadata if hasattr(m, "gt")] == [0.0]
 
 
-def _literal_state_or_reference_indices(path):
-    """``x[<int>]`` / ``ref[<int>]`` in code (not in strings or comments) of ``path``."""
+PLANT_STATE_AND_REFERENCE = ("x", "x0", "xf", "xs", "ref")
+GUIDANCE_RECORDS = ("g", "gd", "gz", "gz0")
+"""Names of the guidance's packed record and state wherever they travel (``plan.gd``, ``gz``)."""
+
+
+def _literal_state_or_reference_indices(path, names=PLANT_STATE_AND_REFERENCE + GUIDANCE_RECORDS):
+    """``x[<int>]`` / ``ref[<int>]`` / ``gd[<int>]`` (any of ``names``) in code (not in strings
+    or comments) of ``path``."""
     import io
     import tokenize
 
     toks = list(tokenize.generate_tokens(io.StringIO(path.read_text(encoding="utf-8")).readline))
     out = []
     for a, b, c, d in zip(toks, toks[1:], toks[2:], toks[3:]):
-        if (a.type == tokenize.NAME and a.string in ("x", "x0", "xf", "xs", "ref") and b.string == "["
+        if (a.type == tokenize.NAME and a.string in names and b.string == "["
                 and c.type == tokenize.NUMBER and d.string == "]"):
             out.append(f"{path.name}:{a.start[0]}: {a.string}[{c.string}]")
     return out
@@ -349,6 +359,50 @@ def test_controllers_guidance_and_loops_read_plant_state_and_reference_by_name()
              src / "trials" / "zigzag_logic.py", src / "jit" / "env_template.py"]
     found = [hit for p in paths for hit in _literal_state_or_reference_indices(p)]
     assert not found, found
+
+
+def test_guidance_kernels_read_their_records_and_state_by_name():
+    """The course schedule, the course models and LOS read their packed record ``g`` and their
+    state ``z`` through the generated constants of their layouts (``g[G_ACCEPT]``, ``z[Z_LEG]``)."""
+    from pathlib import Path
+
+    paths = sorted((Path(__file__).resolve().parent.parent / "src" / "steerlab" / "guidance").glob("*.py"))
+    assert len(paths) >= 7
+    found = [hit for p in paths for hit in _literal_state_or_reference_indices(p, GUIDANCE_RECORDS + ("z",))]
+    assert not found, found
+
+
+def test_the_record_scan_finds_literal_indices(tmp_path):
+    p = tmp_path / "probe.py"
+    p.write_text('R = plan.gd[1]\nz[4] += g[7]\nq = x[IPSI] + ref[2]\ns = "gd[3]"  # g[5]\nw = gz[G_N]\n',
+                 encoding="utf-8")
+    assert [h.split(": ", 1)[1] for h in _literal_state_or_reference_indices(p)] == ["gd[1]", "g[7]", "ref[2]"]
+    assert [h.split(": ", 1)[1] for h in _literal_state_or_reference_indices(p, ("z",))] == ["z[4]"]
+
+
+def test_guidance_layouts_keep_the_kernels_slots():
+    """The slots the guidance kernels were built with (the numbers did not move)."""
+    from steerlab.guidance import course_models as c
+    from steerlab.guidance import los
+    from steerlab.guidance import reference_models as s
+
+    assert (s.G_RATE, s.G_PSI0, s.G_N, s.G_CHANGES) == (0, 1, 2, 3)
+    assert (c.G_KIND, c.G_OMEGA, c.G_ZETA, c.G_RMAX, c.G_AMAX, c.G_PSI0, c.G_N, c.G_CHANGES) == tuple(range(8))
+    assert (c.Z_PSI, c.Z_R, c.Z_A, c.Z_APPLIED, c.Z_TARGET, c.N_STATE) == tuple(range(6))
+    assert (los.G_LOOKAHEAD, los.G_ACCEPT, los.G_N_WP, los.G_N_STAGES, los.G_STOP, los.G_WP) == tuple(range(6))
+    assert (los.Z_LEG, los.Z_STAGES, los.Z_ARRIVED, los.N_STATE) == (0, 1, 2, 3)
+    g = los.pack_los([[0.0, 0.0], [100.0, 0.0], [100.0, 50.0]], 40.0, 12.0, [(60.0, 1.5)], 3.0)
+    assert g.tolist() == [40.0, 12.0, 3.0, 1.0, 3.0, 0.0, 0.0, 100.0, 0.0, 100.0, 50.0, 60.0, 1.5]
+    assert los.ROUTE.unpack(g[:los.G_WP])["accept_radius"] == 12.0
+    g = c.pack_course_model("third_order", 0.5, [(10.0, 0.25, "port")], 0.2, 0.9, 0.03, math.inf)
+    assert g[:c.G_CHANGES].tolist() == [2.0, 0.2, 0.9, 0.03, math.inf, 0.5, 1.0]
+    assert g[c.G_CHANGES] == 10.0 and g[c.G_CHANGES + 1] == pytest.approx(0.25 - 0.5)
+    z = c.initial_course_state(g)
+    assert z[c.Z_PSI] == z[c.Z_TARGET] == 0.5 and z[c.Z_APPLIED] == 0.0
+    g = s.course_schedule(0.1, [(5.0, 0.4)], 0.02)
+    assert g.tolist() == [0.02, 0.1, 1.0, 5.0, 0.4]
+    with pytest.raises(InputError, match=r"guidance\.rate_max: "):
+        s.course_schedule(0.1, [], -1.0)
 
 
 # files where a name of the scan means something else than the plant state or the reference

@@ -93,7 +93,7 @@ def test_wind_on_a_ship_without_a_wind_model_warns_and_the_run_is_the_calm_run()
 ])
 def test_wind_that_acts_does_not_warn(ship, environment):
     from steerlab.environment.channels import W_RUDDER
-    from steerlab.environment.wind_felt import wind_felt
+    from steerlab.sim.wind_felt import wind_felt
 
     with warnings.catch_warnings(record=True) as rec:
         warnings.simplefilter("always", InertSettingWarning)

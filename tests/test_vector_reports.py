@@ -1,5 +1,5 @@
 """The vectorisation report of a cached driver is read from the IR when the driver was
-compiled and kept beside it (:mod:`steerlab.sim.vector_reports`), instead of compiling the
+compiled and kept beside it (:mod:`steerlab.jit.vector_reports`), instead of compiling the
 driver once more in every process that asks: it equals the report of the IR of the same
 driver compiled in memory, and an unreadable report file falls back to that compile."""
 
@@ -9,12 +9,12 @@ import numba
 import pytest
 
 from steerlab.guidance.reference_models import course_guide
-from steerlab.sim import vector_reports
+from steerlab.jit import vector_reports
 from steerlab.sim.batch import simulate_batch
 from steerlab.jit.drivers import cached_signatures, driver, in_memory_twin
 from steerlab.sim.lanes import vectorisation_report
 from steerlab.sim.setup import build
-from steerlab.sim.warm import warm_scenario
+from steerlab.warm import warm_scenario
 
 pytestmark = pytest.mark.skipif(not numba.config.LOOP_VECTORIZE, reason="numba's loop vectoriser is switched off")
 

@@ -49,7 +49,7 @@ _LAZY = {
     "vary": "steerlab.sim.vary:vary",
     # components for other people's loops (steerlab.components)
     "controller": "steerlab.components.controller:controller",
-    "controllers": "steerlab.components.controller_vector:controllers",
+    "controllers": "steerlab.components.controller:controllers",
     "linearize": "steerlab.components.linear:linearize",
     "ship": "steerlab.components.ship:ship",
     "transfer_function": "steerlab.components.linear:transfer_function",
@@ -58,7 +58,7 @@ _LAZY = {
 
 if TYPE_CHECKING:   # what type checkers see of the lazy names above (keep in step with _LAZY)
     from steerlab.components.controller import controller as controller
-    from steerlab.components.controller_vector import controllers as controllers
+    from steerlab.components.controller import controllers as controllers
     from steerlab.components.linear import linearize as linearize
     from steerlab.components.linear import transfer_function as transfer_function
     from steerlab.components.ship import ship as ship

@@ -16,17 +16,9 @@ import textwrap
 from pathlib import Path
 
 from steerlab.errors import EXIT_BAD_INPUT, EXIT_DIVERGED, DivergedError, InertSettingWarning, InputError
+from steerlab.messages import MAX_MESSAGE, SHOWN_WARNINGS, one_line, print_warning
+from steerlab.messages import close_progress as _close_progress
 from steerlab.outputs import _clean, _json_default, dump_json, staged_output  # noqa: F401 (re-exported)
-
-MAX_MESSAGE = 300   #: longest error or warning line [characters]
-
-
-def one_line(text: str, limit: int = MAX_MESSAGE) -> str:
-    """``text`` as one printable line of at most ``limit`` characters (control characters,
-    newlines and terminal escapes shown escaped; the rest cut with "...")."""
-    out = "".join(c if c.isprintable() else c.encode("unicode_escape").decode("ascii") for c in str(text))
-    return out if len(out) <= limit else out[:limit - 3] + "..."
-
 
 def _progress(quiet: bool):
     """The command's progress sink on stderr: status lines and one updating bar
@@ -150,7 +142,7 @@ def cmd_linearize(args) -> int:
         s = summary(args.ship, args.speed_kn)
         print(dump_json(s)) if args.json else print_summary(s)
         return 0
-    summary = linear_summary(args.ship, knots_to_ms(args.speed_kn))
+    summary = linear_summary(get_ship(args.ship), knots_to_ms(args.speed_kn))
     summary["speed_kn"] = args.speed_kn
     if args.json:
         print(dump_json(summary))
@@ -337,21 +329,6 @@ def _say_compiling(msg: str) -> None:
     print(textwrap.fill(msg, 100, subsequent_indent="  "), file=sys.stderr, flush=True)
 
 
-#: the warning lines this command has printed (a repeated warning is printed once)
-SHOWN_WARNINGS: set[str] = set()
-
-
-def print_warning(text: str) -> None:
-    """Print ``steerlab: warning: TEXT`` as one line on stderr (below an open progress bar),
-    once per command."""
-    line = one_line(text)
-    if line in SHOWN_WARNINGS:
-        return
-    SHOWN_WARNINGS.add(line)
-    _close_progress()
-    print(f"steerlab: warning: {line}", file=sys.stderr, flush=True)
-
-
 def _warnings_as_lines():
     """Show steerlab's :class:`~steerlab.errors.InertSettingWarning` as one line
     (:func:`print_warning`) instead of Python's two-line form with a source line; other
@@ -369,13 +346,6 @@ def _warnings_as_lines():
 
     warnings.showwarning = show
     return previous
-
-
-def _close_progress(forget: bool = False) -> None:
-    """End an open progress-bar line, so that what follows starts on a line of its own."""
-    progress = sys.modules.get("steerlab.progress")
-    if progress is not None:
-        progress.close_all(forget)
 
 
 #: commands that run until stopped (a ship server, an autopilot): SIGTERM (``kill``, a service

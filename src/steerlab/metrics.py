@@ -30,7 +30,7 @@ import numpy as np
 from steerlab.angles import wrap_to_pi, wrap_to_pi_array
 from steerlab.guidance.route_metrics import ROUTE_METRIC_UNITS, route_metrics
 from steerlab.metrics_online import (M_ABS_DELTA, M_D2_DEG, M_DURATION, M_E2_DEG, M_IAE, M_ISE, M_ITAE,
-                                     M_MAX_ABS_E, M_REVERSALS, M_TRAVEL)
+                                     M_MAX_ABS_E, M_REVERSALS, M_TRAVEL, online_metrics_from_result)
 
 R2D = 180.0 / math.pi
 
@@ -185,8 +185,6 @@ def step_metrics_in_waves(time, psi, psi_ref) -> dict:
 
 def compute_metrics(res, lam: float = 0.1) -> dict:
     """All indices of a recorded :class:`~steerlab.sim.result.Result` (JSON-ready dict)."""
-    from steerlab.sim.engine import online_metrics_from_result
-
     acc = res.meta.get("online_metrics")
     if acc is None:
         acc = online_metrics_from_result(res)

@@ -12,6 +12,7 @@ import math
 import numba
 import numpy as np
 
+from steerlab.angles import wrap_to_pi_array
 from steerlab.records import Field, Layout
 
 if TYPE_CHECKING:   # Layout.export below writes this module's index constants: ints, for type checkers
@@ -63,3 +64,19 @@ def accumulate(acc, t, e, delta, delta_next, dt):
         if acc[M_LAST_DIR] != 0.0 and d != acc[M_LAST_DIR]:
             acc[M_REVERSALS] += 1.0
         acc[M_LAST_DIR] = d
+
+
+def online_metrics_from_result(res) -> np.ndarray:
+    """Integral metrics of a recorded run (a :class:`~steerlab.sim.result.Result`: ``time``,
+    ``psi``, ``psi_ref``, ``delta`` [s, rad], ``dt`` [s]) through the same accumulator the batch
+    engine uses: ``e = wrap_to_pi(psi_ref - psi)``, step ``k`` adding ``[t_k, t_k + dt)``.
+
+    Here, below the engine, so that :mod:`steerlab.metrics` reads a result without importing the
+    engine (the layers, docs/architecture.md)."""
+    acc = new_accumulator()
+    e = wrap_to_pi_array(res.psi_ref - res.psi)
+    d = res.delta
+    dt = res.dt
+    for k in range(len(res.time) - 1):
+        accumulate(acc, res.time[k], e[k], d[k], d[k + 1], dt)
+    return acc

@@ -160,9 +160,12 @@ class Registry(Mapping[str, S]):
         Module base names not scanned.
     recursive : bool
         Scan sub-packages too.
-    derive : callable, optional
+    derive : callable or str, optional
         ``derive(spec) -> list of specs`` made from each spec found or registered (the
-        controllers' ``"<name>+wf"`` wave-filter variants).
+        controllers' ``"<name>+wf"`` wave-filter variants), or its name
+        ``"module:function"``, imported on first use like the modules the registry finds (a
+        registry does not import the modules of its package at its own import: it sits below
+        them, docs/architecture.md).
     """
 
     #: the registry of each spec class (the last one made for it): :class:`PicklesByName`
@@ -170,7 +173,7 @@ class Registry(Mapping[str, S]):
 
     def __init__(self, kind: str, package: str, collect: Callable[[ModuleType], Iterable[S]], spec_type: type[S],
                  field: str, group: str, skip: Iterable[str] = (), recursive: bool = False,
-                 derive: Callable[[S], Iterable[S]] | None = None) -> None:
+                 derive: Callable[[S], Iterable[S]] | str | None = None) -> None:
         self.kind = kind
         self.package = package
         self.collect = collect
@@ -227,11 +230,15 @@ class Registry(Mapping[str, S]):
 
     def _derive(self, spec) -> list[S]:
         """``derive(spec)``, made once per spec object (a derived spec is one object too)."""
-        if self.derive is None:
+        derive = self.derive
+        if derive is None:
             return []
+        if isinstance(derive, str):
+            module, _, name = derive.partition(":")
+            derive = self.derive = getattr(importlib.import_module(module), name)
         known = self._derived.get(spec.name)
         if known is None or known[0] is not spec:
-            known = self._derived[spec.name] = (spec, list(self.derive(spec)))
+            known = self._derived[spec.name] = (spec, list(derive(spec)))
         return known[1]
 
     def _add(self, found: dict, spec, origin: str, replace: bool = False) -> None:
@@ -394,13 +401,16 @@ class Registry(Mapping[str, S]):
 
 def register_module(ref: str, replace: bool = False) -> list:
     """Import a module (dotted name or ``.py`` path) and register every ship (``SHIP_SPECS``)
-    and controller (``CONTROLLER``/``CONTROLLERS``) it declares; returns the specs."""
-    from steerlab.control.registry import CONTROLLERS
-    from steerlab.ships.registry import SHIPS
+    and controller (``CONTROLLER``/``CONTROLLERS``) it declares; returns the specs.
 
+    The registries are those of :attr:`Registry.of_spec_type`: a module that declares a spec
+    has imported the spec's class, hence the module that made its registry
+    (:mod:`steerlab.ships.registry`, :mod:`steerlab.control.registry`), so this base module needs
+    to import neither (the layers, docs/architecture.md)."""
     module = load_module(ref)
-    out: list = [SHIPS.register(s, replace) for s in SHIPS.collect(module)]
-    out += [CONTROLLERS.register(s, replace) for s in CONTROLLERS.collect(module)]
+    out: list = []
+    for registry in list(Registry.of_spec_type.values()):
+        out += [registry.register(s, replace) for s in registry.collect(module)]
     if not out:
         raise InputError(PLUGINS_ENV, f"module {ref!r} declares no ship (SHIP_SPECS) and no controller "
                                       "(CONTROLLER, CONTROLLERS)")

@@ -146,6 +146,23 @@ def draw_heading(ax, result, title: str = ""):
     return ax
 
 
+def plot_result(result, axes=None, title: str = ""):
+    """Heading, rudder and yaw rate of ``result`` (a :class:`~steerlab.sim.result.Result`) in
+    three Axes (``axes``: three matplotlib Axes, or None for a new pyplot figure); returns the
+    Axes (:func:`draw_heading`, :func:`draw_rudder`, :func:`draw_yaw_rate`). Here, not a method of
+    the result: a result is data and imports no plotting (the layers, docs/architecture.md)."""
+    if axes is None:
+        import matplotlib.pyplot as plt
+
+        _, axes = plt.subplots(3, 1, sharex=True, figsize=(8.0, 8.0), layout="constrained")
+    if len(axes) != 3:
+        from steerlab.errors import InputError
+        raise InputError("axes", f"give three matplotlib Axes (heading, rudder, yaw rate), got {len(axes)}")
+    for draw, ax in zip((draw_heading, draw_rudder, draw_yaw_rate), axes):
+        draw(ax, result, title)
+    return axes
+
+
 def plot_heading(path: Path, result, title: str = "") -> Path:
     """Write :func:`draw_heading` as a PNG at ``path``; returns ``path``."""
     fig, ax = _new_figure()

@@ -73,7 +73,9 @@ def annotate_run(ax, result, scale: float = 1.0, outlines: bool = True) -> None:
     plan = result.meta.get("guidance")
     dims = result.meta.get("ship_dims")
     if plan is not None and getattr(plan, "route", None) is not None:
-        R = plan.gd[1] if len(plan.gd) > 1 else None
+        from steerlab.guidance.los import G_ACCEPT   # (a plan with a route is LOS: its record)
+
+        R = plan.gd[G_ACCEPT]
         draw_route(ax, plan.route, R, scale, plan.berth, plan.success_radius)
     if outlines and dims is not None:
         L, B = dims

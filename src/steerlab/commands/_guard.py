@@ -29,7 +29,7 @@ def design_guard(stage: str = "scenario design"):
 
 def warn(lines) -> None:
     """Print each warning as one ``steerlab: warning: ...`` line on stderr (each once per command)."""
-    from steerlab.cli import print_warning
+    from steerlab.messages import print_warning
 
     for line in lines:
         print_warning(line)

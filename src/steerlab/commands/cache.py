@@ -108,7 +108,7 @@ def _warm(args) -> int:
     from steerlab.ships.registry import get_ship
     from steerlab.jit import drivers
     from steerlab.sim.scenario import load_scenario
-    from steerlab.sim.warm import warm_gym, warm_pair, warm_plant, warm_scenario_file, warm_trial
+    from steerlab.warm import warm_gym, warm_pair, warm_plant, warm_scenario_file, warm_trial
 
     from steerlab.control.registry import CONTROLLERS
     from steerlab.ships.registry import SHIPS

@@ -34,7 +34,7 @@ def run(args) -> int:
 
     from steerlab.cli import _progress, dump_json, staged_output
     from steerlab.environment.channels import CHANNEL_NAMES, CHANNEL_UNITS
-    from steerlab.environment.sea_report import (has_wind, spectrum_figure, timeseries_figure, wave_analysis,
+    from steerlab.sea_report import (has_wind, spectrum_figure, timeseries_figure, wave_analysis,
                                                  wind_current_summary, wind_rose_figure)
     from steerlab.commands._guard import design_checked
     from steerlab.sim.scenario import default_scenario, load_scenario

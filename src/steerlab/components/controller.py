@@ -27,18 +27,18 @@ controller along a recorded engine run reproduces the engine's rudder orders bit
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING, Any, Mapping, Optional, Union
+from typing import TYPE_CHECKING, Any, Iterable, Mapping, Optional, Union
 
 import numpy as np
 from numpy.typing import ArrayLike
 
+from steerlab.components.controller_vector import ControllerVector
 from steerlab.control.registry import get_controller
 from steerlab.errors import InputError
 from steerlab.guidance.reference_vector import REF_PSI, REF_R, initial_reference
 from steerlab.ships.state import IPSI, IR, IU
 
 if TYPE_CHECKING:
-    from steerlab.components.controller_vector import ControllerVector
     from steerlab.control.design_context import DesignContext
     from steerlab.control.registry import ControllerSpec
     from steerlab.steering_gear import SteeringGear
@@ -196,8 +196,6 @@ class Controller:
 
     def vector(self, n: int) -> ControllerVector:
         """``n`` copies of this controller (same design, same state) stepped in one compiled call."""
-        from steerlab.components.controller_vector import ControllerVector
-
         return ControllerVector([self] * int(n))
 
 
@@ -272,3 +270,15 @@ def controller(type: str, *, ship: Optional[str] = None, speed_kn: Optional[floa
             raise need_speed
         raise InputError(type, f"the design gave non-finite parameters {params.tolist()}")
     return Controller(spec, design, params, ctx)
+
+
+def controllers(type_or_items: Union[str, Iterable[Controller]], n: int | None = None, **kw: Any) -> ControllerVector:
+    """N controllers in one compiled call: ``controllers("pid", n=64, nomoto=(K, T), Kp=...)``
+    (N copies of one design) or ``controllers([c1, c2, ...])`` (designed ``Controller`` objects)."""
+    if isinstance(type_or_items, str):
+        if n is None or int(n) < 1:
+            raise InputError("n", f"give the number of controllers n >= 1, got {n!r}")
+        return controller(type_or_items, **kw).vector(int(n))
+    if n is not None or kw:
+        raise InputError("n", "with a list of controllers, give no n or design settings")
+    return ControllerVector(type_or_items)

@@ -9,7 +9,7 @@ from its own design (different gains), as long as the type and sample time are t
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any, Callable, Iterable, Optional, Union
+from typing import TYPE_CHECKING, Any, Callable, Iterable, Optional
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -38,7 +38,7 @@ def _column(name, v, n):
 
 
 class ControllerVector:
-    """N controllers of one type (make it with :func:`controllers` or ``Controller.vector(n)``).
+    """N controllers of one type (make it with :func:`steerlab.components.controller.controllers` or ``Controller.vector(n)``).
 
     Attributes
     ----------
@@ -122,17 +122,3 @@ class ControllerVector:
                                            "yaw rate, speed and rudder: step single controllers with step_state()")
         self._last[:] = self._out
         return self._out.copy()
-
-
-def controllers(type_or_items: Union[str, Iterable[Controller]], n: int | None = None, **kw: Any) -> ControllerVector:
-    """N controllers in one compiled call: ``controllers("pid", n=64, nomoto=(K, T), Kp=...)``
-    (N copies of one design) or ``controllers([c1, c2, ...])`` (designed ``Controller`` objects)."""
-    if isinstance(type_or_items, str):
-        from steerlab.components.controller import controller
-
-        if n is None or int(n) < 1:
-            raise InputError("n", f"give the number of controllers n >= 1, got {n!r}")
-        return controller(type_or_items, **kw).vector(int(n))
-    if n is not None or kw:
-        raise InputError("n", "with a list of controllers, give no n or design settings")
-    return ControllerVector(type_or_items)

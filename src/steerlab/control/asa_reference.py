@@ -39,6 +39,7 @@ from __future__ import annotations
 import numba
 
 from steerlab.angles import wrap_to_pi
+from steerlab.guidance.series_model import series_model_step
 
 
 @numba.njit(cache=True)
@@ -58,29 +59,6 @@ def reference_model_step(zm, i_psi, i_r, psi_set, omega_n, zeta, r_max, rdot_max
                                  r_max, rdot_max, h)
     zm[i_psi] = wrap_to_pi(zm[i_psi])
     return wrap_to_pi(psi_r)
-
-
-@numba.njit(cache=True)
-def series_model_step(zm, i_psi, i_r, e_m, omega_n, zeta, r_max, rdot_max, h):
-    """The series model's Euler step driven by the course error ``e_m`` [rad] itself.
-
-    Same equations as :func:`reference_model_step` (which calls it with
-    ``e_m = wrap_to_pi(psi_set - psi_m)``), but the error is not wrapped and neither is the
-    advanced ``zm[i_psi]``: a caller that keeps an unwrapped heading can make turns of more
-    than 180 deg (the guidance's course-change models, :mod:`steerlab.guidance.course_models`).
-    Returns ``(psi_r', r_m')``: the unwrapped modified set-point [rad] and the model's yaw
-    acceleration [rad/s^2], both before the step.
-    """
-    psi_m = zm[i_psi]
-    r_m = zm[i_r]
-    g = omega_n / (2.0 * zeta)
-    r_d = min(max(g * e_m, -r_max), r_max)
-    acc = 2.0 * zeta * omega_n * (r_d - r_m)
-    acc = min(max(acc, -rdot_max), rdot_max)
-    psi_r = psi_m + (acc + 2.0 * zeta * omega_n * r_m) / (omega_n * omega_n)
-    zm[i_psi] = psi_m + h * r_m
-    zm[i_r] = r_m + h * acc
-    return psi_r, acc
 
 
 @numba.njit(cache=True)

@@ -51,16 +51,13 @@ def _collect(module) -> list:
     return specs
 
 
-def _wave_filtered(spec) -> list:
-    """Every controller also comes behind the wave filter, as ``"<name>+wf"``."""
-    from steerlab.control.wave_filtered import wave_filtered_variants
-
-    return wave_filtered_variants(spec)
-
-
 CONTROLLERS = Registry("controller", "steerlab.control", _collect, ControllerSpec, "controller.type",
-                       "steerlab.controllers", skip={"registry", "design_context"}, derive=_wave_filtered)
-"""Lazy read-only view ``name -> ControllerSpec`` (:class:`steerlab.plugins.Registry`)."""
+                       "steerlab.controllers", skip={"registry", "design_context"},
+                       derive="steerlab.control.wave_filtered:wave_filtered_variants")
+"""Lazy read-only view ``name -> ControllerSpec`` (:class:`steerlab.plugins.Registry`). Every
+controller also comes behind the wave filter, as ``"<name>+wf"``; the deriving function is named,
+not imported: the registry imports it from its package when it first derives, as it imports the
+package's controllers (the registry sits below the controllers it finds)."""
 
 
 def _discover() -> dict:

@@ -142,6 +142,7 @@ def figure(path: Path, runs, title: str) -> Path:
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
+    from steerlab.guidance.los import G_ACCEPT
     from steerlab.track_figures import draw_outlines, draw_route, outline_interval
 
     fig = Figure(figsize=(11.0, 9.0))
@@ -149,7 +150,7 @@ def figure(path: Path, runs, title: str) -> Path:
     axes = fig.subplots(2, 2).ravel()
     for ax, (label, res, m) in zip(axes, runs):
         plan = res.meta["guidance"]
-        draw_route(ax, plan.route, plan.gd[1], 1.0, plan.berth, plan.success_radius)
+        draw_route(ax, plan.route, plan.gd[G_ACCEPT], 1.0, plan.berth, plan.success_radius)
         n, e = res.col("x_n"), res.col("y_e")
         ax.plot(e, n, color="C0", lw=1.2, label="track")
         L, B = res.meta["ship_dims"]

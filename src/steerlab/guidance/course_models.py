@@ -15,7 +15,7 @@ are integrated with forward Euler over the controller sample ``h`` (van Ameronge
 ``rate_limited`` - van Amerongen (1982) Fig. 3.4 (the desired course change: a clear start,
 a stationary turn at the user's rate of turn, an end without overshoot), realised by the
 series model of Fig. 4.9 with the rate-of-turn limiter. steerlab's reconstruction of that
-model is :func:`steerlab.control.asa_reference.series_model_step` (the same kernel the ASA
+model is :func:`steerlab.guidance.series_model.series_model_step` (the same kernel the ASA
 autopilot uses)::
 
     e_m  = target - psi_m;   r_d = sat(omega_n e_m / (2 zeta), r_max)
@@ -31,13 +31,16 @@ Sec. 10.2.1, eq 10.16 with saturating elements)::
 with anti-windup: while ``r_m`` sits on its limit, an ``a_m`` pushing further out is reset
 to 0 (otherwise the stored acceleration delays the end of a long turn into an overshoot).
 
-Packed record ``g``::
+Packed record ``g``: the head :data:`MODEL` (declared once, :mod:`steerlab.records`), then
+the changes::
 
-    g[0] kind (1 rate_limited, 2 third_order)   g[1] omega_n [rad/s]   g[2] zeta [-]
-    g[3] r_max [rad/s]   g[4] acceleration limit [rad/s^2] (inf = none)   g[5] psi_0 [rad]
-    g[6] n   then n pairs (t_i [s], turn_i [rad])
+    g[G_KIND] kind (1 rate_limited, 2 third_order)   g[G_OMEGA] omega_n [rad/s]   g[G_ZETA] zeta [-]
+    g[G_RMAX] r_max [rad/s]   g[G_AMAX] acceleration limit [rad/s^2] (inf = none)
+    g[G_PSI0] psi_0 [rad]   g[G_N] n
+    g[G_CHANGES + 2 i], g[G_CHANGES + 2 i + 1]      t_i [s], turn_i [rad]   (i = 0 .. n - 1)
 
-State ``z = [psi_m (unwrapped) [rad], r_m [rad/s], a_m [rad/s^2], changes applied, target [rad]]``.
+State :data:`STATE` ``z``: ``z[Z_PSI]`` psi_m (unwrapped) [rad], ``z[Z_R]`` r_m [rad/s],
+``z[Z_A]`` a_m [rad/s^2], ``z[Z_APPLIED]`` changes applied, ``z[Z_TARGET]`` target [rad].
 """
 
 from __future__ import annotations
@@ -48,16 +51,35 @@ import numba
 import numpy as np
 
 from steerlab.angles import wrap_to_pi
-from steerlab.control.asa_reference import series_model_step
 from steerlab.errors import InputError, require_finite_range
 from steerlab.guidance.reference_vector import REF_PSI, REF_R, REF_RDOT
+from steerlab.guidance.series_model import series_model_step
+from steerlab.records import Field, Layout
 
 KIND_RATE_LIMITED = 1
 KIND_THIRD_ORDER = 2
 KINDS = {"rate_limited": KIND_RATE_LIMITED, "third_order": KIND_THIRD_ORDER}
 DIRECTIONS = ("shortest", "starboard", "port")
-N_STATE = 5
-G_CHANGES = 7
+
+MODEL = Layout("guidance", "G_", [
+    Field("KIND", "kind", "-", "1 rate_limited, 2 third_order"),
+    Field("OMEGA", "omega_n", "rad/s", "natural frequency of the model"),
+    Field("ZETA", "zeta", "-", "relative damping of the model"),
+    Field("RMAX", "r_max", "rad/s", "rate-of-turn limit"),
+    Field("AMAX", "accel_max", "rad/s^2", "acceleration limit (inf: none)"),
+    Field("PSI0", "psi0", "rad", "initial set course"),
+    Field("N", "n_changes", "-", "number of course changes (t_i, turn_i) after the head"),
+], size_name="G_CHANGES")
+MODEL.export(globals())          # G_KIND = 0, ..., G_N = 6, G_CHANGES = 7
+
+STATE = Layout("guidance state", "Z_", [
+    Field("PSI", "psi_m", "rad", "model heading, unwrapped"),
+    Field("R", "r_m", "rad/s", "model rate of turn"),
+    Field("A", "a_m", "rad/s^2", "model yaw acceleration (third_order)"),
+    Field("APPLIED", "applied", "-", "course changes applied so far"),
+    Field("TARGET", "target", "rad", "unwrapped target: psi_0 + the turns applied"),
+], size_name="N_STATE")
+STATE.export(globals())          # Z_PSI = 0, ..., Z_TARGET = 4, N_STATE = 5
 
 
 def turn_angle(psi_from: float, psi_to: float, direction: str = "shortest") -> float:
@@ -85,7 +107,11 @@ def pack_course_model(kind: str, psi0: float, changes=(), omega_n: float = 0.1, 
     if not (accel_max > 0.0):
         raise InputError("guidance.accel_max_deg_s2", f"must be > 0 (inf = no limit), got {accel_max!r}")
     require_finite_range("guidance.psi0", psi0)
-    g = [float(KINDS[kind]), omega_n, zeta, r_max, accel_max, psi0, float(len(changes))]
+    g = np.empty(G_CHANGES + 2 * len(changes), dtype=np.float64)
+    head = {"kind": float(KINDS[kind]), "omega_n": omega_n, "zeta": zeta, "r_max": r_max,
+            "accel_max": accel_max, "psi0": psi0, "n_changes": float(len(changes))}
+    for i, f in enumerate(MODEL.fields):       # (accel_max may be inf: checked above, not by pack)
+        g[i] = head[f.name]
     prev_t = -math.inf
     prev_psi = psi0
     for i, (ti, psii, direction) in enumerate(changes):
@@ -96,51 +122,54 @@ def pack_course_model(kind: str, psi0: float, changes=(), omega_n: float = 0.1, 
         if direction not in DIRECTIONS:
             raise InputError(f"guidance.changes[{i}].direction",
                              f"must be one of {DIRECTIONS}, got {direction!r}")
-        g += [ti, turn_angle(prev_psi, psii, direction)]
+        g[G_CHANGES + 2 * i] = ti
+        g[G_CHANGES + 2 * i + 1] = turn_angle(prev_psi, psii, direction)
         prev_t, prev_psi = ti, psii
-    return np.array(g, dtype=np.float64)
+    return g
 
 
 def initial_course_state(g: np.ndarray) -> np.ndarray:
+    """The state at ``t = 0``: the model at rest on ``psi_0``, no change applied."""
     z = np.zeros(N_STATE)
-    z[0] = g[5]
-    z[4] = g[5]
+    z[Z_PSI] = g[G_PSI0]
+    z[Z_TARGET] = g[G_PSI0]
     return z
 
 
 @numba.njit(cache=True)
 def course_model_guidance(t, x, g, z, ref, h):
-    """Guidance kernel: write ``ref[0:3] = psi_ref, r_ref, rdot_ref`` at ``t``, then advance ``z`` by ``h``.
+    """Guidance kernel: write ``psi_ref, r_ref, rdot_ref`` (``ref[REF_PSI]``, ``ref[REF_R]``,
+    ``ref[REF_RDOT]``) at ``t``, then advance ``z`` by ``h``.
 
     ``x`` (the plant state) is not read: the reference is open loop.
     """
-    n = int(g[6])
-    i = int(z[3])
+    n = int(g[G_N])
+    i = int(z[Z_APPLIED])
     while i < n and g[G_CHANGES + 2 * i] <= t:
-        z[4] += g[G_CHANGES + 2 * i + 1]
+        z[Z_TARGET] += g[G_CHANGES + 2 * i + 1]
         i += 1
-    z[3] = i
-    e = z[4] - z[0]
-    if int(g[0]) == KIND_RATE_LIMITED:
-        psi = z[0]
-        r = z[1]
-        _, acc = series_model_step(z, 0, 1, e, g[1], g[2], g[3], g[4], h)
+    z[Z_APPLIED] = i
+    e = z[Z_TARGET] - z[Z_PSI]
+    if int(g[G_KIND]) == KIND_RATE_LIMITED:
+        psi = z[Z_PSI]
+        r = z[Z_R]
+        _, acc = series_model_step(z, Z_PSI, Z_R, e, g[G_OMEGA], g[G_ZETA], g[G_RMAX], g[G_AMAX], h)
         ref[REF_PSI] = wrap_to_pi(psi)
         ref[REF_R] = r
         ref[REF_RDOT] = acc
     else:
-        w = g[1]
-        c = 2.0 * g[2] + 1.0
-        psi = z[0]
-        r = z[1]
-        a = z[2]
+        w = g[G_OMEGA]
+        c = 2.0 * g[G_ZETA] + 1.0
+        psi = z[Z_PSI]
+        r = z[Z_R]
+        a = z[Z_A]
         ref[REF_PSI] = wrap_to_pi(psi)
         ref[REF_R] = r
         ref[REF_RDOT] = a
         jerk = w * w * w * e - c * w * w * r - c * w * a
-        r_max = g[3]
-        a_max = g[4]
-        z[0] = psi + h * r
+        r_max = g[G_RMAX]
+        a_max = g[G_AMAX]
+        z[Z_PSI] = psi + h * r
         r_new = r + h * a
         if r_new > r_max:
             r_new = r_max
@@ -151,5 +180,5 @@ def course_model_guidance(t, x, g, z, ref, h):
             if a < 0.0:
                 a = 0.0
         a_new = a + h * jerk
-        z[1] = r_new
-        z[2] = min(max(a_new, -a_max), a_max)
+        z[Z_R] = r_new
+        z[Z_A] = min(max(a_new, -a_max), a_max)

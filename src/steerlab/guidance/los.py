@@ -22,13 +22,16 @@ arrival it is 0. Arrival: inside the circle of radius ``R_stop`` around the bert
 passing abeam of it on the last leg (a ship that misses the circle stops there too, rather
 than sailing on; steerlab's choice, the paper does not say).
 
-Packed record ``g``::
+Packed record ``g``: the head :data:`ROUTE` (declared once, :mod:`steerlab.records`), then the
+waypoints and the plan::
 
-    g[0] Delta [m]   g[1] R [m]   g[2] n_wp   g[3] n_stages   g[4] R_stop [m]
-    g[5 : 5 + 2 n_wp]                 waypoints x_0, y_0, x_1, y_1, ...
+    g[G_LOOKAHEAD] Delta [m]   g[G_ACCEPT] R [m]   g[G_N_WP] n_wp   g[G_N_STAGES] n_stages
+    g[G_STOP] R_stop [m]
+    g[G_WP : G_WP + 2 n_wp]           waypoints x_0, y_0, x_1, y_1, ...
     then n_stages distances [m], then n_stages rates [rev/s]
 
-State ``z = [k (leg), stages passed, arrived (0/1)]``. Logged leg: ``k``, or ``n_wp - 1`` after arrival.
+State :data:`STATE` ``z``: ``z[Z_LEG]`` k (the leg), ``z[Z_STAGES]`` stages passed,
+``z[Z_ARRIVED]`` arrived (0/1). Logged leg: ``k``, or ``n_wp - 1`` after arrival.
 """
 
 from __future__ import annotations
@@ -42,12 +45,27 @@ import numpy as np
 
 from steerlab.angles import wrap_to_pi
 from steerlab.errors import InputError, require_finite_range
-from steerlab.ships.state import IX, IY
 from steerlab.guidance.reference_vector import REF_LEG, REF_PSI, REF_R, REF_RDOT, REF_RPM, REF_XTE
+from steerlab.records import Field, Layout
+from steerlab.ships.state import IX, IY
 
-G_WP = 5
-N_STATE = 3
 MAX_WAYPOINTS = 10_000
+
+ROUTE = Layout("guidance", "G_", [
+    Field("LOOKAHEAD", "lookahead", "m", "look-ahead distance Delta of eq (2)", lo=0.0, lo_open=True),
+    Field("ACCEPT", "accept_radius", "m", "acceptance circle R of eq (3)", lo=0.0, lo_open=True),
+    Field("N_WP", "n_waypoints", "-", "number of waypoints after the head", lo=2.0, hi=float(MAX_WAYPOINTS)),
+    Field("N_STAGES", "n_stages", "-", "number of propeller-plan stages after the waypoints", lo=0.0),
+    Field("STOP", "stop_radius", "m", "arrival circle around the berth", lo=0.0, lo_open=True),
+], size_name="G_WP")
+ROUTE.export(globals())          # G_LOOKAHEAD = 0, ..., G_STOP = 4, G_WP = 5 (first waypoint)
+
+STATE = Layout("guidance state", "Z_", [
+    Field("LEG", "leg", "-", "the leg k being followed (from waypoint k to k + 1)"),
+    Field("STAGES", "stages", "-", "propeller-plan stages passed"),
+    Field("ARRIVED", "arrived", "-", "1 once the berth is reached, else 0"),
+], size_name="N_STATE")
+STATE.export(globals())          # Z_LEG = 0, Z_STAGES = 1, Z_ARRIVED = 2, N_STATE = 3
 
 
 def check_route(route, field: str = "guidance.route") -> np.ndarray:
@@ -109,13 +127,14 @@ def pack_los(route, lookahead: float, accept_radius: float, stages=(), stop_radi
         if d >= d_prev:
             raise InputError(f"guidance.rpm_plan[{j}]", "distances must decrease along the plan")
         d_prev = d
-    g = [lookahead, accept_radius, float(len(wp)), float(len(stages)), r_stop]
-    g += wp.ravel().tolist()
-    g += [float(d) for d, _ in stages] + [float(n) for _, n in stages]
-    return np.array(g, dtype=np.float64)
+    head = ROUTE.pack(lookahead=lookahead, accept_radius=accept_radius, n_waypoints=float(len(wp)),
+                      n_stages=float(len(stages)), stop_radius=r_stop)
+    plan = [float(d) for d, _ in stages] + [float(n) for _, n in stages]
+    return np.concatenate([head, wp.ravel(), np.array(plan, dtype=np.float64)])
 
 
 def initial_los_state(g: np.ndarray) -> np.ndarray:
+    """The state at ``t = 0``: first leg, no stage passed, not arrived."""
     return np.zeros(N_STATE)
 
 
@@ -132,19 +151,19 @@ def los_heading(alpha, e, lookahead):
 
 @numba.njit(cache=True)
 def los_guidance(t, x, g, z, ref, h):
-    """Guidance kernel: LOS heading (eq 2) for the ship at ``x[0], x[1]``; advances the leg (eq 3).
+    """Guidance kernel: LOS heading (eq 2) for the ship at ``x[IX], x[IY]``; advances the leg (eq 3).
 
-    Writes ``ref[0] = psi_ref``, ``ref[1] = ref[2] = 0``, ``ref[3]`` the propeller order
-    [rev/s] (< 0: none), ``ref[4]`` the cross-track error [m], ``ref[5]`` the leg (``n_wp - 1``
-    once the last waypoint is reached).
+    Writes ``ref[REF_PSI] = psi_ref``, ``ref[REF_R] = ref[REF_RDOT] = 0``, ``ref[REF_RPM]`` the
+    propeller order [rev/s] (< 0: none), ``ref[REF_XTE]`` the cross-track error [m],
+    ``ref[REF_LEG]`` the leg (``n_wp - 1`` once the last waypoint is reached).
     """
-    delta_la = g[0]
-    R = g[1]
-    n = int(g[2])
-    ns = int(g[3])
+    delta_la = g[G_LOOKAHEAD]
+    R = g[G_ACCEPT]
+    n = int(g[G_N_WP])
+    ns = int(g[G_N_STAGES])
     px = x[IX]
     py = x[IY]
-    k = int(z[0])
+    k = int(z[Z_LEG])
     while k < n - 2:
         dxn = g[G_WP + 2 * k + 2] - px
         dyn = g[G_WP + 2 * k + 3] - py
@@ -152,7 +171,7 @@ def los_guidance(t, x, g, z, ref, h):
             k += 1
         else:
             break
-    z[0] = k
+    z[Z_LEG] = k
     xa = g[G_WP + 2 * k]
     ya = g[G_WP + 2 * k + 1]
     xb = g[G_WP + 2 * k + 2]
@@ -170,21 +189,21 @@ def los_guidance(t, x, g, z, ref, h):
     dxb = g[G_WP + 2 * n - 2] - px
     dyb = g[G_WP + 2 * n - 1] - py
     dist = math.sqrt(dxb * dxb + dyb * dyb)
-    if k == n - 2 and z[2] == 0.0:
-        r_stop = g[4]
+    if k == n - 2 and z[Z_ARRIVED] == 0.0:
+        r_stop = g[G_STOP]
         if dist <= r_stop or dxb * ca + dyb * sa <= 0.0:
-            z[2] = 1.0
-    if z[2] != 0.0:
+            z[Z_ARRIVED] = 1.0
+    if z[Z_ARRIVED] != 0.0:
         ref[REF_LEG] = n - 1
     if ns == 0:
         ref[REF_RPM] = -1.0
         return
-    s = int(z[1])
+    s = int(z[Z_STAGES])
     o = G_WP + 2 * n
     while s < ns and dist <= g[o + s]:
         s += 1
-    z[1] = s
-    if z[2] != 0.0:
+    z[Z_STAGES] = s
+    if z[Z_ARRIVED] != 0.0:
         ref[REF_RPM] = 0.0
     elif s == 0:
         ref[REF_RPM] = -1.0

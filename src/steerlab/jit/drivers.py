@@ -59,11 +59,11 @@ from steerlab.jit.kernel_refs import describe, kernel_ref
 from steerlab.jit.kernel_sources import LINE as SOURCE_LINE
 from steerlab.jit.kernel_sources import outdated, source_digests
 from steerlab.jit.numba_cache import _fingerprint
+from steerlab.jit.vector_reports import MODULE_PREFIX
 
 TEMPLATE = Path(__file__).with_name("driver_template.py")
 BEGIN = "# ---- bindings: replaced in every generated driver ----"
 END = "# ---- end of bindings ----"
-MODULE_PREFIX = "steerlab_driver_"
 
 _LOCK = threading.RLock()
 _LOADED: dict = {}
@@ -239,7 +239,7 @@ def _from_disk(key: _Key, text: str) -> types.ModuleType:
             raise
     for entry in mod.ENTRY_POINTS:
         _check_cache_files(getattr(mod, entry))
-    from steerlab.sim import vector_reports
+    from steerlab.jit import vector_reports
 
     vector_reports.install()      # a vectorised entry compiled here leaves its report beside the module
     mod._steerlab_cached = True

@@ -15,7 +15,6 @@ from __future__ import annotations
 import numpy as np
 
 from steerlab.errors import InputError, require_finite_range
-from steerlab.ships.registry import get_ship
 
 
 def nomoto_from_linear(A1, B1) -> dict:
@@ -68,15 +67,16 @@ def _reading(K: float, poles, zeros) -> dict:
             "poles": [complex(p) for p in poles], "zero": complex(zeros[0]) if len(zeros) else None}
 
 
-def linear_summary(ship_name: str, speed: float) -> dict:
+def linear_summary(ship, speed: float) -> dict:
     """Everything ``steerlab linearize`` prints, in SI; rudder quantities in steerlab sign.
+
+    ``ship`` is a :class:`~steerlab.ships.registry.ShipSpec` (``get_ship(name)``), ``speed`` [m/s].
 
     Keys with ``_paper`` carry the paper's rudder sign (delta < 0 to starboard).
     """
     require_finite_range("speed", speed, 0.0, lo_open=True)
-    ship = get_ship(ship_name)
     if ship.linearise is None:
-        raise InputError("ship", f"ship {ship_name!r} has no linearisation")
+        raise InputError("ship", f"ship {ship.name!r} has no linearisation")
     A1, B1 = ship.linearise(speed)
     eig = np.linalg.eigvals(A1)
     b2 = float(B1[1])

@@ -11,10 +11,9 @@ from typing import TYPE_CHECKING, Union
 
 import numpy as np
 
-from steerlab.angles import wrap_to_pi_array
 from steerlab.guidance.reference_models import course_guide
 from steerlab.guidance.reference_vector import N_REF, REF_NAMES, REF_PSI, REF_R, REF_RPM, initial_reference
-from steerlab.metrics_online import accumulate, new_accumulator
+from steerlab.metrics_online import accumulate, new_accumulator, online_metrics_from_result
 from steerlab.jit.controller_calls import controller_step
 from steerlab.sim.kernels import closed_loop, plant_step
 from steerlab.sim.result import Result
@@ -145,14 +144,3 @@ def simulate(scenario_or_setup: Union[Scenario, SimSetup], engine: str = "compil
         res = simulate_readable(scenario_or_setup)
         return res if record_every == 1 else _thinned(res, record_every)
     raise InputError("engine", f"must be one of {ENGINES}, got {engine!r}")
-
-
-def online_metrics_from_result(res: Result) -> np.ndarray:
-    """Integral metrics of a recorded run through the same accumulator the batch engine uses."""
-    acc = new_accumulator()
-    e = wrap_to_pi_array(res.psi_ref - res.psi)
-    d = res.delta
-    dt = res.dt
-    for k in range(len(res.time) - 1):
-        accumulate(acc, res.time[k], e[k], d[k], d[k + 1], dt)
-    return acc

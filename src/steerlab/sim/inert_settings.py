@@ -10,7 +10,7 @@ with a wind model. Before, such a setting was accepted and silently ignored (a u
 value other than their default (a dump of a scenario re-read, as sweeps do, sets every field to
 what it was: defaults never warn). :func:`warn_inert_settings` (called once per design by
 :meth:`steerlab.sim.setup.Design.of`) warns each as a :class:`~steerlab.errors.InertSettingWarning`,
-with the wind probed on the ship's kernel (:mod:`steerlab.environment.wind_felt`); the CLI prints
+with the wind probed on the ship's kernel (:mod:`steerlab.sim.wind_felt`); the CLI prints
 them as ``steerlab: warning: ...`` lines and lists them in a run's ``metrics.json``. The run is
 the one the scenario describes without them: no number changes.
 """
@@ -133,7 +133,7 @@ def warn_inert_settings(scenario: Any, ship: Any, ps: Any, x0: Any,
     """Warn (:class:`~steerlab.errors.InertSettingWarning`) for each of :func:`inert_settings`,
     for a wind the ship does not read and for a propeller rate it does not take (with ``repack``,
     :func:`rpm_unread`); returns the messages."""
-    from steerlab.environment.wind_felt import unfelt_wind_message, wind_felt
+    from steerlab.sim.wind_felt import unfelt_wind_message, wind_felt
 
     messages = inert_settings(scenario)
     rpm = None if repack is None else rpm_unread(scenario, ship, ps, repack)

@@ -191,7 +191,7 @@ def vectorisation_report(ship_rhs, ctrl_update, nx: int, guide=None, lanes: int 
     vectoriser could only call once per run (``sin``, ``exp`` ...: such a kernel is vectorised
     in name only). A kernel with branches, loops or library calls gives 0 stages.
     Machine code loaded from the disk cache has no IR to show: its report is the one read from
-    the IR when it was compiled and kept beside the driver (:mod:`steerlab.sim.vector_reports`);
+    the IR when it was compiled and kept beside the driver (:mod:`steerlab.jit.vector_reports`);
     without it, the same driver is compiled once in this process for the inspection
     (:func:`steerlab.jit.drivers.in_memory_twin`).
     """
@@ -213,7 +213,7 @@ def plant_lanes_report(ship_rhs, nx: int, lanes: int = LANES) -> dict:
 
 def _report(ship_rhs, ctrl_update, guide, nx: int, lanes: int, name: str, not_compiled: str) -> dict:
     from steerlab.jit.drivers import cached_signatures, driver, in_memory_twin
-    from steerlab.sim.vector_reports import report_from_ir, stored
+    from steerlab.jit.vector_reports import report_from_ir, stored
 
     disp = getattr(driver(ship_rhs, ctrl_update, guide, nx, lanes), name)
     sigs = list(disp.signatures) or cached_signatures(disp)

@@ -6,7 +6,7 @@ import math
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Callable, Optional, Sequence
+from typing import TYPE_CHECKING, Callable, Optional
 
 import numpy as np
 
@@ -94,22 +94,6 @@ class Result:
         from steerlab.sim.frames import result_frame
 
         return result_frame(self)
-
-    def plot(self, axes: Optional[Sequence[Any]] = None, title: str = "") -> Any:
-        """Heading, rudder and yaw rate in three Axes (``axes``: three matplotlib Axes, or None
-        for a new pyplot figure); returns the Axes (:func:`steerlab.report.draw_heading` etc.)."""
-        from steerlab.report import draw_heading, draw_rudder, draw_yaw_rate
-
-        if axes is None:
-            import matplotlib.pyplot as plt
-
-            _, axes = plt.subplots(3, 1, sharex=True, figsize=(8.0, 8.0), layout="constrained")
-        if len(axes) != 3:
-            from steerlab.errors import InputError
-            raise InputError("axes", f"give three matplotlib Axes (heading, rudder, yaw rate), got {len(axes)}")
-        for draw, ax in zip((draw_heading, draw_rudder, draw_yaw_rate), axes):
-            draw(ax, self, title)
-        return axes
 
     def to_csv(self, path: str | os.PathLike[str], progress: Optional[Callable[[int, int], None]] = None) -> Path:
         """Write the columns of :meth:`columns` as CSV (``%.10g``, one header line).

@@ -33,6 +33,10 @@ from typing import Optional
 VECTOR_ENTRIES = ("group", "step_lanes")
 """The entry points whose vectorisation is reported."""
 
+MODULE_PREFIX = "steerlab_driver_"
+"""Name prefix of the generated driver modules: :mod:`steerlab.jit.drivers` names them with it,
+the reports recognise them by it (declared here, below the drivers, which import this module)."""
+
 # library functions a vectorised loop may still call per lane element: cheap, exact intrinsics
 _CHEAP_VECTOR_INTRINSICS = frozenset({
     "fabs", "floor", "ceil", "trunc", "rint", "round", "sqrt", "copysign", "minnum", "maxnum",
@@ -59,8 +63,6 @@ def combined(reports: list) -> dict:
 def _path(dispatcher) -> Optional[Path]:
     """``d_<hash>.<entry>.vec.json`` beside the cached driver module of ``dispatcher`` (None for
     a driver built in memory or another function)."""
-    from steerlab.jit.drivers import MODULE_PREFIX
-
     func = getattr(dispatcher, "py_func", None)
     module = getattr(func, "__module__", "") or ""
     if getattr(func, "__name__", None) not in VECTOR_ENTRIES or not module.startswith(MODULE_PREFIX):
