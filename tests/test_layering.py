@@ -29,11 +29,11 @@ LAYERS = [
               "outputs", "plugins", "registry_index", "jit"]),
     ("models", ["environment", "ships", "steering_gear", "metrics_online"]),
     ("laws", ["guidance", "control", "sensors"]),
-    ("indices", ["metrics"]),
+    ("indices", ["metrics", "metrics_waves"]),
     ("engine", ["sim"]),
     ("analysis", ["costs", "report", "track_figures", "figure_worker", "sea_report", "resources", "trials",
                   "identification", "sweeps", "tuning", "experiments"]),
-    ("front", ["components", "gym", "runtime", "testing", "bench"]),
+    ("front", ["components", "gym", "runtime", "testing", "bench", "conformance"]),
     ("commands", ["commands", "cli", "__main__", "warm"]),
 ]
 """steerlab's layers, lowest first, and the packages (or top-level modules) of each, named below

@@ -204,13 +204,14 @@ def transfer_function(obj: Union[Controller, str, ShipSpec], speed_kn: Optional[
     """
     import control
 
-    from steerlab.components.controller import Controller
     from steerlab.ships.registry import ShipSpec
 
     if isinstance(obj, (str, ShipSpec)):
         ss = linearize(obj, speed_kn, ship_options)
         return control.ss2tf(ss, name=ss.name)
-    if not isinstance(obj, Controller):
+    # a Controller (steerlab.components.controller), known by what it has: that module
+    # imports this one
+    if not (hasattr(obj, "spec") and hasattr(obj, "params") and hasattr(obj, "type")):
         raise InputError("transfer_function", "takes a Controller (sl.controller) or a ship id "
                                               f"(steerlab ships), got {type(obj).__name__}")
     if speed_kn is not None or ship_options is not None:

@@ -94,6 +94,11 @@ class Plant:
                 np.array([K / (T1 * T2), K * T3 / (T1 * T2)]))
 
 
+
+P_YAW = slice(0, 2)   #: the plain plant's yaw-rate states [x1, x2] (r = Cr . x[P_YAW])
+P_PSI = 2             #: its heading [rad]
+N_PLANT = 3
+
 def random_plants(n: int = N_PLANTS, seed: int = SEED) -> list[Plant]:
     """``n`` seeded plants (module docstring): orders alternate 1, 2; signs alternate in pairs."""
     rng = np.random.default_rng(seed)
@@ -195,7 +200,7 @@ def _simulate(plants: list[Plant], groups: list, dt: float) -> list[tuple[str, s
     steps = int(math.ceil(t_end / dt - 1e-9))
     psi_new = math.radians(CHANGE_DEG)
     tol = math.radians(TOL_DEG)
-    x = np.zeros((n, 3))                                 # [x1, x2, psi]
+    x = np.zeros((n, N_PLANT))                           # [x1, x2, psi]
     delta = np.zeros(n)
     for _, _, vec in groups:
         vec.reset(heading=0.0, yaw_rate=0.0, heading_ref=0.0, rudder=0.0)
@@ -213,8 +218,8 @@ def _simulate(plants: list[Plant], groups: list, dt: float) -> list[tuple[str, s
     for k in range(steps + 1):
         t = k * dt
         ref = psi_new if k >= k_change else 0.0
-        r = np.einsum("ij,ij->i", Cr, x[:, :2])
-        psi = x[:, 2]
+        r = np.einsum("ij,ij->i", Cr, x[:, P_YAW])
+        psi = x[:, P_PSI]
         if k >= k_change:
             e = psi - psi_new
             ae = np.abs(e)
