@@ -29,7 +29,16 @@ steerlab's references. ``x4`` is the measured rudder angle (the last plant state
 
 The gear's rate limit and saturation are outside the design (as in the paper); the order is
 limited to ``u_max``. Gains [1/s], Table 3 (GA-tuned): ballast ``k1..k4 = 5.93, 184.252,
-0.001, 0.001``; full load ``0.001, 111.8115, 1.3708, 0.001``.
+0.001, 0.001``; full load ``0.001, 111.8115, 1.3708, 0.001``. With ``k3 = k4 = 0.001`` per second
+these never settle a 20 deg change (not on the B-481 either): they are the ``gains = "paper"``
+preset only.
+
+Design rule (``gains = "design"``, the default): ``k1..k3`` and the time unit as version A
+(:func:`steerlab.control.backstepping_a.design_gains`: error poles at the shared bandwidth
+``omega_n``), and ``k4 = t_u / T_R``: the gear error ``z4`` decays at the gear's own rate
+``1/T_R`` (the order is then ``u_c = alpha3 + T_R (alpha3' - c mu^3 z3)``, the design's
+rudder plus the lead that undoes the gear's lag). ``V' = -sum k_i z_i^2 < 0`` for any positive
+gains and either sign of ``T``. Integral action with anti-windup as version A (design rule only).
 """
 
 from __future__ import annotations
@@ -38,9 +47,10 @@ import numba
 from pydantic import create_model
 
 from steerlab.config_base import FrozenConfig
-from steerlab.control.backstepping_a import (B_IRDOT, B_K1, B_K2, B_K3, B_K4, B_MU, B_SET, B_TR,
-                                             B_TU, B_UMAX, N_STATE, Z_R_PREV, backstepping_errors,
+from steerlab.control.backstepping_a import (B_IRDOT, B_K1, B_K2, B_K3, B_K4, B_KI, B_MU, B_SET, B_TR,
+                                             B_TU, B_UMAX, N_STATE, Z_R_PREV, Z_XI, backstepping_errors,
                                              config_fields, make)
+from steerlab.control.heading_integral import integral_step
 from steerlab.control.registry import ControllerSpec
 from steerlab.control.backstepping_a import PARAMS as A_PARAMS
 from steerlab.control.van_leeuwen_design import yaw_accel
@@ -74,20 +84,18 @@ def backstepping_b_update(z, p, t, x, ref, h):
     a3d = (-k3 * z3d - z2d - fd + a2dd) / g
     T_R = p[B_TR] / tu
     u = T_R * (-p[B_K4] * z4 + x4 / T_R - g * z3 + a3d)
-    umax = p[B_UMAX]
-    return min(max(u, -umax), umax)
+    return integral_step(z, Z_XI, p[B_KI], -z1, u, p[B_UMAX], h)
 
 
 BacksteppingBConfig = create_model(
     "BacksteppingBConfig", __base__=FrozenConfig,
-    __doc__='``[controller] type = "backstepping_b"``: gains [1/s] (Table 3, ballast, by default).',
-    **config_fields("backstepping_b", ("k1", "k2", "k3", "k4"),
-                    defaults={"k1": 5.93, "k2": 184.252, "k3": 0.001, "k4": 0.001}))
+    __doc__='``[controller] type = "backstepping_b"``: gains [per time unit] (unset: design rule or Table 3).',
+    **config_fields("backstepping_b", ("k1", "k2", "k3", "k4")))
 BacksteppingBConfig.__module__ = __name__
 
 
 def build(cfg: BacksteppingBConfig, ctx):
-    return make(cfg, ctx, k4=cfg.k4)
+    return make(cfg, ctx, "B")
 
 
 CONTROLLER = ControllerSpec(
@@ -95,4 +103,7 @@ CONTROLLER = ControllerSpec(
     description="backstepping on the Van Leeuwen model with the steering gear (Witkowska, version B)",
     update=backstepping_b_update, n_state=N_STATE, config=BacksteppingBConfig, build=build,
     source="Witkowska & Smierzchalski, Table 2 eqs (21)-(24), (26), (29)",
-    params=A_PARAMS)
+    params=A_PARAMS,
+    design_rule=("k1..k3 and time unit as backstepping_a (error poles at the shared bandwidth omega_n), "
+                 "k4 = t_u/T_R: the gear error decays at the gear's rate (Witkowska & Smierzchalski Table 2 "
+                 "error system); cancels f for T of either sign"))
