@@ -321,7 +321,8 @@ BOUND_FACTOR = 2.0
 
 def bounds(cfg: ASAConfig, name: str, x0: float) -> tuple[float, float]:
     """``(lo, hi)`` of ``K_star`` or ``tau_star``: given, the thesis' (``gains = "paper"``), or the
-    thesis' widened to contain ``[x0/2, 2 x0]`` around the ship's initial value (design rule)."""
+    thesis' widened to contain ``[x0/2, 2 x0]`` (at most 100) around the initial value ``x0`` the
+    ship's model gives (design rule; ``x0 = nan``: an initial value the user gave, not widened)."""
     lo, hi = PAPER_BOUNDS[name]
     if cfg.gains == "design" and math.isfinite(x0) and x0 > 0.0:
         lo, hi = min(lo, x0 / BOUND_FACTOR), max(hi, min(BOUND_FACTOR * x0, 100.0))
@@ -345,8 +346,8 @@ def build(cfg: ASAConfig, ctx):
                 f"T = {T:.4g} s ({'course-unstable' if K * T > 0 else 'not finite'}); ASA identifies and adapts "
                 "to a course-stable model (thesis 4.3.2), so use nonlinear_adrc, backstepping_b or sliding_mode "
                 "(or give K_star0 and tau_star0 > 0)"))
-    ks_lo, ks_hi = bounds(cfg, "K_star", cfg.K_star0 if cfg.K_star0 is not None else ks0)
-    ts_lo, ts_hi = bounds(cfg, "tau_star", cfg.tau_star0 if cfg.tau_star0 is not None else ts0)
+    ks_lo, ks_hi = bounds(cfg, "K_star", ks0 if cfg.K_star0 is None else math.nan)
+    ts_lo, ts_hi = bounds(cfg, "tau_star", ts0 if cfg.tau_star0 is None else math.nan)
     if cfg.K_star0 is None or cfg.tau_star0 is None:
         for name, value, lo, hi in (("K_star0", ks0, ks_lo, ks_hi), ("tau_star0", ts0, ts_lo, ts_hi)):
             if getattr(cfg, name) is None and lo <= hi and not lo <= value <= hi:   # (lo > hi: its own error)
