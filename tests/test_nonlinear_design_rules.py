@@ -233,15 +233,17 @@ def test_infinite_nomoto_model_is_refused_naming_a_law_that_can():
 
 def test_integral_step_zero_gain_is_the_law_and_windup_is_stopped():
     z = np.zeros(2)
-    assert integral_step(z, 1, 0.0, 0.3, 0.123456789, 0.5, 0.1) == 0.123456789 and z[1] == 0.0
+    assert integral_step(z, 1, 0.0, 0.03, 0.123456789, 0.5, 0.1) == 0.123456789 and z[1] == 0.0
     # saturated towards the error: no integration; the error reversing the order: integrates
-    assert integral_step(z, 1, 0.01, 0.3, 0.9, 0.5, 0.1) == 0.5 and z[1] == 0.0
-    integral_step(z, 1, 0.01, -0.3, 0.9, 0.5, 0.1)
-    assert z[1] == pytest.approx(-0.03)
+    assert integral_step(z, 1, 0.01, 0.03, 0.9, 0.5, 0.1) == 0.5 and z[1] == 0.0
+    integral_step(z, 1, 0.01, -0.03, 0.9, 0.5, 0.1)
+    assert z[1] == pytest.approx(-0.003)
     z[1] = 0.0
+    integral_step(z, 1, 0.01, 0.3, 0.0, 0.5, 0.1)      # a course change (|e| > 5 deg): off
+    assert z[1] == 0.0
     for _ in range(100000):
-        integral_step(z, 1, 0.01, 0.3, 0.0, 0.5, 0.1)
-    assert z[1] * 0.01 <= 0.5 + 1e-12
+        integral_step(z, 1, 0.01, 0.03, 0.0, 0.5, 0.1)
+    assert 0.0 < z[1] * 0.01 <= 0.5 + 1e-12
 
 
 # --- ASA --------------------------------------------------------------------------------

@@ -11,7 +11,11 @@ side force, wind) leaves no steady heading error::
 ``omega_n`` on ``r' = -a r + b delta``. Anti-windup (conditional integration): ``xi`` is frozen
 while the order is limited, unless the error would bring it back, and ``|k_i xi|`` never
 exceeds the limit ``u_max``. With ``k_i = 0`` (the paper presets) the order is the law's own,
-bit for bit.
+bit for bit. And the integral is off in course changes: it runs only while ``|e|`` is below
+``INTEGRAL_BAND`` = 5 deg (a quarter of the reference turn), as the classic autopilot's
+integral is off in turns (van Amerongen 1982, Fig. 3.3), so a turn's transient does not charge
+it (with ``omega_n`` ~ 0.007 rad/s on a slow ship the charge took longer than 1 600 s to run
+out).
 """
 
 from __future__ import annotations
@@ -20,6 +24,8 @@ import numba
 
 #: ``k_i = omega_n Kp / INTEGRAL_DIVISOR`` with ``Kp = omega_n^2 / b`` (Fossen 2011, Sec. 12.2.7).
 INTEGRAL_DIVISOR = 10.0
+#: The integral runs only while the heading error is below this [rad] (5 deg): off in course changes.
+INTEGRAL_BAND = 0.08726646259971647
 
 
 def integral_gain(omega_n: float, b: float) -> float:
@@ -33,7 +39,7 @@ def integral_step(z, iz, ki, e, u_law, umax, h):
     error ``e`` [rad], over the sample ``h`` [s]) by conditional integration."""
     u = u_law + ki * z[iz]
     us = min(max(u, -umax), umax)
-    if ki > 0.0 and (u == us or e * u < 0.0):
+    if ki > 0.0 and abs(e) < INTEGRAL_BAND and (u == us or e * u < 0.0):
         lim = umax / ki
         z[iz] = min(max(z[iz] + h * e, -lim), lim)
     return us
