@@ -232,17 +232,21 @@ def test_infinite_nomoto_model_is_refused_naming_a_law_that_can():
 # --- integral action --------------------------------------------------------------------
 
 def test_integral_step_zero_gain_is_the_law_and_windup_is_stopped():
+    EDOT = 0.0
     z = np.zeros(2)
-    assert integral_step(z, 1, 0.0, 0.03, 0.123456789, 0.5, 0.1) == 0.123456789 and z[1] == 0.0
+    assert integral_step(z, 1, 0.0, 0.03, EDOT, 0.01, 0.123456789, 0.5, 0.1) == 0.123456789 and z[1] == 0.0
     # saturated towards the error: no integration; the error reversing the order: integrates
-    assert integral_step(z, 1, 0.01, 0.03, 0.9, 0.5, 0.1) == 0.5 and z[1] == 0.0
-    integral_step(z, 1, 0.01, -0.03, 0.9, 0.5, 0.1)
+    assert integral_step(z, 1, 0.01, 0.03, EDOT, 0.01, 0.9, 0.5, 0.1) == 0.5 and z[1] == 0.0
+    integral_step(z, 1, 0.01, -0.03, EDOT, 0.01, 0.9, 0.5, 0.1)
     assert z[1] == pytest.approx(-0.003)
     z[1] = 0.0
-    integral_step(z, 1, 0.01, 0.3, 0.0, 0.5, 0.1)      # a course change (|e| > 5 deg): off
+    integral_step(z, 1, 0.01, 0.3, -0.02, 0.01, 0.0, 0.5, 0.1)   # a course change (|e| > 5 deg, turning): off
     assert z[1] == 0.0
+    integral_step(z, 1, 0.01, 0.3, 0.0, 0.01, 0.0, 0.5, 0.1)      # held off the course (not turning): on
+    assert z[1] == pytest.approx(0.03)
+    z[1] = 0.0
     for _ in range(100000):
-        integral_step(z, 1, 0.01, 0.03, 0.0, 0.5, 0.1)
+        integral_step(z, 1, 0.01, 0.03, EDOT, 0.01, 0.0, 0.5, 0.1)
     assert 0.0 < z[1] * 0.01 <= 0.5 + 1e-12
 
 

@@ -83,7 +83,8 @@ from steerlab.angles import wrap_to_pi
 from steerlab.config_base import FrozenConfig
 from steerlab.control.registry import ControllerSpec
 from steerlab.control.design_model import ZETA
-from steerlab.control.heading_integral import INTEGRAL_DIVISOR, integral_step
+from steerlab.control.heading_integral import (INTEGRAL_BAND, INTEGRAL_DIVISOR, TURN_RATE_FRACTION,
+                                               integral_step)
 from steerlab.control.law_design import GAINS, law_bandwidth, law_model
 from steerlab.control.van_leeuwen_design import design_model, design_mu, yaw_accel
 from steerlab.errors import InputError
@@ -116,6 +117,8 @@ PARAMS = Layout("controller", "B_", [
                 lo=0.0, lo_open=True),
     RecordField("KI", "k_i", "1/s", "integral gain on the heading error (heading_integral; 0: none, the paper)",
                 lo=0.0, default=0.0),
+    RecordField("RBAND", "r_band", "rad/s", "integral off in turns: beyond 5 deg only while |r - r_ref| < r_band",
+                lo=0.0, default=0.0),
 ]).then("design", SET)
 PARAMS.export(globals())   # B_K1 = 0, ..., B_TU = 8, B_DESIGN_T1 = 9, ..., B_DESIGN_A3 = 15
 B_SET = PARAMS.index("design.T1")   # offset of the design set, read by vl_drift/vl_gain as p[B_SET + S_*]
@@ -142,6 +145,7 @@ class Backstepping(NamedTuple):
     design: tuple             #: Van Leeuwen set [T1, T2, K, a0, a1, a2, a3] (radian form)
     time_unit: float = 1.0    #: [s] unit of time of the gains: 1 s, or L/U (ship time)
     k_i: float = 0.0          #: integral gain [1/s] (heading_integral; 0 in the paper preset)
+    r_band: float = 0.0       #: [rad/s] heading_integral's turn detector: omega_n x 5 deg
 
     def pack(self) -> np.ndarray:
         rec = self._asdict()
@@ -181,7 +185,7 @@ def backstepping_a_update(z, p, t, x, ref, h):
     tu3 = p[B_TU] ** 3
     f = vl_drift(p, B_SET, mu, x[IR], rd) * tu3
     u = (-p[B_K3] * z3 - z2 - f + a2d) / (vl_gain(p, B_SET, mu) * tu3)
-    return integral_step(z, Z_XI, p[B_KI], -z1, u, p[B_UMAX], h)
+    return integral_step(z, Z_XI, p[B_KI], -z1, ref[REF_R] - x[IR], p[B_RBAND], u, p[B_UMAX], h)
 
 
 #: Version A's design rule refuses a ship whose ``b2 / (K/T)`` is outside ``[1/B2_MISMATCH, B2_MISMATCH]``.
@@ -277,7 +281,8 @@ def make(cfg, ctx, version: str = "A") -> tuple[Backstepping, np.ndarray]:
         if ki is None:
             w = w or cfg.omega_n or law_bandwidth(ctx, law)[1]
             ki = w / INTEGRAL_DIVISOR * stiffness(c, version)
-        c = c._replace(k_i=ki)
+        wi = w or cfg.omega_n or law_bandwidth(ctx, law)[1]
+        c = c._replace(k_i=ki, r_band=wi * INTEGRAL_BAND * TURN_RATE_FRACTION)
     return c, c.pack()
 
 

@@ -47,7 +47,8 @@ import numba
 from pydantic import create_model
 
 from steerlab.config_base import FrozenConfig
-from steerlab.control.backstepping_a import (B_IRDOT, B_K1, B_K2, B_K3, B_K4, B_KI, B_MU, B_SET, B_TR,
+from steerlab.control.backstepping_a import (B_IRDOT, B_K1, B_K2, B_K3, B_K4, B_KI, B_MU, B_RBAND, B_SET,
+                                             B_TR,
                                              B_TU, B_UMAX, N_STATE, Z_R_PREV, Z_XI, backstepping_errors,
                                              config_fields, make)
 from steerlab.control.heading_integral import integral_step
@@ -55,6 +56,7 @@ from steerlab.control.registry import ControllerSpec
 from steerlab.control.backstepping_a import PARAMS as A_PARAMS
 from steerlab.control.van_leeuwen_design import yaw_accel
 from steerlab.ships.van_leeuwen import vl_drift, vl_drift_partials, vl_gain
+from steerlab.guidance.reference_vector import REF_R
 from steerlab.ships.state import IR
 
 
@@ -84,7 +86,7 @@ def backstepping_b_update(z, p, t, x, ref, h):
     a3d = (-k3 * z3d - z2d - fd + a2dd) / g
     T_R = p[B_TR] / tu
     u = T_R * (-p[B_K4] * z4 + x4 / T_R - g * z3 + a3d)
-    return integral_step(z, Z_XI, p[B_KI], -z1, u, p[B_UMAX], h)
+    return integral_step(z, Z_XI, p[B_KI], -z1, ref[REF_R] - x[IR], p[B_RBAND], u, p[B_UMAX], h)
 
 
 BacksteppingBConfig = create_model(

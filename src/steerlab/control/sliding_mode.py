@@ -63,7 +63,8 @@ from steerlab.angles import wrap_to_pi
 from steerlab.config_base import FrozenConfig
 from steerlab.control.registry import ControllerSpec
 from steerlab.control.design_model import DESIGN_TURN
-from steerlab.control.heading_integral import integral_gain, integral_step
+from steerlab.control.heading_integral import (INTEGRAL_BAND, TURN_RATE_FRACTION, integral_gain,
+                                               integral_step)
 from steerlab.control.law_design import GAINS, GainsMode, law_bandwidth, law_model
 from steerlab.control.van_leeuwen_design import design_model, design_mu, linear_design_matrices, yaw_accel
 from steerlab.errors import InputError
@@ -89,6 +90,8 @@ PARAMS = Layout("controller", "S_", [
     RecordField("IRDOT", "i_rdot", "-", "index of rdot in the plant state; -1: estimate r' from the yaw rate"),
     RecordField("UMAX", "u_max", "rad", "output limit (scenario default: the gear's limit)", lo=0.0, lo_open=True),
     RecordField("KI", "k_i", "1/s", "integral gain on the heading error (heading_integral; 0: none, the paper)",
+                lo=0.0, default=0.0),
+    RecordField("RBAND", "r_band", "rad/s", "integral off in turns: beyond 5 deg only while |r - r_ref| < r_band",
                 lo=0.0, default=0.0),
 ], size_name="N_PARAMS")
 PARAMS.export(globals())   # S_K1..S_K4 = 0..3, S_H1..S_H4 = 4..7, S_ETA = 8, ..., S_UMAX = 12, N_PARAMS = 13
@@ -136,6 +139,7 @@ class SlidingMode(NamedTuple):
     i_rdot: float
     u_max: float
     k_i: float = 0.0  #: integral gain [1/s] (heading_integral)
+    r_band: float = 0.0  #: [rad/s] heading_integral's turn detector: omega_n x 5 deg
 
     def pack(self) -> np.ndarray:
         for name, v in (("k", self.k), ("h", self.h)):
@@ -144,7 +148,7 @@ class SlidingMode(NamedTuple):
         return PARAMS.pack(**{f"k{i + 1}": v for i, v in enumerate(self.k)},
                            **{f"h{i + 1}": v for i, v in enumerate(self.h)},
                            eta=self.eta, phi=self.phi, hb=self.hb, i_rdot=self.i_rdot, u_max=self.u_max,
-                           k_i=self.k_i)
+                           k_i=self.k_i, r_band=self.r_band)
 
     def init_state(self, x0, ref0) -> np.ndarray:
         return STATE.pack(r_prev=x0[IR], xi=0.0)
@@ -162,7 +166,7 @@ def sliding_mode_update(z, p, t, x, ref, h):
     sat = min(max(q, -1.0), 1.0)
     u = -(p[S_K1] * e1 + p[S_K2] * e2 + p[S_K3] * rd + p[S_K4] * e4) \
         - p[S_ETA] / p[S_HB] * sat
-    return integral_step(z, Z_XI, p[S_KI], -e1, u, p[S_UMAX], h)
+    return integral_step(z, Z_XI, p[S_KI], -e1, -e2, p[S_RBAND], u, p[S_UMAX], h)
 
 
 class SlidingModeConfig(FrozenConfig):
@@ -216,10 +220,10 @@ def build(cfg: SlidingModeConfig, ctx):
     hb = float(h @ b)
     if abs(hb) < 1e-12:
         raise InputError("controller.poles", "h^T b = 0: the switching term cannot act on s")
-    ki = cfg.k_i if cfg.k_i is not None else (
-        0.0 if paper else integral_gain(w if w is not None else law_bandwidth(ctx, "sliding_mode")[1],
-                                        law_model(ctx).b))
-    c = SlidingMode(tuple(k), tuple(h), eta, phi, hb, i_rdot, ctx.u_max(cfg.u_max_deg), ki)
+    wi = w if w is not None or (paper and cfg.k_i is None) else law_bandwidth(ctx, "sliding_mode")[1]
+    ki = cfg.k_i if cfg.k_i is not None else (0.0 if paper else integral_gain(wi, law_model(ctx).b))
+    c = SlidingMode(tuple(k), tuple(h), eta, phi, hb, i_rdot, ctx.u_max(cfg.u_max_deg), ki,
+                    0.0 if wi is None else wi * INTEGRAL_BAND * TURN_RATE_FRACTION)
     return c, c.pack()
 
 
