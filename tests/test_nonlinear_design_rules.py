@@ -265,3 +265,26 @@ def test_asa_refuses_a_course_unstable_ship_in_one_line_naming_laws_that_can():
         obj("esso", {"type": "asa"}, speed_kn=16.0)
     msg = str(err.value)
     assert err.value.field == "controller.type" and "nonlinear_adrc" in msg and "\n" not in msg
+
+
+@pytest.mark.parametrize("law", ["adrc", "nonlinear_adrc", "sliding_mode", "backstepping_a", "backstepping_b"])
+def test_designed_from_K_T_alone_of_either_sign_holds_a_20_deg_change(law):
+    """sl.controller(type, nomoto=(K, T)) with no ship, no speed: a plain-Python Nomoto plant
+    behind a rate-limited gear settles within 1 deg of a 20 deg change, course-stable or not."""
+    import steerlab as sl
+
+    for K, T in ((0.08, 60.0), (-0.03, -250.0)):
+        gear = {"delta_max_deg": 30.0, "rate_max_deg_s": 3.0, "T_sg": 1.0}
+        c = sl.controller(law, nomoto=(K, T), gear=gear)
+        c.reset(heading=0.0, yaw_rate=0.0, heading_ref=0.0, rudder=0.0)
+        psi = r = d = 0.0
+        h, dm, rm, tgt = 0.1, rad(30.0), rad(3.0), rad(20.0)
+        worst = 0.0
+        for k in range(int(1500.0 / h)):
+            u = min(max(c.step(k * h, psi, r, tgt, 0.0, rudder=d), -dm), dm)
+            d = min(max(d + h * min(max(u - d, -rm), rm), -dm), dm)
+            r += h * (K * d - r) / T
+            psi += h * r
+            if k * h >= 1200.0:
+                worst = max(worst, abs(psi - tgt))
+        assert worst < rad(1.0), (law, K, T, math.degrees(worst))
