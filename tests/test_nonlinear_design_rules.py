@@ -212,6 +212,19 @@ def test_backstepping_b_designs_course_unstable_ships(ship):
     assert (c.k1, c.k2, c.k3, c.time_unit) == (k, k, k, tu)
     assert c.k4 == pytest.approx(tu / ctx.gear.T_sg)
     assert c.k_i == pytest.approx(w / 10.0 * stiffness(c, "B")) and c.k_i > 0.0
+    assert c.weighted == 1.0 and c.T_f == pytest.approx(0.1 / w)   # unit cross terms; r' low-passed
+
+
+def test_backstepping_b_design_does_not_chatter():
+    """Written on c mu^3 z4 the last step has unit cross terms; as printed, the (z3, z4) pair
+    oscillated near 20 rad/s, above the sample's Nyquist rate (order +-16 deg each sample)."""
+    from steerlab.sim.engine import simulate
+
+    res = simulate(build(scenario("capella-nomoto-10deg", {"type": "backstepping_b"}).replace(duration=1200.0)),
+                   "compiled")
+    late = np.degrees(res.delta_cmd[-3000:])
+    assert late.max() - late.min() < 0.1
+    assert abs(np.degrees(res.states[-1, 2]) - 20.0) < 0.5
 
 
 def test_backstepping_a_refuses_a_ship_whose_b2_is_not_K_over_T_naming_b():

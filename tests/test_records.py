@@ -281,8 +281,8 @@ def test_controller_layouts_keep_the_kernels_slots():
     assert (s.S_K1, s.S_K4, s.S_H1, s.S_H4, s.S_ETA, s.S_PHI, s.S_HB, s.S_IRDOT, s.S_UMAX, s.S_KI, s.S_RBAND,
             s.N_PARAMS, s.N_STATE) == (0, 3, 4, 7, 8, 9, 10, 11, 12, 13, 14, 15, 2)
     b = backstepping_a
-    assert (b.B_K1, b.B_K4, b.B_TR, b.B_MU, b.B_IRDOT, b.B_UMAX, b.B_TU, b.B_KI, b.B_RBAND, b.B_SET, b.N_PARAMS,
-            b.N_STATE) == (0, 3, 4, 5, 6, 7, 8, 9, 10, 11, 18, 2)
+    assert (b.B_K1, b.B_K4, b.B_TR, b.B_MU, b.B_IRDOT, b.B_UMAX, b.B_TU, b.B_KI, b.B_RBAND, b.B_TF, b.B_W4, b.B_SET,
+            b.N_PARAMS, b.N_STATE) == (0, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 20, 3)
     z = asa_layout
     assert (z.Z_MODE, z.Z_KP, z.Z_DELTA_LIM, z.N_STATE) == (N_WF, N_WF + 7, N_WF + 17, N_WF + 18)
     assert (z.P_L, z.P_KD_RULE, z.P_T_POW_ID, z.N_PARAMS) == (N_WF_PARAMS, N_WF_PARAMS + 9, N_WF_PARAMS + 29,

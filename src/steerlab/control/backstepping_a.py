@@ -119,6 +119,10 @@ PARAMS = Layout("controller", "B_", [
                 lo=0.0, default=0.0),
     RecordField("RBAND", "r_band", "rad/s", "integral off in turns: beyond 5 deg only while |r - r_ref| < r_band",
                 lo=0.0, default=0.0),
+    RecordField("TF", "T_f", "s", "version B: time constant of the r' low-pass (0: none, the paper)", lo=0.0,
+                default=0.0),
+    RecordField("W4", "weighted", "-", "version B: 1 = gear error weighted by c mu^3 (design rule), 0 = Table 2",
+                lo=0.0, hi=1.0, default=0.0),
 ]).then("design", SET)
 PARAMS.export(globals())   # B_K1 = 0, ..., B_TU = 8, B_DESIGN_T1 = 9, ..., B_DESIGN_A3 = 15
 B_SET = PARAMS.index("design.T1")   # offset of the design set, read by vl_drift/vl_gain as p[B_SET + S_*]
@@ -127,8 +131,9 @@ STATE = Layout("controller state", "Z_", [
     RecordField("R_PREV", "r_prev", "rad/s", "previous yaw rate, for the r' estimate on ships without an rdot "
                 "state (van_leeuwen_design.yaw_accel)"),
     RecordField("XI", "xi", "rad s", "integral of the heading error (heading_integral)"),
+    RecordField("RDF", "rd_f", "rad/s^2", "low-passed r' estimate (version B's design rule; unused by A)"),
 ], size_name="N_STATE")
-STATE.export(globals())    # Z_R_PREV = 0, Z_XI = 1, N_STATE = 2
+STATE.export(globals())    # Z_R_PREV = 0, Z_XI = 1, Z_RDF = 2, N_STATE = 3
 
 
 class Backstepping(NamedTuple):
@@ -146,6 +151,8 @@ class Backstepping(NamedTuple):
     time_unit: float = 1.0    #: [s] unit of time of the gains: 1 s, or L/U (ship time)
     k_i: float = 0.0          #: integral gain [1/s] (heading_integral; 0 in the paper preset)
     r_band: float = 0.0       #: [rad/s] heading_integral's turn detector: omega_n x 5 deg
+    T_f: float = 0.0          #: [s] version B's r' low-pass (0: none)
+    weighted: float = 0.0     #: version B: 1 = z4 weighted by c mu^3 (design rule), 0 = Table 2 as printed
 
     def pack(self) -> np.ndarray:
         rec = self._asdict()
@@ -156,7 +163,7 @@ class Backstepping(NamedTuple):
         return PARAMS.pack(rec)
 
     def init_state(self, x0, ref0) -> np.ndarray:
-        return STATE.pack(r_prev=x0[IR], xi=0.0)
+        return STATE.pack(r_prev=x0[IR], xi=0.0, rd_f=0.0)
 
 
 @numba.njit(cache=True)
@@ -188,6 +195,8 @@ def backstepping_a_update(z, p, t, x, ref, h):
     return integral_step(z, Z_XI, p[B_KI], -z1, ref[REF_R] - x[IR], p[B_RBAND], u, p[B_UMAX], h)
 
 
+#: Version B's design rule low-passes a differenced r' with the time constant ``RD_FILTER / omega_n`` [s].
+RD_FILTER = 0.1
 #: Version A's design rule refuses a ship whose ``b2 / (K/T)`` is outside ``[1/B2_MISMATCH, B2_MISMATCH]``.
 B2_MISMATCH = 1.25
 
@@ -282,7 +291,9 @@ def make(cfg, ctx, version: str = "A") -> tuple[Backstepping, np.ndarray]:
             w = w or cfg.omega_n or law_bandwidth(ctx, law)[1]
             ki = w / INTEGRAL_DIVISOR * stiffness(c, version)
         wi = w or cfg.omega_n or law_bandwidth(ctx, law)[1]
-        c = c._replace(k_i=ki, r_band=wi * INTEGRAL_BAND * TURN_RATE_FRACTION)
+        c = c._replace(k_i=ki, r_band=wi * INTEGRAL_BAND * TURN_RATE_FRACTION,
+                       T_f=RD_FILTER / wi if version == "B" and i_rdot < 0.0 else 0.0,
+                       weighted=1.0 if version == "B" and gain_time == "design" else 0.0)
     return c, c.pack()
 
 

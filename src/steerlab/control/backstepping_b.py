@@ -33,7 +33,14 @@ limited to ``u_max``. Gains [1/s], Table 3 (GA-tuned): ballast ``k1..k4 = 5.93, 
 these never settle a 20 deg change (not on the B-481 either): they are the ``gains = "paper"``
 preset only.
 
-Design rule (``gains = "design"``, the default): ``k1..k3`` and the time unit as version A
+Design rule (``gains = "design"``, the default). The last step is written on the weighted
+error ``w4 = c mu^3 z4`` (``V = (z1^2 + z2^2 + z3^2 + w4^2)/2``): then ``z3' = -k3 z3 - z2 + w4``,
+``w4' = -k4 w4 - z3`` with unit cross terms, and the order is
+``u_c = T_R (-k4 z4 + x4/T_R - z3/(c mu^3) + alpha3')``. As printed (``V4 = z4^2/2``), the pair
+``(z3, z4)`` oscillates at ``c mu^3 t_u^2`` [rad/s] in real time, about 20 rad/s on a thesis
+ship with the design's time unit: above the 0.1 s sample's Nyquist rate, the order then
+alternated +-16 deg from sample to sample (measured). A differenced ``r'`` (ships without an
+``rdot`` state) is low-passed with the time constant ``0.1/omega_n``. ``k1..k3`` and the time unit as version A
 (:func:`steerlab.control.backstepping_a.design_gains`: error poles at the shared bandwidth
 ``omega_n``), and ``k4 = t_u / T_R``: the gear error ``z4`` decays at the gear's own rate
 ``1/T_R`` (the order is then ``u_c = alpha3 + T_R (alpha3' - c mu^3 z3)``, the design's
@@ -47,9 +54,9 @@ import numba
 from pydantic import create_model
 
 from steerlab.config_base import FrozenConfig
-from steerlab.control.backstepping_a import (B_IRDOT, B_K1, B_K2, B_K3, B_K4, B_KI, B_MU, B_RBAND, B_SET,
+from steerlab.control.backstepping_a import (B_IRDOT, B_K1, B_K2, B_K3, B_K4, B_KI, B_MU, B_RBAND, B_SET, B_TF, B_W4,
                                              B_TR,
-                                             B_TU, B_UMAX, N_STATE, Z_R_PREV, Z_XI, backstepping_errors,
+                                             B_TU, B_UMAX, N_STATE, Z_R_PREV, Z_RDF, Z_XI, backstepping_errors,
                                              config_fields, make)
 from steerlab.control.heading_integral import integral_step
 from steerlab.control.registry import ControllerSpec
@@ -64,6 +71,10 @@ from steerlab.ships.state import IR
 def backstepping_b_update(z, p, t, x, ref, h):
     """One sample of law (26): the rudder order [rad]."""
     rd = yaw_accel(z, Z_R_PREV, p[B_IRDOT], x, h)
+    tf = p[B_TF]
+    if tf > 0.0:
+        z[Z_RDF] = z[Z_RDF] + h / (tf + h) * (rd - z[Z_RDF])
+        rd = z[Z_RDF]
     z1, z2, z3, z1d, z2d, a2d = backstepping_errors(p, x, ref, rd)
     k1 = p[B_K1]
     k2 = p[B_K2]
@@ -85,7 +96,10 @@ def backstepping_b_update(z, p, t, x, ref, h):
     fd = f_r * tu * tu * (rd * tu * tu) + f_rd * tu * x3d
     a3d = (-k3 * z3d - z2d - fd + a2dd) / g
     T_R = p[B_TR] / tu
-    u = T_R * (-p[B_K4] * z4 + x4 / T_R - g * z3 + a3d)
+    if p[B_W4] > 0.5:   # design rule: V4 = (c mu^3 z4)^2 / 2, unit cross terms (module doc)
+        u = T_R * (-p[B_K4] * z4 + x4 / T_R - z3 / g + a3d)
+    else:
+        u = T_R * (-p[B_K4] * z4 + x4 / T_R - g * z3 + a3d)
     return integral_step(z, Z_XI, p[B_KI], -z1, ref[REF_R] - x[IR], p[B_RBAND], u, p[B_UMAX], h)
 
 
