@@ -109,9 +109,9 @@ def test_designed_from_K_T_only_steers_a_plain_python_plant(law, cfg):
 @pytest.mark.parametrize("law,kw,field", [
     ("adrc", {}, "nomoto"),                                    # b2 needs a model
     ("lq_pd", {}, "nomoto"),
-    ("sliding_mode", {"nomoto": (0.05, 80.0)}, "speed_kn"),    # mu = U/L
-    ("sliding_mode", {"ship": "esso", "speed_kn": 16.0}, "nomoto"),   # course-unstable
-    ("asa", {"ship": "esso", "speed_kn": 16.0}, "K_star0"),
+    ("asa", {"nomoto": (0.05, 80.0)}, "speed_kn"),             # K* = K L/U, tau* = T U/L
+    ("backstepping_a", {"ship": "esso", "speed_kn": 16.0}, "type"),   # b2 != K/T: names backstepping_b
+    ("asa", {"ship": "esso", "speed_kn": 16.0}, "type"),   # course-unstable: names laws that can
     ("pid", {"ship": "kosoko", "speed_kn": 16.0}, "speed_kn"),      # outside its range (no speed: design speed)
     ("pid", {"ship": "esso", "speed_kn": 16.0, "nomoto": (0.1, 50.0)}, "nomoto"),
     ("pid", {"Kp": -1.0}, "Kp"),

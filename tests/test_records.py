@@ -274,18 +274,19 @@ def test_controller_layouts_keep_the_kernels_slots():
             i.N_PARAMS) == tuple(range(10))
     assert (i.Z_PSI_P, i.Z_R_P, i.Z_INT, i.N_STATE) == (0, 1, 2, 3)
     a = adrc
-    assert (a.A_C0, a.A_KP, a.A_KD, a.A_KDSIGN, a.A_L1, a.A_L2, a.A_L3, a.A_UMAX, a.N_PARAMS) == tuple(range(9))
+    assert (a.A_C0, a.A_KP, a.A_KD, a.A_KDSIGN, a.A_L1, a.A_L2, a.A_L3, a.A_UMAX, a.A_FMAX,
+            a.N_PARAMS) == tuple(range(10))
     assert (a.Z_PSI, a.Z_R, a.Z_F, a.N_STATE) == (estimators.E_PSI, estimators.E_R, estimators.E_F, 3) == (0, 1, 2, 3)
     n = nonlinear_adrc
-    assert (n.N_B, n.N_BETA1, n.N_A01, n.N_D02, n.N_K1, n.N_A1, n.N_D2, n.N_R, n.N_H0, n.N_UMAX, n.N_PARAMS) == (
-        0, 1, 4, 7, 8, 10, 13, 14, 15, 16, 17)
+    assert (n.N_B, n.N_BETA1, n.N_A01, n.N_D02, n.N_K1, n.N_A1, n.N_D2, n.N_R, n.N_H0, n.N_UMAX, n.N_FMAX, n.N_ESOIN,
+            n.N_PARAMS) == (0, 1, 4, 7, 8, 10, 13, 14, 15, 16, 17, 18, 19)
     assert (n.Z_V1, n.Z_V2, n.Z_Z1, n.Z_Z2, n.Z_Z3, n.N_STATE) == tuple(range(6))
     s = sliding_mode
-    assert (s.S_K1, s.S_K4, s.S_H1, s.S_H4, s.S_ETA, s.S_PHI, s.S_HB, s.S_IRDOT, s.S_UMAX, s.N_PARAMS) == (
-        0, 3, 4, 7, 8, 9, 10, 11, 12, 13)
+    assert (s.S_K1, s.S_K4, s.S_H1, s.S_H4, s.S_ETA, s.S_PHI, s.S_HB, s.S_IRDOT, s.S_UMAX, s.S_KI, s.S_RBAND,
+            s.N_PARAMS, s.N_STATE) == (0, 3, 4, 7, 8, 9, 10, 11, 12, 13, 14, 15, 2)
     b = backstepping_a
-    assert (b.B_K1, b.B_K4, b.B_TR, b.B_MU, b.B_IRDOT, b.B_UMAX, b.B_TU, b.B_SET, b.N_PARAMS, b.N_STATE) == (
-        0, 3, 4, 5, 6, 7, 8, 9, 16, 1)
+    assert (b.B_K1, b.B_K4, b.B_TR, b.B_MU, b.B_IRDOT, b.B_UMAX, b.B_TU, b.B_KI, b.B_RBAND, b.B_TF, b.B_W4, b.B_SET,
+            b.N_PARAMS, b.N_STATE) == (0, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 20, 3)
     z = asa_layout
     assert (z.Z_MODE, z.Z_KP, z.Z_DELTA_LIM, z.N_STATE) == (N_WF, N_WF + 7, N_WF + 17, N_WF + 18)
     assert (z.P_L, z.P_KD_RULE, z.P_T_POW_ID, z.N_PARAMS) == (N_WF_PARAMS, N_WF_PARAMS + 9, N_WF_PARAMS + 29,
@@ -314,12 +315,15 @@ def test_controller_records_pack_by_name_and_check_the_declared_bounds():
         adrc.ADRC(c0=1e-3, Kp=1e-3, Kd=0.1, L=(1.0, -1.0, 1.0)).pack()
     with pytest.raises(InputError, match=r"controller\.k2: must be finite"):
         sliding_mode.SlidingMode((0.0, math.nan, 1.0, 1.0), (1.0, 1.0, 1.0, 1.0), 0.1, 0.1, 1.0, -1.0, 0.5).pack()
-    # one declaration, two controllers: version B's published gains replace the defaults only
+    # one declaration, two controllers: unset gains come from the design rule or, with
+    # gains = "paper", each version's published Table 3 values
     a = backstepping_a.BacksteppingAConfig.model_json_schema()["properties"]
     b = backstepping_b.BacksteppingBConfig.model_json_schema()["properties"]
-    assert a["k1"]["default"] == backstepping_a.PARAMS.fields[backstepping_a.B_K1].default == 0.020568
-    assert b["k1"]["default"] == 5.93 and b["k4"]["default"] == 0.001
-    assert a["k2"]["exclusiveMinimum"] == b["k2"]["exclusiveMinimum"] == 0.0 and b["k2"]["maximum"] == 1e6
+    assert a["k1"]["default"] is None and b["k4"]["default"] is None
+    assert backstepping_a.PARAMS.fields[backstepping_a.B_K1].default == backstepping_a.PAPER_GAINS["A"]["k1"] == 0.020568
+    assert backstepping_a.PAPER_GAINS["B"]["k1"] == 5.93 and backstepping_a.PAPER_GAINS["B"]["k4"] == 0.001
+    k2 = [next(v for v in x["k2"]["anyOf"] if v.get("type") == "number") for x in (a, b)]
+    assert k2[0]["exclusiveMinimum"] == k2[1]["exclusiveMinimum"] == 0.0 and k2[1]["maximum"] == 1e6
 
 
 def test_config_fields_defaults_replace_the_declared_default_only():

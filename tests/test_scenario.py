@@ -104,7 +104,8 @@ def test_adrc_observer_choices():
     def L(**kw):
         s = build(scenario_from_dict(make_scenario_dict(controller={"type": "adrc", **kw})))
         return s.pc[[A_L1, A_L2, A_L3]]
-    np.testing.assert_allclose(L(), PAPER_L)
+    np.testing.assert_allclose(L(gains="paper"), PAPER_L)
+    np.testing.assert_allclose(L(observer="paper"), PAPER_L)
     np.testing.assert_allclose(L(observer="bandwidth", observer_bandwidth=0.2), eso_gains_bandwidth(0.2))
     np.testing.assert_allclose(L(observer="lqr", lqr_q=(2.0, 1.0, 0.5), lqr_r=0.5), eso_gains_lqr((2.0, 1.0, 0.5), 0.5))
     np.testing.assert_allclose(L(observer="bandwidth", L=(1.0, 0.3, 0.01)), [1.0, 0.3, 0.01])
@@ -183,7 +184,7 @@ def test_unknown_controller_type_names_type_field():
 def test_bad_c0_names_field():
     e = _err(make_scenario_dict(controller={"type": "adrc", "c0": "guess"}))
     assert e.field == "controller.c0"
-    assert "'estimate' or 'exact'" in str(e)
+    assert "'estimate', 'exact' or 'design'" in str(e)
 
 
 def test_wave_sample_time_names_scenario_field():

@@ -24,6 +24,32 @@ The paper as printed is inconsistent, and steerlab does not hide it:
 ``c0`` is the rudder efficiency ``b2`` of (37), in steerlab's sign (positive; the paper's
 ``c0 = -9.18e-4`` is for its rudder sign, delta < 0 to starboard). The ESO is fed the
 controller's own (limited) order ``u``; the measured heading enters the error, as in (7d).
+
+Design rule (``gains = "design"``, the default; every value the user gives wins):
+
+* ``c0 = "design"``: the design model's ``b2``: the exact linearisation of the ship model where
+  it has one, else ``K/T`` of its first-order Nomoto model (the definition of ``b0``; the van
+  Amerongen thesis ships, which have no block coefficient and beam for eq 29, and Nomoto-only
+  designs). :class:`ADRC` keeps which one in ``c0_source``. The eq-29 estimate (``c0 =
+  "estimate"``, the paper's choice) is a hull-form regression for a ship whose model is not
+  known; where the model is known it can be far off (the 176k tanker model: 0.0154 against
+  ``K/T = 0.00259`` 1/s^2, and the loop with it limit-cycles at +-25 deg).
+* ``T_settle = 6 / omega_n`` with ``omega_n`` the shared bandwidth
+  (:func:`steerlab.control.design_model.bandwidth`): Herbst's double pole ``-6/T_settle`` of (38)
+  placed at ``-omega_n``, capped by the gear's limit, rate and lag; a course-unstable ship gets
+  ``omega_n >= 2 |1/T|`` (the ESO treats ``-r/T`` as part of the total disturbance) or a
+  one-line refusal naming the gear field.
+* ``observer = "design"``: a triple ESO pole at ``-OBSERVER_MULTIPLE * 6 / T_settle``
+  (``OBSERVER_MULTIPLE = 5``; Gao 2003 advises an observer 3-10 times faster than the loop).
+
+``gains = "paper"``: unset values as in the paper's runs (``T_settle = 150 s``,
+``c0 = "estimate"``, the paper's observer ``L``).
+
+Anti-windup: the ESO is fed the limited order ``u`` (not the unlimited ``u0 - xh3``), so
+its model of the plant input stays true while the rudder saturates (Gao 2006); and the
+disturbance estimate ``xh3``, the one integrator of the loop, is clamped to what the rudder
+can cancel, ``|xh3| <= |c0| u_max`` (conditional integration: a larger estimate would only
+wind up). ``anti_windup = "off"`` removes the clamp (the default with ``gains = "paper"``).
 """
 
 from __future__ import annotations
@@ -39,6 +65,7 @@ from steerlab.angles import wrap_to_pi
 from steerlab.config_base import FrozenConfig
 from steerlab.control.estimators import (ESO, PAPER_L, check_discrete_eso, eso_gains_bandwidth,
                                          eso_gains_lqr, eso_step)
+from steerlab.control.law_design import GAINS, GainsMode, law_bandwidth, law_model
 from steerlab.control.registry import ControllerSpec
 from steerlab.errors import InputError, require_finite_range
 from steerlab.records import Field as RecordField
@@ -58,13 +85,21 @@ PARAMS = Layout("controller", "A_", [
     RecordField("L2", "L2", "1/s^2", "ESO gain l2 of (7a) (Sec. 5: 0.44955)", lo=0.0, lo_open=True),
     RecordField("L3", "L3", "1/s^3", "ESO gain l3 of (7a) (Sec. 5: 0.001)", lo=0.0, lo_open=True),
     RecordField("UMAX", "u_max", "rad", "output limit (scenario default: the gear's limit)", lo=0.0, lo_open=True),
+    RecordField("FMAX", "f_max", "rad/s^2", "anti-windup clamp of the disturbance estimate xh3: |c0| u_max, "
+                "or 1e300 (off)", lo=0.0, lo_open=True),
 ], size_name="N_PARAMS")
-PARAMS.export(globals())   # A_C0 = 0, A_KP, A_KD, A_KDSIGN, A_L1, A_L2, A_L3, A_UMAX = 7, N_PARAMS = 8
+PARAMS.export(globals())   # A_C0 = 0, A_KP, A_KD, A_KDSIGN, A_L1, A_L2, A_L3, A_UMAX = 7, A_FMAX = 8, N_PARAMS = 9
 STATE = Layout("controller state", "Z_", ESO.fields, size_name="N_STATE")
 STATE.export(globals())    # the ESO estimate (estimators.ESO): Z_PSI = 0, Z_R = 1, Z_F = 2, N_STATE = 3
 
 LAWS = ("stable", "printed")
 KD_RULES = ("herbst", "printed")
+#: The clamp value that means "off" (records hold finite numbers only).
+NO_CLAMP = 1e300
+#: ESO bandwidth of the design rule, in multiples of the loop's pole ``6 / T_settle`` [-].
+OBSERVER_MULTIPLE = 5.0
+#: ``T_settle`` = ``HERBST / omega_n``: the double pole of (38) at ``-omega_n``.
+HERBST = 6.0
 
 
 def adrc_gains(T_settle: float, kd_rule: str = "herbst") -> tuple[float, float]:
@@ -90,13 +125,17 @@ class ADRC(NamedTuple):
     L: tuple = PAPER_L             #: ESO gains [1/s, 1/s^2, 1/s^3]
     law: str = "stable"            #: "stable" (-Kd x2) or "printed" (+Kd x2, diverges)
     u_max: float = rad(35.0)       #: output limit [rad]
+    f_max: float = NO_CLAMP        #: anti-windup clamp of xh3 [rad/s^2]; NO_CLAMP: off
+    c0_source: str = ""            #: where c0 came from (design report)
 
     @classmethod
     def from_settling_time(cls, T_settle: float, c0: float, L=PAPER_L, law: str = "stable",
-                           kd_rule: str = "herbst", u_max: float = rad(35.0)) -> "ADRC":
+                           kd_rule: str = "herbst", u_max: float = rad(35.0), f_max: float = NO_CLAMP,
+                           c0_source: str = "") -> "ADRC":
         """Gains by (38) for ``T_settle`` [s] (paper's nominal choice: 150 s)."""
         kp, kd = adrc_gains(T_settle, kd_rule)
-        return cls(c0=c0, Kp=kp, Kd=kd, L=tuple(float(v) for v in L), law=law, u_max=u_max)
+        return cls(c0=c0, Kp=kp, Kd=kd, L=tuple(float(v) for v in L), law=law, u_max=u_max, f_max=f_max,
+                   c0_source=c0_source)
 
     def pack(self) -> np.ndarray:
         require_finite_range("controller.c0", self.c0)
@@ -108,7 +147,7 @@ class ADRC(NamedTuple):
             raise InputError("controller.law", f"must be one of {LAWS}, got {self.law!r}")
         l1, l2, l3 = self.L
         return PARAMS.pack(c0=self.c0, Kp=self.Kp, Kd=self.Kd, kd_sign=-1.0 if self.law == "stable" else 1.0,
-                           L1=l1, L2=l2, L3=l3, u_max=self.u_max)
+                           L1=l1, L2=l2, L3=l3, u_max=self.u_max, f_max=self.f_max)
 
     def init_state(self, x0, ref0) -> np.ndarray:
         """ESO starts at the measured heading and yaw rate with no disturbance estimate."""
@@ -126,52 +165,81 @@ def adrc_update(z, p, t, x, ref, h):
     umax = p[A_UMAX]
     u = min(max(u, -umax), umax)
     eso_step(z, c0, p[A_L1], p[A_L2], p[A_L3], y, u, h)
+    fmax = p[A_FMAX]
+    z[Z_F] = min(max(z[Z_F], -fmax), fmax)
     return u
 
 
 class ADRCConfig(FrozenConfig):
-    """``[controller] type = "adrc"`` in a scenario."""
+    """``[controller] type = "adrc"`` in a scenario (unset fields: module doc, design rule)."""
 
     type: Literal["adrc"]
-    T_settle: float = Field(150.0, ge=1.0, le=1e5, description="settling time of (38) [s], 1-1e5 s")
-    c0: Union[float, Literal["estimate", "exact"]] = "estimate"
-    observer: Literal["paper", "bandwidth", "lqr"] = "paper"
+    gains: GainsMode = GAINS[1]
+    T_settle: Optional[float] = Field(None, ge=1.0, le=1e5, description="settling time of (38) [s], 1-1e5 s; "
+                                      "default: 6/omega_n (design) or 150 s (paper)")
+    c0: Union[float, Literal["estimate", "exact", "design"], None] = None
+    observer: Optional[Literal["paper", "bandwidth", "lqr", "design"]] = None
     observer_bandwidth: float = Field(0.5, gt=0.0, le=100.0, description="[rad/s] for observer='bandwidth'")
     lqr_q: tuple[float, float, float] = (1.0, 1.0, 1.0)
     lqr_r: float = Field(1.0, gt=0.0)
     L: Optional[tuple[float, float, float]] = None
     law: Literal["stable", "printed"] = "stable"
     kd_rule: Literal["herbst", "printed"] = "herbst"
+    anti_windup: Optional[Literal["clamp", "off"]] = None
     u_max_deg: Optional[float] = Field(None, gt=0.0, le=90.0)
     sample_time: Optional[float] = Field(None, gt=0.0, le=60.0)
 
     @field_validator("c0", mode="before")
     @classmethod
     def _c0_number_or_method(cls, v):
-        if isinstance(v, str) and v in ("estimate", "exact"):
+        if v is None or (isinstance(v, str) and v in ("estimate", "exact", "design")):
             return v
         if isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) and v != 0:
             return float(v)
-        raise ValueError(f"must be a finite non-zero number [1/s^2], 'estimate' or 'exact'; got {v!r}")
+        raise ValueError(f"must be a finite non-zero number [1/s^2], 'estimate', 'exact' or 'design'; got {v!r}")
+
+
+def design_c0(ctx) -> tuple[float, str]:
+    """``(c0 [1/s^2], source)`` of ``c0 = "design"``: the design model's ``b2`` (the ship model's
+    exact linearisation where it has one, else ``K/T`` of its first-order Nomoto model)."""
+    m = law_model(ctx)
+    exact = m.source == "the ship's Nomoto model" and m.b2 != m.b
+    return m.b2, ("exact linearisation b2" if exact else f"K/T of the design model ({m.source})")
 
 
 def build(cfg: ADRCConfig, ctx):
-    """c0 from the ship (eq 29 or exact linearisation) unless given; L given, paper's, by
-    bandwidth or by LQR on the dual (python-control)."""
-    c0 = cfg.c0 if isinstance(cfg.c0, float) else ctx.b2(cfg.c0)
+    """c0 from the ship (eq 29, exact linearisation, or the design model) unless given; L given,
+    paper's, by bandwidth, by LQR on the dual (python-control) or by the design rule."""
+    paper = cfg.gains == "paper"
+    c0m = cfg.c0 if cfg.c0 is not None else ("estimate" if paper else "design")
+    if isinstance(c0m, float):
+        c0, c0_source = c0m, "given"
+    elif c0m == "design":
+        c0, c0_source = design_c0(ctx)
+    else:
+        c0, c0_source = ctx.b2(c0m), f"{c0m} (b2)"
+    T_settle = cfg.T_settle
+    if T_settle is None:
+        T_settle = 150.0 if paper else HERBST / law_bandwidth(ctx, "adrc")[1]
+    observer = cfg.observer if cfg.observer is not None else ("paper" if paper else "design")
     if cfg.L is not None:
         L = cfg.L
-    elif cfg.observer == "paper":
+    elif observer == "paper":
         L = PAPER_L
-    elif cfg.observer == "bandwidth":
+    elif observer == "bandwidth":
         L = eso_gains_bandwidth(cfg.observer_bandwidth)
+    elif observer == "design":
+        L = eso_gains_bandwidth(OBSERVER_MULTIPLE * HERBST / T_settle)
     else:
         L = eso_gains_lqr(cfg.lqr_q, cfg.lqr_r)
     field = "controller.L" if cfg.L is not None else (
-        "controller.observer_bandwidth" if cfg.observer == "bandwidth" else "controller.observer")
+        "controller.observer_bandwidth" if observer == "bandwidth" else "controller.observer")
     check_discrete_eso(L, ctx.sample_time, field)
-    c = ADRC.from_settling_time(cfg.T_settle, c0, L=L, law=cfg.law, kd_rule=cfg.kd_rule,
-                                u_max=ctx.u_max(cfg.u_max_deg))
+    u_max = ctx.u_max(cfg.u_max_deg)
+    anti_windup = cfg.anti_windup or ("off" if paper else "clamp")
+    c = ADRC.from_settling_time(T_settle, c0, L=L, law=cfg.law, kd_rule=cfg.kd_rule, u_max=u_max,
+                                f_max=abs(c0) * u_max if anti_windup == "clamp" else NO_CLAMP,
+                                c0_source=c0_source)
     return c, c.pack()
 
 
@@ -179,4 +247,7 @@ CONTROLLER = ControllerSpec(
     name="adrc", description="linear ADRC: ESO + disturbance-cancelling PD (Zwierzewicz et al. 2021)",
     update=adrc_update, n_state=N_STATE, config=ADRCConfig, build=build,
     source="Zwierzewicz, Dorobczynski, Artyszuk (2021) Energies 14:7937, Secs 2 and 5, eqs (7), (38)",
-    params=PARAMS)
+    params=PARAMS,
+    design_rule=("T_settle = 6/omega_n (Herbst's double pole of eq 38 at the shared bandwidth omega_n), ESO "
+                 "triple pole at 5x the loop's (Gao 2003), c0 = the design model's b2 (exact linearisation, "
+                 "else K/T); anti-windup: ESO fed the limited order, |xh3| <= |c0| u_max"))

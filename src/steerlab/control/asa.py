@@ -30,6 +30,20 @@ thesis' flow diagram (Fig. 5.7: FILTER, CTLSET, DELLIM, PAREST):
    parallel adjustable model driven by the actual rudder and compared with the measured yaw
    rate; decreasing, noise-scaled gains.
 
+Design rule (``gains = "design"``, the default). ASA designs itself from the ship: ``K*``,
+``tau*`` start at the ship's first-order Nomoto model at the design speed, every gain follows
+from them, the speed and the noise level by the thesis' rules (above). What the design rule
+adds is the range of the identified ``K*``, ``tau*``: the thesis' ``[0.2, 5]`` and
+``[0.2, 10]`` (Sec. 4.6.3; the ``gains = "paper"`` preset) widened to contain an octave
+``[x0/2, 2 x0]`` around the ship's own values, so a ship whose ``K*`` is above 5 (the Capella's
+Norrbin models, ``K* ~ 7``) is designed instead of refused. A course-unstable ship (``T < 0``)
+is refused in one line naming ``controller.type`` and the laws that design it
+(``nonlinear_adrc``, ``backstepping_b``, ``sliding_mode``): the MRAS identification and the
+reference model assume a course-stable ship (thesis 4.3.2). Anti-windup: the integral ``Ki`` of
+course keeping integrates only while the order is not limited or the error drives it back, and
+is clamped to the limit; in course changing the adaptation stops while the order is limited
+(Landau 1979).
+
 Speed enters as ``U = x[3]`` (surge speed, m/s) for the gain scheduling and the
 non-dimensional model; below ``freeze_speed`` every adaptation (direct and identification)
 is frozen and the scheduling uses ``U = freeze_speed`` (no division by a vanishing speed).
@@ -66,6 +80,7 @@ from steerlab.control.asa_modes import MODE_CHANGING, asa_mode_step
 from steerlab.control.asa_mras import mras_gain_step, mras_identify_step
 from steerlab.control.asa_reference import lyapunov_p12_p22, reference_model_step
 from steerlab.control.asa_schedule import kd_damping, kd_lq, keeping_kp
+from steerlab.control.law_design import GAINS, GainsMode
 from steerlab.control.registry import ControllerSpec
 from steerlab.control.wave_filter import PARAMS as WF_PARAMS
 from steerlab.control.wave_filter import (F_DELTA, F_PSI, F_R, F_XI, WaveFilterConfig, WaveFilterParams,
@@ -263,10 +278,12 @@ class ASAConfig(FrozenConfig):
     L: Optional[float] = Field(None, gt=0.0, le=2000.0, description="ship length [m]; default: the ship's")
     K_star0: Optional[float] = Field(None, gt=0.0, le=100.0, description="initial K* = K L/U; default: ship's Nomoto")
     tau_star0: Optional[float] = Field(None, gt=0.0, le=100.0, description="initial tau* = tau U/L")
-    K_star_min: float = Field(0.2, gt=0.0, le=100.0)
-    K_star_max: float = Field(5.0, gt=0.0, le=100.0)
-    tau_star_min: float = Field(0.2, gt=0.0, le=100.0)
-    tau_star_max: float = Field(10.0, gt=0.0, le=100.0)
+    gains: GainsMode = GAINS[1]
+    K_star_min: Optional[float] = Field(None, gt=0.0, le=100.0, description="default 0.2, widened by the design "
+                                        "rule to K*0/2")
+    K_star_max: Optional[float] = Field(None, gt=0.0, le=100.0, description="default 5, widened to 2 K*0")
+    tau_star_min: Optional[float] = Field(None, gt=0.0, le=100.0, description="default 0.2, widened to tau*0/2")
+    tau_star_max: Optional[float] = Field(None, gt=0.0, le=100.0, description="default 10, widened to 2 tau*0")
     kp_change: float = Field(2.5, gt=0.0, le=100.0, description="Kp at cruising speed in course changes (4.82)")
     kp_low: float = Field(0.5, ge=0.0, le=100.0, description="lowest course-keeping Kp at cruising speed (3.12)")
     zeta_change: float = Field(1.0, gt=0.0, le=10.0, description="reference-model damping")
@@ -296,25 +313,43 @@ def ship_length(ctx) -> float:
     return float(L) if L is not None else float(ctx.ship.dims[1])
 
 
+#: The thesis' bounds of the identified K*, tau* (Sec. 4.6.3) [-]: the paper preset.
+PAPER_BOUNDS = {"K_star": (0.2, 5.0), "tau_star": (0.2, 10.0)}
+#: The design rule widens the bounds to ``[x0 / BOUND_FACTOR, BOUND_FACTOR x0]`` around the ship's own value.
+BOUND_FACTOR = 2.0
+
+
+def bounds(cfg: ASAConfig, name: str, x0: float) -> tuple[float, float]:
+    """``(lo, hi)`` of ``K_star`` or ``tau_star``: given, the thesis' (``gains = "paper"``), or the
+    thesis' widened to contain ``[x0/2, 2 x0]`` (at most 100) around the initial value ``x0`` the
+    ship's model gives (design rule; ``x0 = nan``: an initial value the user gave, not widened)."""
+    lo, hi = PAPER_BOUNDS[name]
+    if cfg.gains == "design" and math.isfinite(x0) and x0 > 0.0:
+        lo, hi = min(lo, x0 / BOUND_FACTOR), max(hi, min(BOUND_FACTOR * x0, 100.0))
+    lo = getattr(cfg, f"{name}_min") if getattr(cfg, f"{name}_min") is not None else lo
+    hi = getattr(cfg, f"{name}_max") if getattr(cfg, f"{name}_max") is not None else hi
+    return lo, hi
+
+
 def build(cfg: ASAConfig, ctx):
     """ASA from its settings; K*, tau* initialised from the ship's Nomoto model at the speed."""
     L = cfg.L if cfg.L is not None else ship_length(ctx)
     U0 = knots_to_ms(cfg.cruise_speed_kn) if cfg.cruise_speed_kn is not None else ctx.speed
+    ks0 = ts0 = math.nan
     if cfg.K_star0 is None or cfg.tau_star0 is None:
         K, T = ctx.nomoto()
         ks0 = K * L / ctx.speed
         ts0 = T * ctx.speed / L
-        bad_k = cfg.K_star0 is None and not K > 0.0
-        bad_t = cfg.tau_star0 is None and not T > 0.0
-        if bad_k or bad_t:
-            name = "K_star0" if bad_k else "tau_star0"
-            raise InputError(f"controller.{name}", (
-                f"ship {ctx.ship.name!r} at {ctx.speed:.3g} m/s has the Nomoto model K = {K:.4g} 1/s, "
-                f"T = {T:.4g} s (course-unstable): ASA's initial K*, tau* come from a course-stable "
-                f"model (thesis 4.3.2); give K_star0 in [{cfg.K_star_min}, {cfg.K_star_max}] and "
-                f"tau_star0 in [{cfg.tau_star_min}, {cfg.tau_star_max}] explicitly"))
-        for name, value, lo, hi in (("K_star0", ks0, cfg.K_star_min, cfg.K_star_max),
-                                    ("tau_star0", ts0, cfg.tau_star_min, cfg.tau_star_max)):
+        if not (math.isfinite(K) and math.isfinite(T) and K > 0.0 and T > 0.0):
+            raise InputError("controller.type", (
+                f"asa: ship {ctx.ship.name!r} at {ctx.speed:.3g} m/s has the Nomoto model K = {K:.4g} 1/s, "
+                f"T = {T:.4g} s ({'course-unstable' if K * T > 0 else 'not finite'}); ASA identifies and adapts "
+                "to a course-stable model (thesis 4.3.2), so use nonlinear_adrc, backstepping_b or sliding_mode "
+                "(or give K_star0 and tau_star0 > 0)"))
+    ks_lo, ks_hi = bounds(cfg, "K_star", ks0 if cfg.K_star0 is None else math.nan)
+    ts_lo, ts_hi = bounds(cfg, "tau_star", ts0 if cfg.tau_star0 is None else math.nan)
+    if cfg.K_star0 is None or cfg.tau_star0 is None:
+        for name, value, lo, hi in (("K_star0", ks0, ks_lo, ks_hi), ("tau_star0", ts0, ts_lo, ts_hi)):
             if getattr(cfg, name) is None and lo <= hi and not lo <= value <= hi:   # (lo > hi: its own error)
                 raise InputError(f"controller.{name}", (
                     f"ship {ctx.ship.name!r} at {ctx.speed:.3g} m/s (L = {L:.4g} m) has the Nomoto model "
@@ -329,7 +364,7 @@ def build(cfg: ASAConfig, ctx):
             alpha=cfg.alpha, beta=cfg.beta, gamma=cfg.gamma, alpha_id=cfg.alpha_id, beta_id=cfg.beta_id,
             T_decay=cfg.adapt_decay_s, T_decay_id=cfg.identify_decay_s,
             threshold=rad(cfg.change_threshold_deg), n_hold=cfg.hold_time_constants,
-            K_star_bounds=(cfg.K_star_min, cfg.K_star_max), tau_star_bounds=(cfg.tau_star_min, cfg.tau_star_max),
+            K_star_bounds=(ks_lo, ks_hi), tau_star_bounds=(ts_lo, ts_hi),
             n_ti=cfg.integral_time_constants, rho_acc=cfg.accel_margin, f_delta=cfg.rudder_limit_factor,
             use_estimator=cfg.use_estimator, wave_filter=cfg.wave_filter.params())
     return c, c.pack()
@@ -340,4 +375,7 @@ CONTROLLER = ControllerSpec(
     description="adaptive autopilot ASA: MRAS course changing + identification, noise-adaptive filter",
     update=asa_update, n_state=N_STATE, config=ASAConfig, build=build,
     source="van Amerongen (1982) Adaptive steering of ships, ch. 4 (Sec. 4.6), eqs 4.43-4.45, 4.66-4.105",
-    params=PARAMS)
+    params=PARAMS,
+    design_rule=("initial K*, tau* from the ship's Nomoto model, gains by the thesis' rules (Kp = mu/2 U0/U, Kd "
+                 "LQ-optimal, MRAS course changing; van Amerongen 1982 4.6), identification bounds widened to an "
+                 "octave around the ship's K*, tau*; clamping anti-windup on Ki; course-unstable ships refused"))

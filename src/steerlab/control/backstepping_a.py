@@ -36,10 +36,43 @@ second or per ship length travelled is not stated): ``r`` becomes ``r L/U``, ``r
 
 The output ``x4`` is the rudder order, limited to ``u_max``. Gains ``k1, k2, k3 > 0`` [1/s]:
 Table 3 (GA-tuned): ballast ``0.020568, 176.3781, 2.545``; full load ``1.8795, 42.5205, 0.001``.
+
+Design rule (``gains = "design"``, the default; a value the user gives wins). With the drift
+cancelled, the errors obey the linear system (in the time unit ``t_u`` of the gains)::
+
+    z' = M z,   M = [[-k1, 1, 0], [-1, -k2, 1], [0, -1, -k3]]
+    det(sI - M) = (s + k1)(s + k2)(s + k3) + (s + k1) + (s + k3)
+
+With ``k1 = k2 = k3 = k`` this is ``(s + k)((s + k)^2 + 2)``: poles ``-k`` and ``-k +- j sqrt(2)``,
+a pair of damping ``k / sqrt(k^2 + 2)``. So ``k = zeta sqrt(2 / (1 - zeta^2))`` (``zeta = ZETA``
+= 0.9, :mod:`steerlab.control.design_model`) and the time unit ``t_u = sqrt(k^2 + 2) / omega_n``
+(``gain_time = "design"``) give, in seconds, the poles ``-zeta omega_n +- j omega_n sqrt(1 - zeta^2)``
+and ``-zeta omega_n``: the error dynamics at the shared bandwidth ``omega_n``
+(:func:`steerlab.control.design_model.bandwidth`, capped by the gear's limit, rate and lag; for a
+course-unstable ship above its unstable pole). The law cancels ``f`` whatever the sign of ``T``,
+so ``K < 0, T < 0`` ships are designed like the others. (:func:`design_gains`.)
+
+Version A has no rudder feedback: its order holds the inverse term ``(T r' + r)/K`` of the design
+model, an inner loop whose gain on the real ship is ``b2 / (K/T)`` (the rudder efficiency over
+the design model's). Where that is far from 1 (a second-order Nomoto ship with a zero, a 3-DOF
+ship: Esso, KVLCC2, the MSS tanker have ``b2 ~ 2.5 K/T``) the loop limit-cycles at the gear's
+stops, so the design rule refuses such a ship (outside ``[1/1.25, 1.25]``) in one line naming
+``backstepping_b``, which feeds the measured rudder back and designs them.
+``gains = "paper"``: Table 3 (ballast) read per second (``gain_time = "s"``), as before, no
+integral action.
+
+Integral action (design rule): the law cancels the drift of its design model but not an
+unknown constant yaw moment (a thesis ship's spiral offset ``c0``, a propeller side force);
+its own stiffness at rest is only about ``omega_n T2`` times a PD loop's (the rudder enters
+the chain at the jerk), so the design adds :mod:`steerlab.control.heading_integral`
+with ``k_i = (omega_n/10) S``, ``S`` the law's own stiffness at rest (:func:`stiffness`; a
+PD-scale ``omega_n^2/b`` would overpower that stiffness and limit-cycle), with
+conditional-integration anti-windup.
 """
 
 from __future__ import annotations
 
+import math
 from typing import Literal, NamedTuple, Optional
 
 import numba
@@ -49,7 +82,11 @@ from pydantic import Field, create_model
 from steerlab.angles import wrap_to_pi
 from steerlab.config_base import FrozenConfig
 from steerlab.control.registry import ControllerSpec
-from steerlab.control.van_leeuwen_design import design_model, yaw_accel
+from steerlab.control.design_model import ZETA
+from steerlab.control.heading_integral import (INTEGRAL_BAND, INTEGRAL_DIVISOR, TURN_RATE_FRACTION,
+                                               integral_step)
+from steerlab.control.law_design import GAINS, law_bandwidth, law_model
+from steerlab.control.van_leeuwen_design import design_model, design_mu, yaw_accel
 from steerlab.errors import InputError
 from steerlab.records import Field as RecordField
 from steerlab.records import Layout
@@ -75,8 +112,17 @@ PARAMS = Layout("controller", "B_", [
     RecordField("MU", "mu", "1/s", "mu = U / L of the design (ship speed over length)", lo=0.0, lo_open=True),
     RecordField("IRDOT", "i_rdot", "-", "index of rdot in the plant state; -1: estimate r' from the yaw rate"),
     RecordField("UMAX", "u_max", "rad", "output limit (scenario default: the gear's limit)", lo=0.0, lo_open=True),
-    RecordField("TU", "time_unit", "s", "unit of time of the gains: 1 s, or L/U (gain_time = 'ship')",
+    RecordField("TU", "time_unit", "s", "unit of time of the gains: 1 s, L/U (gain_time = 'ship') or "
+                "sqrt(k^2 + 2)/omega_n (gain_time = 'design')",
                 lo=0.0, lo_open=True),
+    RecordField("KI", "k_i", "1/s", "integral gain on the heading error (heading_integral; 0: none, the paper)",
+                lo=0.0, default=0.0),
+    RecordField("RBAND", "r_band", "rad/s", "integral off in turns: beyond 5 deg only while |r - r_ref| < r_band",
+                lo=0.0, default=0.0),
+    RecordField("TF", "T_f", "s", "version B: time constant of the r' low-pass (0: none, the paper)", lo=0.0,
+                default=0.0),
+    RecordField("W4", "weighted", "-", "version B: 1 = gear error weighted by c mu^3 (design rule), 0 = Table 2",
+                lo=0.0, hi=1.0, default=0.0),
 ]).then("design", SET)
 PARAMS.export(globals())   # B_K1 = 0, ..., B_TU = 8, B_DESIGN_T1 = 9, ..., B_DESIGN_A3 = 15
 B_SET = PARAMS.index("design.T1")   # offset of the design set, read by vl_drift/vl_gain as p[B_SET + S_*]
@@ -84,8 +130,10 @@ N_PARAMS = PARAMS.size
 STATE = Layout("controller state", "Z_", [
     RecordField("R_PREV", "r_prev", "rad/s", "previous yaw rate, for the r' estimate on ships without an rdot "
                 "state (van_leeuwen_design.yaw_accel)"),
+    RecordField("XI", "xi", "rad s", "integral of the heading error (heading_integral)"),
+    RecordField("RDF", "rd_f", "rad/s^2", "low-passed r' estimate (version B's design rule; unused by A)"),
 ], size_name="N_STATE")
-STATE.export(globals())    # Z_R_PREV = 0, N_STATE = 1
+STATE.export(globals())    # Z_R_PREV = 0, Z_XI = 1, Z_RDF = 2, N_STATE = 3
 
 
 class Backstepping(NamedTuple):
@@ -101,6 +149,10 @@ class Backstepping(NamedTuple):
     u_max: float              #: output limit [rad]
     design: tuple             #: Van Leeuwen set [T1, T2, K, a0, a1, a2, a3] (radian form)
     time_unit: float = 1.0    #: [s] unit of time of the gains: 1 s, or L/U (ship time)
+    k_i: float = 0.0          #: integral gain [1/s] (heading_integral; 0 in the paper preset)
+    r_band: float = 0.0       #: [rad/s] heading_integral's turn detector: omega_n x 5 deg
+    T_f: float = 0.0          #: [s] version B's r' low-pass (0: none)
+    weighted: float = 0.0     #: version B: 1 = z4 weighted by c mu^3 (design rule), 0 = Table 2 as printed
 
     def pack(self) -> np.ndarray:
         rec = self._asdict()
@@ -111,7 +163,7 @@ class Backstepping(NamedTuple):
         return PARAMS.pack(rec)
 
     def init_state(self, x0, ref0) -> np.ndarray:
-        return STATE.pack(r_prev=x0[IR])
+        return STATE.pack(r_prev=x0[IR], xi=0.0, rd_f=0.0)
 
 
 @numba.njit(cache=True)
@@ -140,42 +192,122 @@ def backstepping_a_update(z, p, t, x, ref, h):
     tu3 = p[B_TU] ** 3
     f = vl_drift(p, B_SET, mu, x[IR], rd) * tu3
     u = (-p[B_K3] * z3 - z2 - f + a2d) / (vl_gain(p, B_SET, mu) * tu3)
-    umax = p[B_UMAX]
-    return min(max(u, -umax), umax)
+    return integral_step(z, Z_XI, p[B_KI], -z1, ref[REF_R] - x[IR], p[B_RBAND], u, p[B_UMAX], h)
 
 
-def config_fields(type_name: str, gains=("k1", "k2", "k3"), defaults=None) -> dict:
-    """The scenario fields of both versions: gains from :data:`PARAMS` (bounds, unit), the design
-    options at the edge."""
+#: Version B's design rule low-passes a differenced r' with the time constant ``RD_FILTER / omega_n`` [s].
+RD_FILTER = 0.1
+#: Version A's design rule refuses a ship whose ``b2 / (K/T)`` is outside ``[1/B2_MISMATCH, B2_MISMATCH]``.
+B2_MISMATCH = 1.25
+
+#: Table 3, ballast (GA-tuned gains of the paper), by version.
+PAPER_GAINS = {"A": {"k1": 0.020568, "k2": 176.3781, "k3": 2.545},
+               "B": {"k1": 5.93, "k2": 184.252, "k3": 0.001, "k4": 0.001}}
+
+
+def design_gains(omega_n: float, zeta: float = ZETA) -> tuple[float, float]:
+    """``(k [-], t_u [s])`` of the design rule (module doc): ``k1 = k2 = k3 = k`` in the time unit
+    ``t_u``, so that the error dynamics have the poles ``-zeta omega_n (1, +- j sqrt(1 - zeta^2)/zeta)``."""
+    if not (0.0 < zeta < 1.0):
+        raise InputError("controller.zeta", f"must be in (0, 1), got {zeta!r}")
+    k = zeta * math.sqrt(2.0 / (1.0 - zeta * zeta))
+    return k, math.sqrt(k * k + 2.0) / omega_n
+
+
+def config_fields(type_name: str, gains=("k1", "k2", "k3")) -> dict:
+    """The scenario fields of both versions: gains (unset: the design rule, or Table 3 with
+    ``gains = "paper"``) with bounds and unit from :data:`PARAMS`, the design options at the edge."""
+    ks = {}
+    for n in gains:
+        f = PARAMS.fields[PARAMS.index(n)]
+        ks[n] = (Optional[float], Field(None, gt=0.0, le=f.hi, description=f"[{f.unit}] {f.doc}"))
     return dict(
         type=(Literal[type_name], ...),
-        **PARAMS.config_fields(gains, defaults=defaults),
+        gains=GAINS,
+        **ks,
+        k_i=(Optional[float], Field(None, ge=0.0, le=1e3, description="[1/s] integral gain on the heading error; "
+                                    "default (omega_n/10) x the law's stiffness (design) or 0 (paper)")),
+        omega_n=(Optional[float], Field(None, gt=0.0, le=100.0, description="[rad/s] closed-loop bandwidth of the "
+                                        "design rule; default: the shared rule (design_model.bandwidth)")),
         design_loading=(Optional[str], Field(None, description="Van Leeuwen ships: loading of the design model")),
         design_T2=(Optional[float], Field(None, ge=0.001, le=1e3,
                                           description="[s], 0.001-1000 s, other ships; default gear T_sg")),
-        gain_time=(Literal["s", "ship"], Field("s", description="time unit of the gains: 1 s or L/U")),
+        gain_time=(Optional[Literal["s", "ship", "design"]],
+                   Field(None, description="time unit of the gains: 1 s, L/U, or the design rule's "
+                                           "sqrt(k^2 + 2)/omega_n; default 'design' (design) or 's' (paper)")),
         u_max_deg=(Optional[float], Field(None, gt=0.0, le=90.0, description="default: gear limit")),
         sample_time=(Optional[float], Field(None, gt=0.0, le=60.0, description="default: dt")))
 
 
 BacksteppingAConfig = create_model(
     "BacksteppingAConfig", __base__=FrozenConfig,
-    __doc__='``[controller] type = "backstepping_a"``: gains [1/s] (Table 3, ballast, by default).',
+    __doc__='``[controller] type = "backstepping_a"``: gains [per time unit] (unset: design rule or Table 3).',
     **config_fields("backstepping_a"))
 BacksteppingAConfig.__module__ = __name__
 
 
-def make(cfg, ctx, k4: float = 1.0) -> tuple[Backstepping, np.ndarray]:
-    s, L, i_rdot = design_model(ctx, cfg.design_loading, cfg.design_T2)
-    mu = ctx.speed / L
-    c = Backstepping(cfg.k1, cfg.k2, cfg.k3, k4, ctx.gear.T_sg, mu, i_rdot,
-                     ctx.u_max(cfg.u_max_deg), tuple(float(v) for v in s),
-                     1.0 if cfg.gain_time == "s" else 1.0 / mu)
+def make(cfg, ctx, version: str = "A") -> tuple[Backstepping, np.ndarray]:
+    """Version ``A`` or ``B`` from its config: given gains, Table 3 (``gains = "paper"``) or the
+    design rule (module doc); ``k4`` (B) by default ``t_u / T_R``: the gear error decays at the
+    gear's own rate (version B's module doc)."""
+    paper = cfg.gains == "paper"
+    s, L, i_rdot = design_model(ctx, cfg.design_loading, cfg.design_T2, match_b2=False)
+    mu = design_mu(ctx, L)
+    gain_time = cfg.gain_time if cfg.gain_time is not None else ("s" if paper else "design")
+    names = ("k1", "k2", "k3") + (("k4",) if version == "B" else ())
+    given = {n: getattr(cfg, n) for n in names}
+    kd = tu = 1.0
+    law = f"backstepping_{version.lower()}"
+    w = None
+    if gain_time == "design" or not (paper or all(given[n] is not None for n in ("k1", "k2", "k3"))):
+        w = cfg.omega_n or law_bandwidth(ctx, law)[1]
+        kd, tu = design_gains(w)
+    if gain_time == "s":
+        tu = 1.0
+    elif gain_time == "ship":
+        tu = 1.0 / mu
+    k = {}
+    for n in names:
+        if given[n] is not None:
+            k[n] = given[n]
+        elif paper:
+            k[n] = PAPER_GAINS[version][n]
+        else:
+            k[n] = tu / ctx.gear.T_sg if n == "k4" else kd
+    if version == "A" and not paper:
+        m = law_model(ctx)
+        if not (1.0 / B2_MISMATCH <= m.b2 / m.b <= B2_MISMATCH):
+            raise InputError("controller.type", (
+                f"backstepping_a inverts the design model with an ideal gear, and this ship's rudder efficiency "
+                f"b2 = {m.b2:.3g} 1/s^2 differs from K/T = {m.b:.3g} by a factor {m.b2 / m.b:.3g} (outside "
+                f"[{1 / B2_MISMATCH:.3g}, {B2_MISMATCH:g}]: a second-order or 3-DOF ship), so the inversion "
+                "over- or under-compensates and the loop limit-cycles; use backstepping_b (gear and rudder "
+                "feedback in the design) or nonlinear_adrc"))
+    c = Backstepping(k["k1"], k["k2"], k["k3"], k.get("k4", 1.0), ctx.gear.T_sg, mu, i_rdot,
+                     ctx.u_max(cfg.u_max_deg), tuple(float(v) for v in s), tu, 0.0)
+    if cfg.k_i is not None or not paper:
+        ki = cfg.k_i
+        if ki is None:
+            w = w or cfg.omega_n or law_bandwidth(ctx, law)[1]
+            ki = w / INTEGRAL_DIVISOR * stiffness(c, version)
+        wi = w or cfg.omega_n or law_bandwidth(ctx, law)[1]
+        c = c._replace(k_i=ki, r_band=wi * INTEGRAL_BAND * TURN_RATE_FRACTION,
+                       T_f=RD_FILTER / wi if version == "B" and i_rdot < 0.0 else 0.0,
+                       weighted=1.0 if version == "B" and gain_time == "design" else 0.0)
     return c, c.pack()
 
 
+def stiffness(c: Backstepping, version: str) -> float:
+    """The law's rudder per rad of heading error at rest [rad/rad] (no integral action): the
+    first-step order for a small error with ``r = r' = delta = 0``. Version A:
+    ``(k3 (k1 k2 + 1) + k1) / (c mu^3 t_u^3)``; version B: its ``alpha3``, the same."""
+    k1, k2, k3 = c.k1, c.k2, c.k3
+    p = c.pack()
+    return (k3 * (k1 * k2 + 1.0) + k1) / (vl_gain(p, B_SET, c.mu) * c.time_unit ** 3)
+
+
 def build(cfg: BacksteppingAConfig, ctx):
-    return make(cfg, ctx)
+    return make(cfg, ctx, "A")
 
 
 CONTROLLER = ControllerSpec(
@@ -183,4 +315,7 @@ CONTROLLER = ControllerSpec(
     description="backstepping on the Van Leeuwen model, steering gear neglected (Witkowska, version A)",
     update=backstepping_a_update, n_state=N_STATE, config=BacksteppingAConfig, build=build,
     source="Witkowska & Smierzchalski, Table 2 eqs (18)-(20), (25), (27)-(28)",
-    params=PARAMS)
+    params=PARAMS,
+    design_rule=("k1 = k2 = k3 = zeta sqrt(2/(1 - zeta^2)) in the time unit sqrt(k^2 + 2)/omega_n: error "
+                 "poles -zeta omega_n +- j omega_n sqrt(1 - zeta^2) and -zeta omega_n at the shared bandwidth "
+                 "(Krstic et al. 1995 error system); cancels f for T of either sign"))

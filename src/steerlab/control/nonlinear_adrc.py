@@ -36,6 +36,32 @@ ship 1 is moved to ship 2 by ``m = p1 / p2 = sqrt(b2 / b1)``::
 
 (:func:`time_scale_retune`). With ``reference_b`` set, the configured ``k1, k2, beta, b`` are
 read as tuned for a ship with ``b = reference_b`` and re-tuned to this ship by (31).
+
+Design rule (``gains = "design"``, the default; a value the user gives wins). (31) moves a
+setting from ship to ship by scaling time with ``m = sqrt(b2 / b1)``: every bandwidth of the
+controller is multiplied by ``m``, i.e. it is proportional to ``sqrt(b)``. That is the
+shared bandwidth rule of :func:`steerlab.control.design_model.bandwidth` where the gear's limit
+binds (``omega_n = sqrt(0.7 delta_max b / 20 deg)``), and the rule also keeps the loop within
+the gear's rate and lag and above a course-unstable ship's pole. So by default
+
+* ``b``: the design model's ``b2`` (exact linearisation, else ``K/T``; a neutral ship with
+  infinite ``K``, ``T``: its ``b2``);
+* ``omega_c = omega_n`` (NLSEF linear zone ``s^2 + 2 omega_c s + omega_c^2``, above);
+* ``omega_o = OBSERVER_MULTIPLE * omega_c`` (``OBSERVER_MULTIPLE = 5``, Gao 2003: 3-10).
+
+The ESO lumps ``-r/T`` into the total disturbance ``f``, so a course-unstable ship (``T < 0``,
+``b > 0``) is designed like any other once ``omega_n`` exceeds its unstable pole (the shared
+rule ensures ``omega_n >= 2 |1/T|``, or refuses in one line naming the gear field).
+``gains = "paper"``: unset values as before (``b`` exact, ``omega_c = 0.05``, ``omega_o = 0.5`` rad/s).
+
+Anti-windup: the ESO is fed the rudder angle the ship actually gets (``eso_input = "rudder"``, the
+design default: the measured rudder, the last plant state), so neither the gear's limit nor its
+rate limit and lag are mistaken for a disturbance (fed the order, a rate-limited gear lagging
+the order by tens of degrees makes ``z3`` absorb ``b (u - delta)`` and the loop limit-cycles
+bang-bang; the paper preset keeps the order, ``eso_input = "order"``), and its disturbance
+estimate ``z3`` (the loop's only integrator) is clamped to what the rudder can cancel,
+``|z3| <= b u_max`` (``anti_windup = "off"`` removes the clamp; the paper preset has it off, as
+before: on the berthing runs it binds and would move the paper's numbers).
 """
 
 from __future__ import annotations
@@ -49,6 +75,7 @@ from pydantic import Field, create_model, field_validator
 
 from steerlab.angles import wrap_to_pi
 from steerlab.config_base import FrozenConfig
+from steerlab.control.law_design import GAINS, law_bandwidth, law_model
 from steerlab.control.nonlinear_eso import NLESO, fal, nleso_gains_bandwidth, nleso_step
 from steerlab.control.registry import ControllerSpec
 from steerlab.control.tracking_differentiator import TD, td_step
@@ -57,6 +84,10 @@ from steerlab.records import Field as RecordField
 from steerlab.records import Layout
 from steerlab.ships.state import IPSI, IR
 from steerlab.guidance.reference_vector import REF_PSI
+
+
+#: The clamp value that means "off" (records hold finite numbers only).
+NO_CLAMP = 1e300
 
 
 def _fal_exponent(const, name, doc, default):
@@ -82,8 +113,14 @@ PARAMS = Layout("controller", "N_", [
                 default=0.01),
     RecordField("H0", "h0", "s", "TD filtering factor h0 of (22)", lo=0.0, lo_open=True, default=1.0),
     RecordField("UMAX", "u_max", "rad", "output limit (scenario default: the gear's limit)", lo=0.0, lo_open=True),
+    RecordField("FMAX", "f_max", "rad/s^2", "anti-windup clamp of the disturbance estimate z3: b u_max, or 1e300 (off)",
+                lo=0.0, lo_open=True, default=NO_CLAMP),
+    RecordField("ESOIN", "eso_rudder", "-", "ESO input: 0 the limited order u (27), 1 the measured rudder angle",
+                lo=0.0, hi=1.0, default=0.0),
 ], size_name="N_PARAMS")
-PARAMS.export(globals())   # N_B = 0, N_BETA1..3, N_A01, N_D01, N_A02, N_D02, N_K1, ..., N_UMAX = 16, N_PARAMS = 17
+PARAMS.export(globals())   # N_B = 0, N_BETA1..3, N_A01, ..., N_UMAX = 16, N_FMAX = 17, N_ESOIN = 18, N_PARAMS = 19
+#: ESO bandwidth of the design rule in multiples of the NLSEF's ``omega_c`` [-].
+OBSERVER_MULTIPLE = 5.0
 STATE = Layout("controller state", "Z_", TD.fields + NLESO.fields, size_name="N_STATE")
 STATE.export(globals())    # TD: Z_V1 = 0, Z_V2 = 1; ESO: Z_Z1 = 2, Z_Z2 = 3, Z_Z3 = 4; N_STATE = 5
 
@@ -127,6 +164,8 @@ class NonlinearADRC(NamedTuple):
     r_td: float
     h0: float
     u_max: float
+    f_max: float = NO_CLAMP
+    eso_rudder: float = 0.0
 
     def pack(self) -> np.ndarray:
         if len(self.beta) != 3:
@@ -155,13 +194,16 @@ def nonlinear_adrc_update(z, p, t, x, ref, h):
     u = u0 - z[Z_Z3] / b
     umax = p[N_UMAX]
     u = min(max(u, -umax), umax)
+    ue = x[x.shape[0] - 1] if p[N_ESOIN] > 0.5 else u
     nleso_step(z, Z_Z1, b, p[N_BETA1], p[N_BETA2], p[N_BETA3], p[N_A01], p[N_D01], p[N_A02],
-               p[N_D02], x[IPSI], u, h)
+               p[N_D02], x[IPSI], ue, h)
+    fmax = p[N_FMAX]
+    z[Z_Z3] = min(max(z[Z_Z3], -fmax), fmax)
     return u
 
 
 def _b_number_or_method(cls, v):
-    if isinstance(v, str) and v in ("estimate", "exact"):
+    if v is None or isinstance(v, str) and v in ("estimate", "exact"):
         return v
     if isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) and v > 0:
         return float(v)
@@ -180,9 +222,16 @@ NonlinearADRCConfig = create_model(
     __validators__={"_b_number_or_method": field_validator("b", mode="before")(_b_number_or_method),
                     "_beta_positive": field_validator("beta")(_beta_positive)},
     type=(Literal["nonlinear_adrc"], ...),
-    b=(Union[float, Literal["estimate", "exact"]], "exact"),
-    omega_c=(float, Field(0.05, gt=0.0, le=100.0, description="NLSEF bandwidth [rad/s]")),
-    omega_o=(float, Field(0.5, gt=0.0, le=100.0, description="ESO bandwidth [rad/s]")),
+    gains=GAINS,
+    b=(Union[float, Literal["estimate", "exact"], None], None),
+    omega_c=(Optional[float], Field(None, gt=0.0, le=100.0, description="NLSEF bandwidth [rad/s]; default: "
+                                    "omega_n of the design model (design) or 0.05 (paper)")),
+    omega_o=(Optional[float], Field(None, gt=0.0, le=100.0, description="ESO bandwidth [rad/s]; default: "
+                                    "5 omega_c (design) or 0.5 (paper)")),
+    anti_windup=(Optional[Literal["clamp", "off"]], Field(None, description="clamp of the disturbance estimate; "
+                 "default 'clamp' (design) or 'off' (paper)")),
+    eso_input=(Optional[Literal["order", "rudder"]], Field(None, description="what the ESO is fed: the limited "
+               "order or the measured rudder angle; default 'rudder' (design) or 'order' (paper)")),
     k1=(Optional[float], Field(None, ge=0.0, le=1e9)),
     k2=(Optional[float], Field(None, ge=0.0, le=1e9)),
     beta=(Optional[tuple[float, float, float]], None),
@@ -200,9 +249,27 @@ NonlinearADRCConfig.__module__ = __name__
 
 
 def build(cfg: NonlinearADRCConfig, ctx):
-    b = cfg.b if isinstance(cfg.b, float) else ctx.b2(cfg.b)
+    """Gains from the config, (31), or the design rule (module doc)."""
+    paper = cfg.gains == "paper"
+    if isinstance(cfg.b, float):
+        b = cfg.b
+    elif cfg.b is not None or paper:
+        b = ctx.b2(cfg.b or "exact")
+    else:
+        b = law_model(ctx).b2
     if not (b > 0.0):
         raise InputError("controller.b", f"the ship's rudder gain must be > 0, got {b}")
+    omega_c, omega_o = cfg.omega_c, cfg.omega_o
+    if paper:
+        omega_c = 0.05 if omega_c is None else omega_c
+        omega_o = 0.5 if omega_o is None else omega_o
+    else:
+        if omega_c is None and (cfg.reference_b is None and (cfg.k1 is None or cfg.k2 is None)):
+            omega_c = law_bandwidth(ctx, "nonlinear_adrc")[1]
+        if omega_o is None and cfg.beta is None and cfg.reference_b is None:
+            if omega_c is None:
+                omega_c = law_bandwidth(ctx, "nonlinear_adrc")[1]
+            omega_o = OBSERVER_MULTIPLE * omega_c
     if cfg.reference_b is not None:
         if cfg.k1 is None or cfg.k2 is None or cfg.beta is None:
             raise InputError("controller.reference_b", "needs k1, k2 and beta (the reference ship's setting)")
@@ -211,12 +278,15 @@ def build(cfg: NonlinearADRCConfig, ctx):
         beta, k1, k2, b = ts.beta, ts.k1, ts.k2, ts.b
     else:
         beta = cfg.beta if cfg.beta is not None else tuple(
-            nleso_gains_bandwidth(cfg.omega_o, cfg.a01, cfg.delta01, cfg.a02, cfg.delta02))
-        k1 = cfg.k1 if cfg.k1 is not None else cfg.omega_c ** 2 / b / cfg.delta1 ** (cfg.a1 - 1.0)
-        k2 = cfg.k2 if cfg.k2 is not None else 2.0 * cfg.omega_c / b / cfg.delta2 ** (cfg.a2 - 1.0)
+            nleso_gains_bandwidth(omega_o, cfg.a01, cfg.delta01, cfg.a02, cfg.delta02))
+        k1 = cfg.k1 if cfg.k1 is not None else omega_c ** 2 / b / cfg.delta1 ** (cfg.a1 - 1.0)
+        k2 = cfg.k2 if cfg.k2 is not None else 2.0 * omega_c / b / cfg.delta2 ** (cfg.a2 - 1.0)
+    u_max = ctx.u_max(cfg.u_max_deg)
     c = NonlinearADRC(b, tuple(float(v) for v in beta), cfg.a01, cfg.delta01, cfg.a02, cfg.delta02,
                       k1, k2, cfg.a1, cfg.delta1, cfg.a2, cfg.delta2, cfg.r_td, cfg.h0,
-                      ctx.u_max(cfg.u_max_deg))
+                      u_max, b * u_max if (cfg.anti_windup or ("off" if paper else "clamp")) == "clamp"
+                      else NO_CLAMP,
+                      1.0 if (cfg.eso_input or ("order" if paper else "rudder")) == "rudder" else 0.0)
     return c, c.pack()
 
 
@@ -225,4 +295,7 @@ CONTROLLER = ControllerSpec(
     description="nonlinear ADRC: tracking differentiator, ESO with fal, NLSEF (berthing paper eq 20-27)",
     update=nonlinear_adrc_update, n_state=N_STATE, config=NonlinearADRCConfig, build=build,
     source="LOS + ADRC automatic berthing (2019) eqs (20)-(31); Han (2009)",
-    params=PARAMS)
+    params=PARAMS,
+    design_rule=("omega_c = omega_n, the shared bandwidth: proportional to sqrt(b) where the gear's limit binds, "
+                 "i.e. Han's time-scale rule (31) (berthing paper 2019), capped by the gear's rate and lag; ESO "
+                 "omega_o = 5 omega_c (Gao 2003); anti-windup: ESO fed the measured rudder, |z3| <= b u_max"))

@@ -11,7 +11,9 @@ from (:func:`design_model`):
 * a Van Leeuwen ship (``b481``): its Table 1 set for ``design_loading`` (default: the loading
   the ship starts in); the controller is then exact for that loading and mismatched after a
   loading switch, as in the paper's Tables 5-6 experiment.
-* any other ship: its first-order Nomoto model ``(K, T)`` at the design speed written as a
+* any other ship: its first-order Nomoto model ``(K, T)`` (either sign: ``T < 0`` is a
+  course-unstable ship; the laws cancel the drift term, so the sign does not matter to them) at the
+  design speed written as a
   Van Leeuwen set with ``T1* = T U/L``, ``T2* = T2 U/L``, ``K* = K L/U``, ``a1* = 1``,
   ``a0* = a2* = a3* = 0``. ``T2`` [s] is the design's second time constant (default: the
   steering gear's ``T_sg``; a first-order Nomoto ship behind a first-order gear with time
@@ -30,12 +32,13 @@ import math
 import numba
 import numpy as np
 
+from steerlab.control.law_design import law_model
 from steerlab.errors import InputError
 from steerlab.ships import van_leeuwen as vl
 from steerlab.ships.state import IR
 
 
-def design_model(ctx, design_loading: str | None, T2: float | None):
+def design_model(ctx, design_loading: str | None, T2: float | None, match_b2: bool = False):
     """``(set7 packed (radian form), L [m], i_rdot)`` for a controller built in ``ctx``.
 
     ``i_rdot`` is the index of ``rdot`` in the plant state, or ``-1`` (estimate it; also when the
@@ -59,15 +62,28 @@ def design_model(ctx, design_loading: str | None, T2: float | None):
                          f"only for Van Leeuwen ships {sorted(known)}; ship is {ship.name!r}")
     K, T = ctx.nomoto()
     L = float(ship.dims[1])
-    mu = ctx.speed / L
+    mu = design_mu(ctx, L)
     T2s = ctx.gear.T_sg if T2 is None else T2
-    if not (math.isfinite(K) and math.isfinite(T) and T > 0.0 and K > 0.0):
-        raise InputError("ship.model", "the design needs a course-stable ship with a finite first-order "
-                                       f"Nomoto model (0 < K, T < inf); got K={K}, T={T}")
+    if not (math.isfinite(K) and math.isfinite(T) and K * T > 0.0):
+        raise InputError("ship.model", "the design needs a finite first-order Nomoto model with K, T of one "
+                                       f"sign (course-stable or -unstable); got K={K}, T={T}: use nonlinear_adrc, "
+                                       "which needs only b2")
     if not (T2s > 0.0):
         raise InputError("controller.design_T2", f"must be > 0 s, got {T2s}")
-    s = vl.Loading(K=K / mu, T1=T * mu, T2=T2s * mu, a0=0.0, a1=1.0, a2=0.0, a3=0.0).packed()
+    T1 = T
+    if match_b2:
+        b2 = law_model(ctx).b2
+        T1 = K / b2
+    s = vl.Loading(K=K / mu, T1=T1 * mu, T2=T2s * mu, a0=0.0, a1=1.0, a2=0.0, a3=0.0).packed()
     return s, L, i_rdot
+
+
+def design_mu(ctx, L: float) -> float:
+    """``mu = U/L`` [1/s] of the design: the design speed over the length; ``1/s`` when the design has
+    no speed (a Nomoto-only design: the set of a non-Van Leeuwen ship is the same law for any ``mu``,
+    since ``c mu^3 = K / (T T2)`` and ``phi^T theta = -(r + (T + T2) r') / (T T2)``)."""
+    mu = ctx.speed / L
+    return mu if math.isfinite(mu) and mu > 0.0 else 1.0
 
 
 def linear_design_matrices(s, mu: float, T_R: float):

@@ -52,9 +52,9 @@ WIND_FROM_DEG = 90.0      # ASSUMED
 HEADING_BAND_DEG = 5.0
 
 PID_PAPER = {"type": "pid", "Kp": 0.84, "Ki": 0.001, "Kd": 1.56}
-ADRC_PAPER = {"type": "nonlinear_adrc", "b": 1.0, "k1": 0.35, "k2": 0.01, "beta": [10.0, 100.0, 500.0],
-              "r_td": 100.0, "h0": 0.1}
-ADRC_BANDWIDTH = {"type": "nonlinear_adrc", "omega_c": 0.6, "omega_o": 4.0}
+ADRC_PAPER = {"type": "nonlinear_adrc", "gains": "paper", "b": 1.0, "k1": 0.35, "k2": 0.01,
+              "beta": [10.0, 100.0, 500.0], "r_td": 100.0, "h0": 0.1}
+ADRC_BANDWIDTH = {"type": "nonlinear_adrc", "gains": "paper", "omega_c": 0.6, "omega_o": 4.0}
 
 # Table 5: heading adjustment time [s], RPM zero time [s], D [m], success
 PAPER = {

@@ -73,7 +73,7 @@ def controller_config(name: str, loading: str, gain_time: str = "s") -> dict:
     """The ``[controller]`` table for a controller of the paper with its published gains."""
     if name in ("A", "B"):
         k = TABLE3[(name, loading)]
-        cfg = {"type": f"backstepping_{name.lower()}", "k1": k[0], "k2": k[1], "k3": k[2],
+        cfg = {"type": f"backstepping_{name.lower()}", "gains": "paper", "k1": k[0], "k2": k[1], "k3": k[2],
                "design_loading": loading, "gain_time": gain_time}
         if name == "B":
             cfg["k4"] = k[3]
@@ -81,7 +81,7 @@ def controller_config(name: str, loading: str, gain_time: str = "s") -> dict:
     a, b = TABLE5[(name, loading)]
     if name == "PD":
         return {"type": "pid", "Kp": a, "Ki": 0.0, "Kd": b}
-    return {"type": "sliding_mode", "phi_deg": a, "eta_deg_s": b, "design_loading": loading}
+    return {"type": "sliding_mode", "gains": "paper", "phi_deg": a, "eta_deg_s": b, "design_loading": loading}
 
 
 def scenario(ctrl: dict, speed: float, options: dict, changes, duration: float):

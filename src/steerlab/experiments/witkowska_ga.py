@@ -127,7 +127,7 @@ def base_scenario(label: str, loading: str, settings: Optional[dict] = None):
         ctrl.update(Kp=PAPER_SETTINGS[("PD", loading)][0][0], Ki=0.0,
                     Kd=PAPER_SETTINGS[("PD", loading)][0][1])
     else:
-        ctrl["design_loading"] = loading
+        ctrl.update(gains="paper", design_loading=loading)
     ctrl.update(settings or {})
     return scenario_from_dict({
         "name": f"witkowska-ga-{label}-{loading}", "seed": 0, "dt": DT, "duration": DURATION,

@@ -124,7 +124,7 @@ def base_scenario() -> Scenario:
 
 def adrc_config(T_settle: float, law: str = "stable", kd_rule: str = "herbst") -> dict:
     """ADRC with c0 by eq (29) and the paper's observer gains."""
-    return {"type": "adrc", "T_settle": float(T_settle), "c0": "estimate", "observer": "paper",
+    return {"type": "adrc", "gains": "paper", "T_settle": float(T_settle), "c0": "estimate", "observer": "paper",
             "law": law, "kd_rule": kd_rule}
 
 
