@@ -47,6 +47,8 @@ import sys
 import numpy as np
 import numba
 import steerlab
+from steerlab.jit import command
+command.settings()                                                # the steerlab command's, not import steerlab's
 from steerlab.environment.iir_filter import lfilter
 
 def scipys_blas_loaded():    # scipy's own OpenBLAS (numpy's is libscipy_openblas64_)
@@ -74,6 +76,8 @@ BLAS_SCIPY_FIRST_SCRIPT = """
 import sys
 import numpy as np
 import steerlab
+from steerlab.jit import command
+command.settings()                                                # the steerlab command's, not import steerlab's
 from steerlab.environment.iir_filter import lfilter
 lfilter(np.array([1.0]), np.array([1.0, -0.5]), np.ones(4))
 import scipy.linalg                                               # scipy's own users: the whole module
@@ -87,7 +91,8 @@ print("ok")
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc/self/maps")
 @pytest.mark.parametrize("script", [BLAS_SCRIPT, BLAS_SCIPY_FIRST_SCRIPT], ids=["numba-uses-blas", "scipy-first"])
 def test_numbas_blas_probe_skips_the_scipy_linalg_import_and_blas_still_works(script):
-    """steerlab.jit.numba_blas_probe: the first kernel call neither imports scipy.linalg (0.16 s)
+    """steerlab.jit.numba_blas_probe (the steerlab command's setting): the first kernel call
+    neither imports scipy.linalg (0.16 s)
     nor loads scipy's own BLAS (its threads' start-up spin); numba's BLAS-backed ``@`` loads it
     and gives numpy's result; ``import scipy.linalg`` is whole (``cython_blas`` attribute set
     to the real module), whether numba used BLAS first or not."""

@@ -20,9 +20,11 @@ process that uses it. When something later imports ``scipy.linalg`` for real, th
 imported as usual; :class:`_AttachOnImport` then sets its ``cython_blas`` attribute to the
 real module, as the normal import would have.
 
-Anything unexpected (no scipy, another layout, a numba that already loaded its registries)
-leaves everything as numba does it: :func:`preload` returns ``False`` and changes nothing.
-Set ``STEERLAB_BLAS_PROBE=0`` to switch it off.
+It puts a module of its own in another library's place, so only the ``steerlab`` command does
+it (:mod:`steerlab.jit.command`), never ``import steerlab``, and only on the numba versions the
+tests cover (:mod:`steerlab.jit.numba_gate`). Anything unexpected (no scipy, another layout, a
+numba that already loaded its registries) leaves everything as numba does it: :func:`preload`
+returns ``False`` and changes nothing. Set ``STEERLAB_BLAS_PROBE=0`` to switch it off.
 """
 
 from __future__ import annotations

@@ -18,8 +18,10 @@ Compiling is unchanged: numba's compiler refreshes the context itself before eve
 compilation, so a process that compiles later (a cache miss, a new kernel) gets the
 registries then. A load that fails for any reason is retried the numba way (full refresh).
 
-It patches a numba internal (``numba.core.caching.Cache``; written against numba 0.68): if
-the names it needs are missing, :func:`install` changes nothing. Set
+It patches a numba internal (``numba.core.caching.Cache``; written against numba 0.68), so it
+is made by the ``steerlab`` command only (:mod:`steerlab.jit.command`), never at ``import
+steerlab``, and only on the numba versions the tests cover (:mod:`steerlab.jit.numba_gate`);
+if the names it needs are missing, :func:`install` changes nothing. Set
 ``STEERLAB_LIGHT_CACHE_LOAD=0`` to switch it off.
 """
 
@@ -44,7 +46,12 @@ def _prepare(target_context) -> None:
 
 def install() -> bool:
     """Replace numba's ``Cache.load_overload`` (idempotent); returns whether it is in place."""
+    global INSTALLED
     if os.environ.get(ENV, "1") == "0":
+        return False
+    from steerlab.jit import numba_gate
+
+    if not numba_gate.internals_allowed():
         return False
     try:
         from numba.core import caching
@@ -71,8 +78,10 @@ def install() -> bool:
     load_overload._steerlab = True  # type: ignore[attr-defined]
     load_overload.__doc__ = original.__doc__
     cache.load_overload = load_overload
+    INSTALLED = True
     return True
 
 
-INSTALLED = install()
-"""Installed at import of steerlab (``STEERLAB_LIGHT_CACHE_LOAD=0`` leaves numba's own)."""
+INSTALLED = False
+"""Whether :func:`install` replaced numba's load in this process (the ``steerlab`` command does,
+unless ``STEERLAB_LIGHT_CACHE_LOAD=0``)."""
