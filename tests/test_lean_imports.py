@@ -14,6 +14,9 @@ HEAVY = ("control", "scipy.linalg", "scipy.signal", "scipy.optimize", "scipy.sta
 SCRIPT = """
 import json, sys
 import steerlab as sl
+if sys.argv[1] == "command":         # the steerlab command's own settings (steerlab.jit.command)
+    from steerlab.jit import command
+    command.settings()
 from steerlab.sim.setup import build
 sc = sl.default_scenario()
 s = build(sc.replace(duration=50.0))
@@ -24,13 +27,16 @@ print(json.dumps(sorted(m for m in heavy if m in sys.modules)))
 """
 
 
-def test_a_run_and_a_batch_import_no_heavy_optional_library():
+@pytest.mark.parametrize("mode, imported", [("command", []), ("library", ["scipy.linalg"])])
+def test_a_run_and_a_batch_import_no_heavy_optional_library(mode, imported):
+    """In a user's program numba's own first-use BLAS probe imports scipy.linalg, as without
+    steerlab; the steerlab command skips it (steerlab.jit.numba_blas_probe)."""
     # the eq-39 filter coefficients come from the disk memo after the first computation
     for _ in range(2):
-        out = subprocess.run([sys.executable, "-c", SCRIPT % (HEAVY,)], capture_output=True, text=True,
+        out = subprocess.run([sys.executable, "-c", SCRIPT % (HEAVY,), mode], capture_output=True, text=True,
                              timeout=600)
         assert out.returncode == 0, out.stderr
-    assert json.loads(out.stdout.strip().splitlines()[-1]) == []
+    assert json.loads(out.stdout.strip().splitlines()[-1]) == imported
 
 
 def test_import_steerlab_imports_only_numpy_and_numba():
