@@ -38,7 +38,6 @@ from __future__ import annotations
 import hashlib
 import os
 import re
-import warnings
 from functools import lru_cache
 from pathlib import Path
 
@@ -176,7 +175,11 @@ def install() -> bool:
     user = str(getattr(config, "CACHE_LOCATOR_CLASSES", "") or "")
     if user and not user.startswith(CONFIG_NAME + ","):
         # numba reads this list instead of its own: ours first, wrapping the user's classes
-        _INNER[:] = _user_classes(user, caching)
+        try:
+            inner = _user_classes(user, caching)
+        except (ImportError, AttributeError, ValueError):
+            return False        # a class numba cannot find either: numba says so at first use
+        _INNER[:] = inner
         config.CACHE_LOCATOR_CLASSES = f"{CONFIG_NAME},{user}"
     INSTALLED = True
     return True
