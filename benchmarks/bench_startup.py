@@ -7,6 +7,7 @@ Usage::
     python benchmarks/bench_startup.py --repeats 9 --json > startup.json
     python benchmarks/bench_startup.py --skip-cold      # without the cold-cache run
     python benchmarks/bench_startup.py --warm-run-only  # only the reference and the warm default run
+    python benchmarks/bench_startup.py --switches       # the command's settings, each switched off
 
 Measured (wall time of whole processes, medians of ``--repeats``; these machines are noisy,
 so the figures that matter are the ratios to the reference measured in the same session,
@@ -28,6 +29,11 @@ interleaved with the runs):
   the wave filter's Nomoto design imported python-control);
 * ``run_default_cold``: the default run with an empty driver cache (a fresh
   ``STEERLAB_CACHE_DIR``; target <= 10 s, and it says that it is compiling).
+
+``--switches`` measures what each of the ``steerlab`` command's process-wide settings
+(:mod:`steerlab.jit.command`) saves: the warm default run with all of them, with each one
+switched off by its environment variable, and with all of them off, interleaved with the
+reference (medians of wall and CPU time, and their ratios to the reference's).
 
 Each measurement uses its own cache directory under a temporary folder, so the user's cache
 is neither used nor changed. steerlab's sources are compiled to bytecode first and the runs
@@ -172,17 +178,73 @@ def measure(repeats: int, cold: bool, progress=print, first_calls: bool = True) 
     return res
 
 
+SWITCHES = {
+    "light cache load": {"STEERLAB_LIGHT_CACHE_LOAD": "0"},
+    "BLAS probe": {"STEERLAB_BLAS_PROBE": "0"},
+    "fast exit": {"STEERLAB_FAST_EXIT": "0"},
+    "one OpenBLAS thread": {"STEERLAB_ONE_BLAS_THREAD": "0"},
+}
+"""The command's settings and the variables that switch each off (:mod:`steerlab.jit.command`)."""
+
+
+def measure_switches(repeats: int, progress=print) -> dict:
+    """The warm default run with all the command's settings, each one off, all off (module
+    docstring): medians [s] and ratios to the reference measured in the same rounds."""
+    py = sys.executable
+    tmp = Path(tempfile.mkdtemp(prefix="steerlab-switches-"))
+    warm, out = tmp / "warm", tmp / "out"
+    import compileall
+
+    compileall.compile_dir(str(SRC / "steerlab"), quiet=1)
+    reference_cmd = [py, "-c", "import numpy, numba, matplotlib.pyplot"]
+    run_cmd = [py, "-m", "steerlab", "run", "--out", str(out), "--quiet"]
+    every_off = {k: v for env in SWITCHES.values() for k, v in env.items()}
+    cases = {"reference": ({}, reference_cmd), "all on": ({}, run_cmd),
+             **{f"without {name}": (env, run_cmd) for name, env in SWITCHES.items()},
+             "all off": (every_off, run_cmd)}
+    progress("warming the cache ...")
+    _timed(run_cmd, _env(warm))
+    wall: dict = {k: [] for k in cases}
+    cpu: dict = {k: [] for k in cases}
+    for i in range(repeats):
+        progress(f"round {i + 1}/{repeats}")
+        for name, (env, cmd) in cases.items():
+            e = _env(warm)
+            for k in set(every_off) | {"OPENBLAS_NUM_THREADS"}:
+                e.pop(k, None)            # each run decides as a user's shell would
+            e.update(env)
+            dt, c, _ = _timed_cpu(cmd, e)
+            wall[name].append(dt)
+            cpu[name].append(c)
+    res: dict = {"repeats": repeats}
+    ref_w, ref_c = statistics.median(wall["reference"]), statistics.median(cpu["reference"])
+    for name in cases:
+        w, c = statistics.median(wall[name]), statistics.median(cpu[name])
+        res[name] = {"wall_s": round(w, 3), "cpu_s": round(c, 3),
+                     "wall_vs_reference": round(w / ref_w, 3), "cpu_vs_reference": round(c / ref_c, 3)}
+    load = os.getloadavg() if hasattr(os, "getloadavg") else None
+    res["load_average_1min_at_end"] = load[0] if load else None
+    return res
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--repeats", type=int, default=5)
     ap.add_argument("--skip-cold", action="store_true")
     ap.add_argument("--warm-run-only", action="store_true",
                     help="only the reference and the warm default run (no first calls, no cold run)")
+    ap.add_argument("--switches", action="store_true",
+                    help="the warm default run with each of the command's settings switched off")
     ap.add_argument("--json", action="store_true")
     args = ap.parse_args(argv)
     if args.repeats < 1:
         print("bench_startup: error: --repeats: must be >= 1", file=sys.stderr)
         return 2
+    if args.switches:
+        res = measure_switches(args.repeats, progress=lambda m: print(m, file=sys.stderr, flush=True))
+        print(json.dumps(res, indent=2) if args.json else
+              "\n".join(f"{k:32s} {v}" for k, v in res.items()))
+        return 0
     res = measure(args.repeats, not (args.skip_cold or args.warm_run_only),
                   progress=lambda m: print(m, file=sys.stderr, flush=True), first_calls=not args.warm_run_only)
     if args.json:

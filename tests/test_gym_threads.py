@@ -1,5 +1,5 @@
 """The vector environment's threaded step on numba's threads (``step_parallel``, ``prange``) and the
-process-wide threading layer steerlab asks for (:mod:`steerlab.jit.threading_layer`): fork-safe, a
+process-wide threading layer the steerlab command asks for (:mod:`steerlab.jit.threading_layer`): fork-safe, a
 forked child steps its own environments; steerlab's parallel calls from several Python threads
 take turns; a user's explicit layer is kept. Each case runs in a fresh interpreter (the layer is
 chosen once per process, and a wrong one aborts the process)."""
@@ -76,9 +76,12 @@ THREADS = PRELUDE + textwrap.dedent("""
 LAYER = textwrap.dedent("""
     import json, sys
     import numba
-    if len(sys.argv) > 1:
-        numba.config.THREADING_LAYER = sys.argv[1]     # chosen in code before importing steerlab
+    if len(sys.argv) > 2:
+        numba.config.THREADING_LAYER = sys.argv[2]     # chosen in code before importing steerlab
     import steerlab
+    if sys.argv[1] == "command":                       # what the steerlab command sets up
+        from steerlab.jit import command
+        command.settings()
     from steerlab.jit.threading_layer import num_threads, tbb_library, threads_pay
     num_threads()                                      # starts numba's threads, as steerlab does
     print(json.dumps({"layer": numba.threading_layer(), "config": numba.config.THREADING_LAYER,
@@ -108,16 +111,27 @@ def test_threaded_steps_from_two_python_threads_take_turns_and_keep_their_number
     assert r["same"] == [True, True]
 
 
-def test_steerlab_asks_for_the_fork_safe_layer_unless_the_user_chose_one():
-    r = _run(LAYER)
+def test_the_command_asks_for_the_fork_safe_layer_unless_the_user_chose_one():
+    r = _run(LAYER, "command")
     assert r["config"] == "forksafe"
     assert r["layer"] == ("tbb" if r["tbb"] else "workqueue")          # pip's TBB found and loaded when installed
     assert r["pay"] == r["tbb"]
-    wq = _run(LAYER, env_extra={"NUMBA_THREADING_LAYER": "workqueue"})
+    wq = _run(LAYER, "command", env_extra={"NUMBA_THREADING_LAYER": "workqueue"})
     assert (wq["layer"], wq["config"], wq["pay"]) == ("workqueue", "workqueue", False)
-    omp = _run(LAYER, "omp")                                            # set in code before import: kept
+    omp = _run(LAYER, "command", "omp")                                 # set in code before import: kept
     assert (omp["layer"], omp["config"], omp["pay"]) == ("omp", "omp", True)
-    assert _run(LAYER, env_extra={"NUMBA_THREADING_LAYER": "omp"})["layer"] == "omp"   # set outside: kept
+    assert _run(LAYER, "command", env_extra={"NUMBA_THREADING_LAYER": "omp"})["layer"] == "omp"   # set outside: kept
+
+
+def test_import_steerlab_leaves_numbas_choice():
+    """A user's program keeps numba's "default" layer: TBB where it loads (pip's found for it);
+    where numba falls back to fork-unsafe OpenMP by itself, steerlab does not thread on it."""
+    r = _run(LAYER, "library")
+    assert r["config"] == "default"
+    if r["tbb"]:
+        assert (r["layer"], r["pay"]) == ("tbb", True)
+    else:
+        assert r["layer"] in ("omp", "workqueue") and r["pay"] is False
 
 
 def test_the_threaded_step_runs_on_workqueue_too():

@@ -14,6 +14,9 @@ HEAVY = ("control", "scipy.linalg", "scipy.signal", "scipy.optimize", "scipy.sta
 SCRIPT = """
 import json, sys
 import steerlab as sl
+if sys.argv[1] == "command":         # the steerlab command's own settings (steerlab.jit.command)
+    from steerlab.jit import command
+    command.settings()
 from steerlab.sim.setup import build
 sc = sl.default_scenario()
 s = build(sc.replace(duration=50.0))
@@ -24,13 +27,16 @@ print(json.dumps(sorted(m for m in heavy if m in sys.modules)))
 """
 
 
-def test_a_run_and_a_batch_import_no_heavy_optional_library():
+@pytest.mark.parametrize("mode, imported", [("command", []), ("library", ["scipy.linalg"])])
+def test_a_run_and_a_batch_import_no_heavy_optional_library(mode, imported):
+    """In a user's program numba's own first-use BLAS probe imports scipy.linalg, as without
+    steerlab; the steerlab command skips it (steerlab.jit.numba_blas_probe)."""
     # the eq-39 filter coefficients come from the disk memo after the first computation
     for _ in range(2):
-        out = subprocess.run([sys.executable, "-c", SCRIPT % (HEAVY,)], capture_output=True, text=True,
+        out = subprocess.run([sys.executable, "-c", SCRIPT % (HEAVY,), mode], capture_output=True, text=True,
                              timeout=600)
         assert out.returncode == 0, out.stderr
-    assert json.loads(out.stdout.strip().splitlines()[-1]) == []
+    assert json.loads(out.stdout.strip().splitlines()[-1]) == imported
 
 
 def test_import_steerlab_imports_only_numpy_and_numba():
@@ -47,6 +53,8 @@ import sys
 import numpy as np
 import numba
 import steerlab
+from steerlab.jit import command
+command.settings()                                                # the steerlab command's, not import steerlab's
 from steerlab.environment.iir_filter import lfilter
 
 def scipys_blas_loaded():    # scipy's own OpenBLAS (numpy's is libscipy_openblas64_)
@@ -74,6 +82,8 @@ BLAS_SCIPY_FIRST_SCRIPT = """
 import sys
 import numpy as np
 import steerlab
+from steerlab.jit import command
+command.settings()                                                # the steerlab command's, not import steerlab's
 from steerlab.environment.iir_filter import lfilter
 lfilter(np.array([1.0]), np.array([1.0, -0.5]), np.ones(4))
 import scipy.linalg                                               # scipy's own users: the whole module
@@ -87,7 +97,8 @@ print("ok")
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc/self/maps")
 @pytest.mark.parametrize("script", [BLAS_SCRIPT, BLAS_SCIPY_FIRST_SCRIPT], ids=["numba-uses-blas", "scipy-first"])
 def test_numbas_blas_probe_skips_the_scipy_linalg_import_and_blas_still_works(script):
-    """steerlab.jit.numba_blas_probe: the first kernel call neither imports scipy.linalg (0.16 s)
+    """steerlab.jit.numba_blas_probe (the steerlab command's setting): the first kernel call
+    neither imports scipy.linalg (0.16 s)
     nor loads scipy's own BLAS (its threads' start-up spin); numba's BLAS-backed ``@`` loads it
     and gives numpy's result; ``import scipy.linalg`` is whole (``cython_blas`` attribute set
     to the real module), whether numba used BLAS first or not."""

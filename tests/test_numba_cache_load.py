@@ -34,7 +34,8 @@ SCRIPT = '''
 import json, sys
 import numpy as np
 import steerlab
-from steerlab.jit import numba_cache_load
+from steerlab.jit import command, numba_cache_load
+command.settings()                    # the steerlab command's settings (not import steerlab's)
 import kmod
 value = kmod.everything(6)
 from steerlab.environment.iir_filter import lfilter

@@ -34,7 +34,7 @@ def test_changelog_covers_the_current_version():
 
 def test_the_rl_extra_installs_gymnasium_and_gym_is_its_alias():
     extras = PROJECT["project"]["optional-dependencies"]
-    assert extras["rl"][0] == "gymnasium>=1.0"              # what steerlab.gym's import error names
+    assert extras["rl"][0] == "gymnasium>=1.1"              # AutoresetMode; what steerlab.gym's import error names
     # numba's TBB threading layer for the vector env's threaded step (steerlab.jit.threading_layer)
     assert extras["rl"][1:] == ["tbb>=2021.6; sys_platform == 'linux' and platform_machine == 'x86_64'"]
     assert extras["gym"] == extras["rl"]

@@ -327,3 +327,23 @@ def test_bad_optimiser_settings_are_input_errors(lq_conditions):
     with pytest.raises(InputError) as e:
         tune(TuneSpec(scenario_from_dict(LQ_SCENARIO), ["kp"], [[0.1, 5]], controller="nope"))
     assert e.value.field == "controller.type"
+
+
+def test_a_scipy_outside_the_tested_versions_tunes_publicly_and_refuses_only_the_checkpoint(
+        lq_conditions, tmp_path, monkeypatch):
+    """The DE checkpoint's gate (SCIPY_DE_TESTED): on another scipy (simulated) a run without a
+    checkpoint goes through scipy's public differential_evolution with the same numbers, and
+    ``--checkpoint`` is refused in one line before anything is written."""
+    import scipy
+
+    pm = build_param_map(lq_conditions, ["kp", "kd"], np.array([[0.1, 5.0], [1.0, 100.0]]))
+    before = run_optimiser(PopulationEvaluator(lq_conditions, pm, [parse_cost("ise")]), "de", 2, 6, 0)
+    monkeypatch.setattr(scipy, "__version__", "1.30.0")
+    after = run_optimiser(PopulationEvaluator(lq_conditions, pm, [parse_cost("ise")]), "de", 2, 6, 0)
+    assert np.array_equal(after.x, before.x) and after.history == before.history
+    assert after.n_sims == before.n_sims
+    with pytest.raises(InputError, match=r"^--checkpoint: this scipy \(1\.30\.0\) is not one whose differential "
+                                         r"evolution state steerlab's tests cover \(>=1\.15,<1\.18\)"):
+        run_optimiser(PopulationEvaluator(lq_conditions, pm, [parse_cost("ise")]), "de", 2, 6, 0,
+                      checkpoint=tmp_path / "de.ckpt")
+    assert list(tmp_path.iterdir()) == []

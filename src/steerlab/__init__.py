@@ -8,7 +8,7 @@ Conventions (everywhere inside the library)
 * Every heading error goes through :func:`steerlab.angles.wrap_to_pi`.
 
 The public API (``import steerlab as sl``) is loaded lazily: ``import steerlab`` imports
-numpy and numba only; ``sl.simulate`` and friends import their module on first use
+numpy and numba only and changes nothing outside steerlab; ``sl.simulate`` and friends import their module on first use
 (PEP 562 module ``__getattr__``), so a command pays only for what it uses.
 """
 
@@ -19,22 +19,18 @@ from typing import TYPE_CHECKING, Any
 
 __version__ = "0.1.0"
 
-# the steerlab command's numpy on one OpenBLAS thread: before numpy is imported (blas_threads)
+# Nothing here changes anything outside steerlab (tests/test_import_side_effects.py). Two
+# settings must come first: in the steerlab command's own process only, numpy's OpenBLAS on one
+# thread, which works only before numpy is imported (blas_threads: a no-op in a user's program);
+# and before any kernel is defined, the package stamp of steerlab's own cached kernels, which
+# claims steerlab's files only (numba_cache). The command's other process-wide settings are
+# made by its entry point (steerlab.jit.command, from steerlab.cli.console_main).
 from steerlab.jit import blas_threads  # noqa: E402  (isort: skip)
 
 blas_threads.one_thread_for_commands()
-# before any kernel is defined: cached kernels are keyed on the whole package, not one file
-from steerlab.jit import numba_cache  # noqa: F401,E402  (isort: skip)
-# a cached kernel is loaded without numba's compile-time registries (numba_cache_load)
-from steerlab.jit import numba_cache_load  # noqa: F401,E402  (isort: skip)
-# numba's first-use BLAS probe without the scipy.linalg package import (numba_blas_probe)
-from steerlab.jit import numba_blas_probe  # noqa: E402  (isort: skip)
+from steerlab.jit import numba_cache  # noqa: E402  (isort: skip)
 
-numba_blas_probe.preload()
-# numba's fork-safe threading layer for the parallel entry points, unless the user chose one
-from steerlab.jit import threading_layer  # noqa: E402  (isort: skip)
-
-threading_layer.prefer_fork_safe()
+numba_cache.install()
 from steerlab.angles import wrap_to_pi  # noqa: F401
 from steerlab.errors import InputError  # noqa: F401
 

@@ -34,8 +34,8 @@ from typing import Callable, Optional
 
 import numba
 import numpy as np
-from numba.core.registry import CPUDispatcher
 
+from steerlab.jit.dispatch import is_dispatcher
 from steerlab.sim.batch import simulate_batch, vary_controller
 from steerlab.sim.engine import simulate_compiled, simulate_readable
 from steerlab.sim.kernels import plant_step
@@ -93,7 +93,7 @@ def w1_batch_setups(setup: SimSetup, n: int, seed: int = BATCH_SEED) -> list[Sim
 
 def _pure_callable(obj):
     """``obj`` itself, or, for a numba dispatcher, its Python function made pure (recursively)."""
-    if isinstance(obj, CPUDispatcher):
+    if is_dispatcher(obj):
         return pure_python(obj)
     return obj
 
@@ -117,7 +117,7 @@ def _rebind(fn, overrides: Optional[dict] = None):
     code = fn.__code__
     g = fn.__globals__
     subs = {name: _pure_callable(g[name]) for name in code.co_names
-            if isinstance(g.get(name), CPUDispatcher)}
+            if is_dispatcher(g.get(name))}
     subs.update(overrides or {})
     closure = fn.__closure__
     if closure is not None:

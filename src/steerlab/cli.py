@@ -311,7 +311,12 @@ def main(argv=None) -> int:
 
 def console_main() -> None:
     """The ``steerlab`` command and ``python -m steerlab``: :func:`main`, then the exit (a
-    finished ``run`` skips the interpreter's teardown: :mod:`steerlab.jit.fast_exit`)."""
+    finished ``run`` skips the interpreter's teardown: :mod:`steerlab.jit.fast_exit`). The
+    command's process-wide settings are made here, not at ``import steerlab``
+    (:mod:`steerlab.jit.command`)."""
+    from steerlab.jit import command
+
+    command.settings()
     argv = sys.argv[1:]
     code = main(argv)
     if argv[:1] == ["run"]:

@@ -65,10 +65,15 @@ def load_module(ref: str) -> ModuleType:
         existing = sys.modules.get(name)
         if existing is not None and Path(getattr(existing, "__file__", "") or "").resolve() == path:
             return existing
+        if existing is not None and not getattr(existing, "__steerlab_plugin__", False):
+            raise InputError(PLUGINS_ENV, f"plug-in file {str(path)!r} would replace the module {name!r} "
+                             f"already imported from {getattr(existing, '__file__', None) or 'built-in'}; "
+                             f"rename the file")
         spec = importlib.util.spec_from_file_location(name, path)
         if spec is None or spec.loader is None:
             raise InputError(PLUGINS_ENV, f"cannot load {str(path)!r} as a Python module")
         module = importlib.util.module_from_spec(spec)
+        module.__steerlab_plugin__ = True     # another plug-in file of the same name may replace it
         sys.modules[name] = module
         try:
             spec.loader.exec_module(module)

@@ -42,6 +42,7 @@ from steerlab.environment.waves import _hold, band_pass_eq39
 
 from steerlab.errors import InputError, require_finite_range
 from steerlab.sim.lanes import LANES, range_cuts
+from steerlab.jit.numba_gate import internals_allowed
 from steerlab.jit.threading_layer import launch, num_threads, threads_pay
 from steerlab.units import rad
 from steerlab.ships.state import IPSI
@@ -216,7 +217,7 @@ class Episodes:
         """Threads for a compiled call over ``m`` lanes: 1 below ``threads_from``, else
         ``threads``; None: ``numba.get_num_threads()`` on a threading layer where threads pay,
         else 1 (:func:`steerlab.jit.threading_layer.threads_pay`: not on workqueue)."""
-        if m < self.threads_from:
+        if m < self.threads_from or not internals_allowed():   # the threaded step: call_at
             return 1
         if self.threads is not None:
             return self.threads

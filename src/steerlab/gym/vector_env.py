@@ -8,7 +8,7 @@ advanced by the batch engine's vectorised groups of ``LANES`` ships in one compi
 guidance, observations and rewards; the single environment steps its ship with the scalar
 kernel, with the same numbers); from 512 ships on (:data:`~steerlab.gym.episodes.THREADS_FROM`)
 the call is split into ranges of whole groups spread over ``numba.get_num_threads()``
-threads by numba's ``prange`` (on a fork-safe threading layer, :mod:`steerlab.jit.threading_layer`),
+threads by numba's ``prange`` (on TBB, or a layer the user chose: :mod:`steerlab.jit.threading_layer`),
 after every action has been checked (same numbers whatever the split). ``reset(seed=s)`` seeds ship i with ``s + i`` (as gymnasium's
 ``SyncVectorEnv``; or ``seed=[s0, s1, ...]``, one per ship), so ship i's episodes equal a
 single environment's after ``reset(seed=s + i)``. Autoreset: gymnasium's ``NEXT_STEP`` mode

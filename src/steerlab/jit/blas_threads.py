@@ -16,7 +16,13 @@ default threads and 0.70-0.75 s with one (medians of alternating runs; CPU 1.38-
 ``python -m steerlab``: :func:`is_command_process`), numpy is not imported yet (afterwards it
 would have no effect) and the variable is not set (a user's value is kept). The processes the
 command starts inherit it. ``import steerlab`` in a user's own program or notebook changes
-nothing: their numpy keeps its threads.
+nothing: their numpy keeps its threads. ``STEERLAB_ONE_BLAS_THREAD=0`` switches it off.
+
+Measured with ``python benchmarks/bench_startup.py --switches`` (2026-11-28, the warm default
+run with this setting switched off against all on, medians of 5 interleaved rounds, CPU of
+the process tree; the machine was loaded, 1-minute load 17, so wall times were 5x the idle
+ones and only CPU is quoted; ``benchmarks/RESULTS.md``): 1.77 s of CPU without it against 1.64 s
+with it: 0.13 s.
 """
 
 from __future__ import annotations
@@ -27,6 +33,7 @@ from collections.abc import Sequence
 from pathlib import Path
 
 VARIABLE = "OPENBLAS_NUM_THREADS"
+ENV = "STEERLAB_ONE_BLAS_THREAD"
 #: the interpreter's options that take a value in the next argument (``python -X importtime``)
 _OPTIONS_WITH_VALUE = ("-W", "-X")
 #: the console script's names (``pip`` writes ``steerlab``, on Windows ``steerlab.exe``)
@@ -60,7 +67,7 @@ def is_command_process(orig_argv: Sequence[str], argv0: str) -> bool:
 def one_thread_for_commands() -> bool:
     """Set ``OPENBLAS_NUM_THREADS=1`` in the ``steerlab`` command's process (see the module
     docstring). Returns whether it was set."""
-    if VARIABLE in os.environ or "numpy" in sys.modules:
+    if VARIABLE in os.environ or "numpy" in sys.modules or os.environ.get(ENV, "1") == "0":
         return False
     if not is_command_process(getattr(sys, "orig_argv", ()), sys.argv[0] if sys.argv else ""):
         return False

@@ -20,9 +20,19 @@ process that uses it. When something later imports ``scipy.linalg`` for real, th
 imported as usual; :class:`_AttachOnImport` then sets its ``cython_blas`` attribute to the
 real module, as the normal import would have.
 
-Anything unexpected (no scipy, another layout, a numba that already loaded its registries)
-leaves everything as numba does it: :func:`preload` returns ``False`` and changes nothing.
-Set ``STEERLAB_BLAS_PROBE=0`` to switch it off.
+It puts a module of its own in another library's place, so only the ``steerlab`` command does
+it (:mod:`steerlab.jit.command`), never ``import steerlab``, and only on the numba versions the
+tests cover (:mod:`steerlab.jit.numba_gate`). Anything unexpected (no scipy, another layout, a
+numba that already loaded its registries) leaves everything as numba does it: :func:`preload`
+returns ``False`` and changes nothing. Set ``STEERLAB_BLAS_PROBE=0`` to switch it off.
+
+Measured with ``python benchmarks/bench_startup.py --switches`` (2026-11-28, the warm default
+run with this setting switched off against all on, medians of 5 interleaved rounds, CPU of
+the process tree; the machine was loaded, 1-minute load 17, so wall times were 5x the idle
+ones and only CPU is quoted; ``benchmarks/RESULTS.md``): 1.67 s of CPU without it against 1.64 s
+with it: 0.03 s, within that measurement's noise (on a quieter machine earlier, 0.12-0.16 s of
+CPU and 0.08 s of wall time: ``docs/compile-cache.md``). The smallest of the command's
+savings: the first to drop if a quiet measurement does not confirm it.
 """
 
 from __future__ import annotations

@@ -7,13 +7,30 @@ such a module changes (a ``git pull`` on an editable install, an upgrade in plac
 would load the old machine code, which then reads the wrong channels, silently. This
 module adds the fingerprint of the whole steerlab package (every ``.py`` file's path and
 contents) to the stamp of every steerlab kernel, so any change to steerlab
-recompiles its cached kernels once. Functions outside steerlab are left to numba as they are,
-except the generated drivers (:mod:`steerlab.jit.drivers`), whose stamp is their file name:
-the hash of their text, in a directory named after the fingerprint.
+recompiles its cached kernels once. The generated drivers (:mod:`steerlab.jit.drivers`) are
+stamped with their file name: the hash of their text, in a directory named after the
+fingerprint.
 
-It plugs into numba's cache locators (``numba.core.caching.CacheImpl._locator_classes``, an
-internal list): if a future numba changes that, :func:`install` does nothing and says so
-with a warning, and the cache behaves as numba's own.
+How: :func:`install` (called by ``import steerlab``, before any steerlab kernel is defined)
+puts :class:`PackageStampLocator` first among numba's cache locators
+(``numba.core.caching.CacheImpl._locator_classes``, an internal list). It claims only the
+files of this steerlab package and this steerlab's generated drivers; for any other file it
+answers ``None`` and numba asks its own locators, as without steerlab: a user's own
+``@numba.njit(cache=True)`` functions are cached where, and under the names and stamps,
+numba gives them (``tests/test_import_side_effects.py`` checks it in a fresh process).
+
+``NUMBA_CACHE_LOCATOR_CLASSES`` (numba >= 0.68: a comma-separated list of locator classes that
+replaces numba's own list) would bypass that list, and with it the package stamp. When it is
+set, :func:`install` puts ``steerlab.jit.numba_cache.PackageStampLocator`` in front of the
+user's classes in ``numba.config.CACHE_LOCATOR_CLASSES``; for steerlab's files the stamped
+locator then wraps the first of the user's classes that accepts the file, for other files the
+user's classes decide alone.
+
+Outside the numba versions the tests cover (:mod:`steerlab.jit.numba_gate`) the locator is
+not installed; instead :func:`sweep_stale` removes numba's cache files of steerlab's sources
+(numba's documented ``__pycache__/*.nbi``/``*.nbc`` next to each source) whenever the
+fingerprint differs from the one recorded there, so stale code is never loaded.
+``STEERLAB_NUMBA_CACHE_STAMP=0`` leaves numba's own locators (and the stale-code risk).
 """
 
 from __future__ import annotations
@@ -21,7 +38,6 @@ from __future__ import annotations
 import hashlib
 import os
 import re
-import warnings
 from functools import lru_cache
 from pathlib import Path
 
@@ -59,33 +75,46 @@ _DRIVER_NAME = re.compile(r"d_[0-9a-f]{20}\.py")
 
 
 def _is_driver(py_file: str) -> bool:
-    """A generated driver module (:mod:`steerlab.jit.drivers`): ``.../drivers/<fp>/d_<hash>.py``."""
+    """This steerlab's generated driver module (:mod:`steerlab.jit.drivers`):
+    ``.../drivers/<fingerprint[:20]>/d_<hash>.py``."""
     p = Path(py_file)
-    return bool(_DRIVER_NAME.fullmatch(p.name)) and p.parent.parent.name == "drivers"
+    return (bool(_DRIVER_NAME.fullmatch(p.name)) and p.parent.parent.name == "drivers"
+            and p.parent.name == _fingerprint()[:20])
 
 
-def install() -> bool:
-    """Put the package-fingerprint locator first among numba's cache locators (idempotent).
+ENV = "STEERLAB_NUMBA_CACHE_STAMP"
+CONFIG_NAME = "steerlab.jit.numba_cache.PackageStampLocator"
+"""How ``NUMBA_CACHE_LOCATOR_CLASSES`` names the locator (:func:`install`)."""
 
-    Returns whether it is installed.
-    """
-    try:
-        from numba.core import caching
+PackageStampLocator = None
+"""numba's own locator for the file, with the steerlab fingerprint in its stamp (the class is
+made by :func:`install`, on numba's ``_CacheLocator``)."""
 
-        classes = caching.CacheImpl._locator_classes
-        base = caching._CacheLocator
-    except (ImportError, AttributeError):   # pragma: no cover - depends on the numba version
-        warnings.warn("steerlab: numba's cache locators have moved; cached kernels are keyed "
-                      "on their own file only (clear __pycache__ after updating steerlab)",
-                      RuntimeWarning, stacklevel=2)
-        return False
-    if any(getattr(c, "_steerlab", False) for c in classes):
-        return True
-    standard = list(classes)
+_INNER: list = []
+"""The locators the stamped locator wraps: numba's list as it was, or the user's
+``NUMBA_CACHE_LOCATOR_CLASSES``."""
 
-    class PackageStampLocator(base):
-        """numba's own locator for the file, with the steerlab fingerprint in its stamp."""
 
+def _user_classes(spec: str, caching) -> list:
+    """The locator classes ``NUMBA_CACHE_LOCATOR_CLASSES`` names (as numba reads it), ours left out."""
+    import importlib
+
+    out = []
+    for name in (s.strip() for s in spec.split(",")):
+        if not name or name == CONFIG_NAME:
+            continue
+        if "." in name:
+            module, _, attr = name.rpartition(".")
+            cls = getattr(importlib.import_module(module), attr)
+        else:
+            cls = getattr(caching, name)
+        out.append(cls)
+    return out
+
+
+def _make_locator(base):
+    class _PackageStampLocator(base):
+        __doc__ = "numba's own locator for the file, with the steerlab fingerprint in its stamp."
         _steerlab = True
 
         def __init__(self, inner, driver=""):
@@ -110,16 +139,89 @@ def install() -> bool:
         def from_function(cls, py_func, py_file):
             driver = _is_driver(py_file)
             if not driver and not _inside(py_file):
-                return None
-            for locator_class in standard:
+                return None                    # not steerlab's: numba's own locators decide
+            for locator_class in _INNER:
                 inner = locator_class.from_function(py_func, py_file)
                 if inner is not None:
-                    return cls(inner, str(Path(py_file).relative_to(Path(py_file).parent.parent)) if driver else "")
+                    p = Path(py_file)
+                    return cls(inner, str(p.relative_to(p.parent.parent)) if driver else "")
             return None
 
-    classes.insert(0, PackageStampLocator)
+    _PackageStampLocator.__name__ = _PackageStampLocator.__qualname__ = "PackageStampLocator"
+    _PackageStampLocator.__module__ = __name__
+    return _PackageStampLocator
+
+
+def install() -> bool:
+    """Put :class:`PackageStampLocator` first among numba's cache locators (idempotent; see the
+    module docstring). Returns whether it is installed; ``False`` when switched off
+    (``STEERLAB_NUMBA_CACHE_STAMP=0``) or outside the tested numba versions (then
+    :func:`sweep_stale` guards steerlab's cache instead)."""
+    global PackageStampLocator, INSTALLED
+    if os.environ.get(ENV, "1") == "0":
+        return False
+    from steerlab.jit import numba_gate
+
+    if not numba_gate.internals_allowed():
+        sweep_stale()
+        return False
+    from numba.core import caching, config
+
+    classes = caching.CacheImpl._locator_classes
+    if PackageStampLocator is None:
+        PackageStampLocator = _make_locator(caching._CacheLocator)
+        _INNER[:] = [c for c in classes if not getattr(c, "_steerlab", False)]
+        classes.insert(0, PackageStampLocator)
+    user = str(getattr(config, "CACHE_LOCATOR_CLASSES", "") or "")
+    if user and not user.startswith(CONFIG_NAME + ","):
+        # numba reads this list instead of its own: ours first, wrapping the user's classes
+        try:
+            inner = _user_classes(user, caching)
+        except (ImportError, AttributeError, ValueError):
+            return False        # a class numba cannot find either: numba says so at first use
+        _INNER[:] = inner
+        config.CACHE_LOCATOR_CLASSES = f"{CONFIG_NAME},{user}"
+    INSTALLED = True
     return True
 
 
-INSTALLED = install() if os.environ.get("STEERLAB_NUMBA_CACHE_STAMP", "1") != "0" else False
-"""Installed at import of steerlab (``STEERLAB_NUMBA_CACHE_STAMP=0`` leaves numba's own)."""
+INSTALLED = False
+"""Whether :func:`install` has put the locator in place in this process."""
+
+MARK = "steerlab-numba-fingerprint"
+"""The file, in steerlab's top ``__pycache__``, that names the fingerprint numba's cache files
+of steerlab's sources were written for (:func:`sweep_stale`)."""
+
+
+def sweep_stale(root: Path = PACKAGE_ROOT) -> int:
+    """Remove numba's cache files (``*.nbi``, ``*.nbc``) of steerlab's sources under
+    ``root/**/__pycache__`` if they were written for another fingerprint of the package (or for
+    an unknown one), and record the current one. Used where the locator is not installed
+    (module docstring). With ``NUMBA_CACHE_DIR`` set numba keeps the files elsewhere, under
+    names of its own making: nothing is removed there (clear that directory after updating
+    steerlab). Returns the number of files removed."""
+    import numba
+
+    if getattr(numba.config, "CACHE_DIR", ""):    # numba's public settings (NUMBA_CACHE_DIR)
+        return 0
+    mark = Path(root) / "__pycache__" / MARK
+    current = _fingerprint() if Path(root) == PACKAGE_ROOT else package_fingerprint(root)
+    try:
+        if mark.read_text(encoding="ascii").strip() == current:
+            return 0
+    except OSError:
+        pass
+    removed = 0
+    for pattern in ("*.nbi", "*.nbc"):
+        for path in Path(root).rglob(f"__pycache__/{pattern}"):
+            try:
+                path.unlink()
+                removed += 1
+            except OSError:
+                pass
+    try:
+        mark.parent.mkdir(exist_ok=True)
+        mark.write_text(current, encoding="ascii")
+    except OSError:
+        pass
+    return removed

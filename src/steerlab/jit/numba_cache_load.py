@@ -18,9 +18,17 @@ Compiling is unchanged: numba's compiler refreshes the context itself before eve
 compilation, so a process that compiles later (a cache miss, a new kernel) gets the
 registries then. A load that fails for any reason is retried the numba way (full refresh).
 
-It patches a numba internal (``numba.core.caching.Cache``; written against numba 0.68): if
-the names it needs are missing, :func:`install` changes nothing. Set
+It patches a numba internal (``numba.core.caching.Cache``; written against numba 0.68), so it
+is made by the ``steerlab`` command only (:mod:`steerlab.jit.command`), never at ``import
+steerlab``, and only on the numba versions the tests cover (:mod:`steerlab.jit.numba_gate`);
+if the names it needs are missing, :func:`install` changes nothing. Set
 ``STEERLAB_LIGHT_CACHE_LOAD=0`` to switch it off.
+
+Measured with ``python benchmarks/bench_startup.py --switches`` (2026-11-28, the warm default
+run with this setting switched off against all on, medians of 5 interleaved rounds, CPU of
+the process tree; the machine was loaded, 1-minute load 17, so wall times were 5x the idle
+ones and only CPU is quoted; ``benchmarks/RESULTS.md``): 1.88 s of CPU without it against 1.64 s
+with it: 0.24 s.
 """
 
 from __future__ import annotations
@@ -44,7 +52,12 @@ def _prepare(target_context) -> None:
 
 def install() -> bool:
     """Replace numba's ``Cache.load_overload`` (idempotent); returns whether it is in place."""
+    global INSTALLED
     if os.environ.get(ENV, "1") == "0":
+        return False
+    from steerlab.jit import numba_gate
+
+    if not numba_gate.internals_allowed():
         return False
     try:
         from numba.core import caching
@@ -71,8 +84,10 @@ def install() -> bool:
     load_overload._steerlab = True  # type: ignore[attr-defined]
     load_overload.__doc__ = original.__doc__
     cache.load_overload = load_overload
+    INSTALLED = True
     return True
 
 
-INSTALLED = install()
-"""Installed at import of steerlab (``STEERLAB_LIGHT_CACHE_LOAD=0`` leaves numba's own)."""
+INSTALLED = False
+"""Whether :func:`install` replaced numba's load in this process (the ``steerlab`` command does,
+unless ``STEERLAB_LIGHT_CACHE_LOAD=0``)."""

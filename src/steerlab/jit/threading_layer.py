@@ -13,14 +13,18 @@ after a parallel call aborts at its own first parallel call ("fork() called from
 already using GNU OpenMP"); steerlab forks (the figure worker, multiprocessing, Dask
 workers), and so do RL libraries' subprocess vector envs. It also busy-waits: with the cores
 held by other programs, a 1024-ship step took 8 ms instead of 0.3 ms on the 2-core
-development VM. So :func:`prefer_fork_safe` (called by ``import steerlab``) asks numba for
+development VM. So :func:`prefer_fork_safe` (called by the ``steerlab`` command) asks numba for
 its ``"forksafe"`` layer - **TBB** when it can be loaded, else **workqueue** (numba's own
 pthreads pool, always there) - **unless the user chose**: ``NUMBA_THREADING_LAYER`` set, or
-``numba.config.THREADING_LAYER`` changed before ``import steerlab``, or numba's threads
+``numba.config.THREADING_LAYER`` changed before the command starts, or numba's threads
 already started; then steerlab runs on that layer (an explicit ``omp`` is the user's choice,
-fork-unsafe). It only sets ``numba.config.THREADING_LAYER``, so it applies to any other
-``parallel=True`` code of the process too; numba starts its threads later, on first use
-(13-20 ms, not paid by commands that never use them).
+fork-unsafe). It only sets ``numba.config.THREADING_LAYER``, so it would apply to any other
+``parallel=True`` code of the process too: the ``steerlab`` command makes this choice
+(:mod:`steerlab.jit.command`), ``import steerlab`` does not (a user's program keeps numba's
+``"default"``: TBB where it loads, which :func:`num_threads` helps it find, else OpenMP; choose
+``NUMBA_THREADING_LAYER=forksafe`` to fork after steerlab's parallel calls on a machine without
+TBB). numba starts its threads later, on first use (13-20 ms, not paid by commands that never
+use them).
 
 steerlab starts them through :func:`num_threads` (the vector environment's and the batch
 engine's thread counts), which first loads pip's TBB where numba would not find it
@@ -55,16 +59,28 @@ LAUNCH = threading.Lock()
 
 def prefer_fork_safe() -> bool:
     """Ask numba for its fork-safe threading layer unless the user chose one (module docstring);
-    returns whether it did."""
+    returns whether it did. The ``steerlab`` command's setting (:mod:`steerlab.jit.command`):
+    ``import steerlab`` leaves numba's choice to the user's program."""
     import numba
-    from numba.np.ufunc import parallel
 
-    if "NUMBA_THREADING_LAYER" in os.environ or getattr(parallel, "_is_initialized", False):
+    if "NUMBA_THREADING_LAYER" in os.environ or _threads_started():
         return False
     if str(numba.config.THREADING_LAYER).lower() != "default":
         return False
     numba.config.THREADING_LAYER = FORK_SAFE
     return True
+
+
+def _threads_started() -> bool:
+    """Whether numba's threads have started in this process (numba's internal flag, on the
+    tested numba versions: :mod:`steerlab.jit.numba_gate`; else steerlab's own record)."""
+    from steerlab.jit import numba_gate
+
+    if not numba_gate.internals_allowed():
+        return _started
+    from numba.np.ufunc import parallel
+
+    return bool(getattr(parallel, "_is_initialized", False))
 
 
 _started = False
@@ -77,9 +93,7 @@ def num_threads() -> int:
 
     global _started
     if not _started:
-        from numba.np.ufunc import parallel
-
-        if not getattr(parallel, "_is_initialized", False) and str(numba.config.THREADING_LAYER).lower() in (
+        if not _threads_started() and str(numba.config.THREADING_LAYER).lower() in (
                 "forksafe", "tbb", "safe", "threadsafe", "default"):
             preload_pip_tbb()
         _started = True
@@ -96,7 +110,10 @@ def threads_pay() -> bool:
     call faster than one thread: TBB and OpenMP do; workqueue, which wakes its sleeping
     threads at every call and leaves the calling thread waiting, does not (a threaded step of
     1024 ships took 330-390 us against 290 us in one call on the 2-core development VM with a
-    core free; TBB 155-160 us). The vector environment stays on one thread where it does not
+    core free; TBB 155-160 us). OpenMP counts only where it was chosen (``NUMBA_THREADING_LAYER``
+    or ``numba.config.THREADING_LAYER`` = ``"omp"``), not where numba's ``"default"`` fell back
+    to it in a user's program (fork-unsafe). On a numba outside the tested versions none does
+    (:mod:`steerlab.jit.numba_gate`: the threaded step calls by address). The vector environment stays on one thread where it does not
     (:meth:`steerlab.gym.episodes.Episodes._threads`, at every step: the answer is kept, a
     started layer does not change)."""
     global _pays
@@ -104,7 +121,15 @@ def threads_pay() -> bool:
         import numba
 
         num_threads()
-        _pays = numba.threading_layer() in PAYING
+        from steerlab.jit import numba_gate
+
+        # the threaded step calls the one-call step by address, in numba's calling convention
+        # (steerlab.jit.numba_call_at): on the tested numba versions only
+        layer = numba.threading_layer()
+        # GNU OpenMP is fork-unsafe: steerlab threads on it only where someone chose it (numba's
+        # "default" picks it when TBB is missing, and a user's program may fork afterwards)
+        chosen = layer != "omp" or str(numba.config.THREADING_LAYER).lower() == "omp"
+        _pays = layer in PAYING and chosen and numba_gate.internals_allowed()
     return _pays
 
 

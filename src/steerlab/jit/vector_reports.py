@@ -123,12 +123,11 @@ def on_compiled(dispatcher, args) -> None:
     _store(path, cres.signature.args, report_from_ir(cres.library.get_llvm_str()))
 
 
-def _on_end(event) -> None:
+def _on_end(dispatcher, args) -> None:
     """End of a numba compile: :func:`on_compiled` (best effort: a failure only means the report
     is read from a twin later)."""
-    data = event.data or {}
     try:
-        on_compiled(data.get("dispatcher"), data.get("args", ()))
+        on_compiled(dispatcher, args)
     except Exception:  # noqa: BLE001 - never let the report break a compile
         pass
 
@@ -137,17 +136,10 @@ _INSTALLED = False
 
 
 def install() -> None:
-    """Listen to numba's compiles in this process (once)."""
+    """Listen to numba's compiles in this process (once; :func:`steerlab.jit.dispatch.on_compiled`)."""
     global _INSTALLED
     if not _INSTALLED:
-        from numba.core import event
+        from steerlab.jit.dispatch import on_compiled as listen
 
-        class Listener(event.Listener):
-            def on_start(self, ev) -> None:
-                pass
-
-            def on_end(self, ev) -> None:
-                _on_end(ev)
-
-        event.register("numba:compile", Listener())
+        listen(_on_end)
         _INSTALLED = True

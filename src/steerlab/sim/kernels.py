@@ -34,9 +34,9 @@ import types
 from functools import lru_cache
 
 import numba
-from numba.core.registry import CPUDispatcher
 
 from steerlab.guidance.reference_models import course_guide
+from steerlab.jit.dispatch import is_dispatcher, supported_options
 
 @lru_cache(maxsize=None)
 def _fuse_options() -> dict:
@@ -53,12 +53,7 @@ def _fuse_options() -> dict:
     process would cost start-up time) against numba's target options; plain ``njit`` if
     this numba lacks one.
     """
-    opts = {"forceinline": True, "_nrt": False, "error_model": "numpy"}
-    try:
-        from numba.core.cpu import CPUTargetOptions
-    except ImportError:  # pragma: no cover - depends on the numba version
-        return {}
-    return {k: v for k, v in opts.items() if hasattr(CPUTargetOptions, k)}
+    return supported_options({"forceinline": True, "_nrt": False, "error_model": "numpy"})
 
 
 def _jit_fused(fn):
@@ -74,11 +69,11 @@ def _fused(kernel):
     ``NUMBA_DISABLE_JIT=1`` kernels are plain functions and are returned as they are.
     """
     py = getattr(kernel, "py_func", None)
-    if py is None or not isinstance(kernel, CPUDispatcher):
+    if py is None or not is_dispatcher(kernel):
         return kernel
     g = py.__globals__
     subs = {name: _fused(g[name]) for name in py.__code__.co_names
-            if isinstance(g.get(name), CPUDispatcher)}
+            if is_dispatcher(g.get(name))}
     if subs:
         py = types.FunctionType(py.__code__, {**g, **subs}, py.__name__, py.__defaults__,
                                 py.__closure__)

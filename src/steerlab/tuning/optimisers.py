@@ -185,11 +185,42 @@ def run_optimiser(evaluator, method: str, generations: int, pop_size: int, seed:
 
 #: what a DE checkpoint keeps of scipy's ``DifferentialEvolutionSolver``: ``(checkpoint key,
 #: solver attribute)``. scipy has no public way to continue a run, so private attributes are
-#: among them; a scipy that keeps them differently refuses ``--checkpoint`` before the first
-#: generation, in one line (a run without a checkpoint does not read them)
+#: among them; a scipy that keeps them differently, or is outside :data:`SCIPY_DE_TESTED`,
+#: refuses ``--checkpoint`` before the first generation, in one line (a run without a
+#: checkpoint uses scipy's public differential_evolution and reads none of them)
 DE_SOLVER_STATE = (("population", "population"), ("population_energies", "population_energies"),
                    ("feasible", "feasible"), ("constraint_violation", "constraint_violation"),
                    ("nfev", "_nfev"), ("random_index", "_random_population_index"))
+
+
+SCIPY_DE_TESTED = ((1, 15), (1, 18))
+"""scipy versions whose differential-evolution solver state the checkpoint tests cover (from,
+inclusive; to, exclusive): ``--checkpoint`` with ``--method de`` uses scipy's private solver
+class only on these (:func:`_private_de_solver`); a run without a checkpoint uses the public
+``scipy.optimize.differential_evolution`` on any scipy."""
+
+
+def _private_de_solver():
+    """scipy's ``DifferentialEvolutionSolver`` (a private module's class) for a checkpointed DE
+    run, on the scipy versions of :data:`SCIPY_DE_TESTED` only; else one ``--checkpoint``
+    InputError, before the first generation."""
+    import re
+
+    import scipy
+
+    m = re.match(r"(\d+)\.(\d+)", scipy.__version__)
+    version = (int(m.group(1)), int(m.group(2))) if m else None
+    (a, b), (c, d) = SCIPY_DE_TESTED
+    refuse = (f"this scipy ({scipy.__version__}) is not one whose differential evolution state steerlab's "
+              f"tests cover (>={a}.{b},<{c}.{d}), so a DE checkpoint cannot be written or resumed; run "
+              "without --checkpoint, or use --method ga")
+    if version is None or not (SCIPY_DE_TESTED[0] <= version < SCIPY_DE_TESTED[1]):
+        raise InputError("--checkpoint", refuse)
+    try:
+        from scipy.optimize._differentialevolution import DifferentialEvolutionSolver
+    except ImportError:
+        raise InputError("--checkpoint", refuse) from None
+    return DifferentialEvolutionSolver
 
 
 def _check_de_solver_state(solver) -> None:
@@ -213,11 +244,12 @@ def _de_solver_state(solver) -> dict:
 
 
 def _run_de(ev, generations, pop_size, seed, checkpoint, key, ck, prog) -> TuningResult:
-    # scipy's own solver object (what differential_evolution builds and runs), driven here so
-    # that a checkpoint holds its exact state: the unit-scaled population, its energies, the
-    # feasibility arrays, the evaluation count, the in-place-shuffled sample index and the
-    # random generator after the generation.
-    from scipy.optimize._differentialevolution import DifferentialEvolutionSolver
+    # With a checkpoint: scipy's own solver object (what differential_evolution builds and
+    # runs), driven here so that a checkpoint holds its exact state: the unit-scaled population,
+    # its energies, the feasibility arrays, the evaluation count, the in-place-shuffled sample
+    # index and the random generator after the generation (on the tested scipy versions only:
+    # _private_de_solver). Without: scipy's public differential_evolution, the same solver.
+    solver_class = _private_de_solver() if checkpoint else None
 
     bounds = ev.param_map.bounds
     d = bounds.shape[0]
@@ -238,7 +270,7 @@ def _run_de(ev, generations, pop_size, seed, checkpoint, key, ck, prog) -> Tunin
 
     def callback(intermediate_result):
         state["gen"] += 1
-        solver = state["solver"]
+        solver = state.get("solver")
         energies = np.asarray(intermediate_result.population_energies)
         best_x = np.asarray(intermediate_result.x, dtype=float)
         best_f = float(intermediate_result.fun)
@@ -254,9 +286,14 @@ def _run_de(ev, generations, pop_size, seed, checkpoint, key, ck, prog) -> Tunin
             _atomic_pickle(state["last"], checkpoint)
 
     popsize = max(2, int(math.ceil(pop_size / d)))
-    with DifferentialEvolutionSolver(objective, bounds, vectorized=True, updating="deferred", polish=False,
-                                     rng=rng, popsize=popsize, maxiter=remaining, init="latinhypercube",
-                                     tol=0.0, atol=0.0, callback=callback) as solver:
+    options = dict(vectorized=True, updating="deferred", polish=False, rng=rng, popsize=popsize,
+                   maxiter=remaining, init="latinhypercube", tol=0.0, atol=0.0, callback=callback)
+    if solver_class is None:
+        from scipy.optimize import differential_evolution
+
+        differential_evolution(objective, bounds, **options)
+        return _de_result(state.get("last", ck), history, state["gen"], ev, resumed=gen0 or None)
+    with solver_class(objective, bounds, **options) as solver:
         state["solver"] = solver
         if checkpoint:
             _check_de_solver_state(solver)
