@@ -6,9 +6,11 @@ context is made here from one of:
 
 * ``ship=ID, speed_kn=U`` - a catalogue ship (``steerlab ships``) at its approach speed;
 * ``nomoto=(K, T)`` - a first-order Nomoto model alone (``T r' + r = K delta``, Nomoto 1957),
-  realised as the ``nomoto1`` ship with those K [1/s], T [s] (and ``length_m``, default 100 m,
-  for laws written in non-dimensional form). The rudder efficiency is ``b2 = K / T``
-  [1/s^2] (exact for that model) unless ``b2=`` is given;
+  carried by the context itself (:class:`NomotoModel`): K [1/s] and T [s] of either sign but
+  the same one (``T < 0``, ``K < 0``: a course-unstable ship; ``K/T > 0`` always: a starboard
+  rudder starts a starboard turn), and ``length_m`` (default 100 m) for laws written in
+  non-dimensional form. The rudder efficiency is ``b2 = K / T`` [1/s^2] (exact for that
+  model) unless ``b2=`` is given;
 * neither - only laws that need no model (fixed-gain PID, classic autopilot, ...) can be
   designed; a law that needs one raises :class:`~steerlab.errors.InputError` naming ``nomoto``.
 
@@ -63,6 +65,57 @@ class NoModel:
 
     def b2(self, speed: float, method: str, options: object = None) -> NoReturn:
         self._need("rudder efficiency b2")
+
+
+@dataclass(frozen=True)
+class NomotoModel:
+    """The "ship" of a design from a first-order Nomoto model alone (``nomoto=(K, T)``).
+
+    It answers what a design rule may ask of a ship: ``nomoto()`` gives ``(K [1/s], T [s])``
+    with their signs, ``b2()`` the rudder efficiency [1/s^2] (``K/T`` unless given), ``dims``
+    the (draught, length, beam) [m] of the ``nomoto1`` ship of that length. Its plant state has
+    the planar layout of ``nomoto1`` (``x_n, y_e, psi, u, v, r``). Unlike ``nomoto1``'s
+    ``[ship.options]`` (``K > 0``) it takes a course-unstable model (``K < 0``, ``T < 0``).
+    """
+
+    K: float
+    T: float
+    L: float = 100.0
+    b2_value: float = math.nan
+
+    name = "nomoto"
+    n_states = len(PLANAR_NAMES)
+    state_names = PLANAR_NAMES
+    state_units = PLANAR_UNITS
+    options_model = None
+    source = "nomoto=(K, T)"
+
+    @classmethod
+    def checked(cls, nomoto, length_m: Optional[float], b2: Optional[float]) -> "NomotoModel":
+        """The model of ``nomoto=(K, T)``, or :class:`InputError` naming ``nomoto``/``length_m``."""
+        try:
+            K, T = (float(v) for v in nomoto)
+        except (TypeError, ValueError):
+            raise InputError("nomoto", f"must be a pair (K [1/s], T [s]), got {nomoto!r}") from None
+        if not (math.isfinite(K) and math.isfinite(T)) or K == 0.0 or abs(T) < 1e-6 or abs(K) > 100.0 \
+                or abs(T) > 1e5:
+            raise InputError("nomoto", f"needs finite K with 0 < |K| <= 100 [1/s] and T with 1e-6 <= |T| <= 1e5 [s], "
+                                       f"got ({K!r}, {T!r})")
+        if K / T < 0.0:
+            raise InputError("nomoto", f"K = {K:g} 1/s and T = {T:g} s have opposite signs; give both with one sign "
+                                       f"(a course-unstable ship: K < 0 and T < 0, e.g. ({-abs(K):g}, {-abs(T):g}))")
+        L = 100.0 if length_m is None else require_finite_range("length_m", length_m, 0.0, 1000.0, lo_open=True)
+        return cls(K, T, L, K / T if b2 is None else float(b2))
+
+    @property
+    def dims(self) -> tuple[float, float, float]:
+        return (0.8, self.L, self.L / 6.5)
+
+    def nomoto(self, speed: float, options: object = None) -> tuple[float, float]:
+        return self.K, self.T
+
+    def b2(self, speed: float, method: str, options: object = None) -> float:
+        return self.b2_value
 
 
 def make_gear(gear: Union[SteeringGear, Mapping[str, float], None]) -> SteeringGear:
@@ -138,21 +191,8 @@ def design_context(ship: Optional[str] = None, speed_kn: Optional[float] = None,
     if ship_options is not None:
         raise InputError("ship_options", "only with ship=ID")
     if nomoto is not None:
-        try:
-            K, T = (float(v) for v in nomoto)
-        except (TypeError, ValueError):
-            raise InputError("nomoto", f"must be a pair (K [1/s], T [s]), got {nomoto!r}") from None
-        spec = get_ship("nomoto1")
-        raw = {"K": K, "T": T}
-        if length_m is not None:
-            raw["L"] = length_m
-        try:
-            opts = spec.options(raw)
-        except InputError as err:
-            name = {"K": "nomoto", "T": "nomoto", "L": "length_m"}.get(err.field.rsplit(".", 1)[-1], "nomoto")
-            part = err.field.rsplit(".", 1)[-1]
-            raise InputError(name, f"{part}: {err.message}") from None
-        return GivenB2Context(spec, speed, g, sample_time, sample_time, opts, b2 if b2 is not None else K / T)
+        model = NomotoModel.checked(nomoto, length_m, b2)
+        return GivenB2Context(model, speed, g, sample_time, sample_time, None, model.b2_value)
     if length_m is not None:
         raise InputError("length_m", "only with nomoto=(K, T)")
     if b2 is not None:
