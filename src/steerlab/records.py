@@ -209,10 +209,8 @@ class Layout:
             hi = (upper or {}).get(n, f.hi)
             if hi is not None:
                 kw["lt" if f.hi_open and n not in (upper or {}) else "le"] = hi
-            if optional:
-                out[n] = (Optional[float], PField(None, **kw))
-            else:
-                out[n] = (float, PField((defaults or {}).get(n, f.default), **kw))
+            kind: Any = Optional[float] if optional else float
+            out[n] = (kind, PField(None if optional else (defaults or {}).get(n, f.default), **kw))
         return out
 
     def __repr__(self) -> str:
