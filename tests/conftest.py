@@ -36,7 +36,7 @@ BASE = {
     "dt": 0.1,
     "duration": 300.0,
     "ship": {"model": "esso", "speed_kn": 16.0},
-    "controller": {"type": "pid"},
+    "controller": {"type": "pid", "gains": "paper"},   # the vehicle of many tests: Zwierzewicz et al. (2021) gains
     "guidance": {"psi0_deg": 0.0, "changes": []},
     "environment": {},
 }

@@ -61,7 +61,7 @@ def test_nomoto_and_norrbin_linear_model_is_their_first_order_nomoto(name):
 
 def test_lq_pd_closed_loop_poles_are_eq_3_10(control):
     K, T = 0.05, 80.0
-    c = controller("lq_pd", nomoto=(K, T), lam=0.5)
+    c = controller("lq_pd", nomoto=(K, T), lam=0.5, gains="paper")          # the thesis' PD: no integral
     C = transfer_function(c)
     P = linearize("nomoto1", 10.0, ship_options={"K": K, "T": T})[0, 0]      # delta -> psi
     cl = control.feedback(C * P, 1)

@@ -197,7 +197,7 @@ def test_wind_equivalent_rudder():
 # ---- scenario level --------------------------------------------------------------------------
 
 def _sc(env, seed=0, ship="esso", duration=200.0, **extra):
-    d = {"seed": seed, "dt": 0.1, "duration": duration, "ship": {"model": ship}, "controller": {"type": "pid"},
+    d = {"seed": seed, "dt": 0.1, "duration": duration, "ship": {"model": ship}, "controller": {"type": "pid", "gains": "paper"},
          "environment": env, **extra}
     return scenario_from_dict(d)
 

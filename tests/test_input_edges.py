@@ -25,6 +25,7 @@ model = "kosoko"
 speed_kn = 10.0
 [controller]
 type = "pid"
+gains = "paper"
 [guidance]
 changes = [{ t = 2.0, psi_deg = 20.0 }]
 """

@@ -23,11 +23,11 @@ from steerlab.units import deg, rad
 K_SHIP, T_SHIP = 0.1, 50.0
 SHIP = {"model": "nomoto1", "speed_kn": 10.0, "options": {"K": K_SHIP, "T": T_SHIP}}
 
-CONTROLLERS = {
+CONTROLLERS = {     # the papers' settings (gains = "paper"; docs/controllers-pid.md)
     "classic_autopilot": {"type": "classic_autopilot", "Kp": 1.0, "Kd": 20.0, "Ki": 0.01},
-    "itae_pid": {"type": "itae_pid", "t_r": 53.0},
-    "lq_pd": {"type": "lq_pd", "lam": 1.0},
-    "gain_shaping_pid": {"type": "gain_shaping_pid", "T01": 20.0},
+    "itae_pid": {"type": "itae_pid", "gains": "paper", "t_r": 53.0},
+    "lq_pd": {"type": "lq_pd", "gains": "paper", "lam": 1.0},
+    "gain_shaping_pid": {"type": "gain_shaping_pid", "gains": "paper", "T01": 20.0},
 }
 INTEGRAL = {"classic_autopilot": True, "itae_pid": True, "lq_pd": False, "gain_shaping_pid": False}
 
@@ -270,9 +270,20 @@ def test_bad_config_names_the_field(cfg, field):
 
 
 @pytest.mark.parametrize("ctrl", ["itae_pid", "lq_pd", "gain_shaping_pid"])
-def test_course_unstable_design_model_is_refused(ctrl):
+def test_K_and_T_of_opposite_signs_are_refused(ctrl):
+    """K > 0 with T < 0 would be a rudder that turns the ship the wrong way at first: one line
+    naming controller.K; an explicit design model of one sign is accepted."""
     from steerlab.sim.setup import build
     ship = {"model": "nomoto1", "speed_kn": 10.0, "options": {"K": 0.1, "T": -50.0}}
-    with pytest.raises(InputError, match=r"controller\.T"):
+    with pytest.raises(InputError, match=r"controller\.K") as ei:
         build(_scenario(ctrl, ship=ship))
+    assert "\n" not in str(ei.value)
     build(_scenario(dict(CONTROLLERS[ctrl], T=50.0), ship=ship))   # an explicit design T is accepted
+
+
+def test_gain_shaping_refuses_a_course_unstable_ship_naming_the_laws_that_can():
+    from steerlab.sim.setup import build
+    with pytest.raises(InputError) as ei:
+        build(_scenario("gain_shaping_pid", ship={"model": "esso", "speed_kn": 16.0}))
+    assert ei.value.field == "controller.type" and "\n" not in str(ei.value)
+    assert '"pid"' in str(ei.value) and '"lq_pd"' in str(ei.value)

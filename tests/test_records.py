@@ -137,7 +137,9 @@ def test_pid_gain_is_named_once_config_record_and_constants_agree():
 
     schema = pid.PIDConfig.model_json_schema()["properties"]
     for f in pid.PARAMS.fields[:3]:
-        assert schema[f.name]["default"] == f.default and schema[f.name]["minimum"] == f.lo
+        # not given: designed (gains = "design") or the paper's, which is the record's default
+        assert schema[f.name]["default"] is None and pid.PAPER_GAINS[f.name] == f.default
+        assert schema[f.name]["anyOf"][0]["minimum"] == f.lo
         assert f"[{f.unit}]" in schema[f.name]["description"]
     rec = pid.PID(Kp=2.0, Ki=0.1, Kd=5.0, u_max=0.5).pack()
     assert rec[pid.C_KP] == 2.0 and rec[pid.C_KI] == 0.1 and rec[pid.C_KD] == 5.0 and rec[pid.C_UMAX] == 0.5

@@ -209,14 +209,14 @@ def test_tune_estimate_names_seeds(tmp_path, capsys):
 
 
 def test_a_run_that_never_settles_far_off_its_course_says_what_to_try(tmp_path, capsys):
-    """The default PID gains on the Zeefakkel (thesis Table 2.3) overshoot a 20 deg change to
+    """The paper's PID gains (gains = "paper") on the Zeefakkel (thesis Table 2.3) overshoot a 20 deg change to
     126 deg and end 96 deg off: the run still reports (no spin), and stderr says why and what
     designs settings, within the output width; a run that settles gets no such line."""
     from steerlab.commands._run_options import tracking_hint
     from steerlab.text_table import MAX_WIDTH
 
     toml = ('name = "zeefakkel-pid"\nduration = 600.0\n[ship]\nmodel = "zeefakkel-nomoto-10deg"\nspeed_kn = 12.0\n'
-            '[controller]\ntype = "pid"\n[guidance]\npsi0_deg = 0.0\nchanges = [{ t = 10.0, psi_deg = 20.0 }]\n')
+            '[controller]\ntype = "pid"\ngains = "paper"\n[guidance]\npsi0_deg = 0.0\nchanges = [{ t = 10.0, psi_deg = 20.0 }]\n')
     p = tmp_path / "zee.toml"
     p.write_text(toml)
     assert main(["run", str(p), "--out", str(tmp_path / "o")]) == 0

@@ -65,7 +65,7 @@ def test_load_scenario_roundtrip(tmp_path):
     p.write_text(
         'name = "t"\nseed = 7\ndt = 0.2\nduration = 100.0\n'
         '[ship]\nmodel = "esso"\nspeed_kn = 14.0\n'
-        '[controller]\ntype = "pid"\nKp = 2.0\nsample_time = 1.0\n'
+        '[controller]\ntype = "pid"\ngains = "paper"\nKp = 2.0\nsample_time = 1.0\n'
         '[guidance]\npsi0_deg = 10.0\nrate_max_deg_s = 0.5\nchanges = [{ t = 5.0, psi_deg = 30.0 }]\n'
         '[environment]\nconstant_rudder_deg = 3.0\n', encoding="utf-8")
     sc = load_scenario(p)

@@ -192,12 +192,13 @@ def test_wf_takes_a_course_unstable_ships_own_nomoto_model():
     import tomllib
 
     data = tomllib.loads(_toml("wf").replace("filter_K = 0.05\nfilter_T = 100.0\n", ""))
+    data["controller"]["gains"] = "paper"            # the old vehicle: Zwierzewicz et al.'s gains
     setup = build(scenario_from_dict(data))
     record = setup.controller.params.unpack(setup.pc)
     K, T = record["filter_K"], record["filter_T"]
     assert (K, T) == pytest.approx(setup.ship.nomoto(16.0 * 1852 / 3600)) and K < 0 and T < 0
     res = simulate(setup)
-    plain = simulate(build(scenario_from_dict({**data, "controller": {"type": "pid"}})))
+    plain = simulate(build(scenario_from_dict({**data, "controller": {"type": "pid", "gains": "paper"}})))
     # low waves (wave_power 1e-3): the filter passes the heading on; the turn is the plain PID's
     assert np.isfinite(res.states).all()
     assert np.abs(np.degrees(res.states[:, 2] - plain.states[:, 2])).max() < 0.1

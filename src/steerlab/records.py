@@ -191,12 +191,13 @@ class Layout:
         return cls
 
     def config_fields(self, names: Iterable[str], upper: Optional[Mapping[str, float]] = None,
-                      defaults: Optional[Mapping[str, float]] = None) -> dict:
+                      defaults: Optional[Mapping[str, float]] = None, optional: bool = False) -> dict:
         """pydantic field definitions ``{name: (float, Field(...))}`` for the scenario schema:
         default, bounds and ``[unit] doc`` from the layout; ``upper`` adds input-edge upper
         bounds (sanity limits of a TOML value that the record itself does not need);
         ``defaults`` replaces the layout's defaults (a record shared by two controllers whose
-        published settings differ)."""
+        published settings differ); ``optional``: the fields are ``Optional[float]`` with the
+        default ``None`` (a value the design rule fills when the user gives none)."""
         from pydantic import Field as PField
 
         out = {}
@@ -208,7 +209,8 @@ class Layout:
             hi = (upper or {}).get(n, f.hi)
             if hi is not None:
                 kw["lt" if f.hi_open and n not in (upper or {}) else "le"] = hi
-            out[n] = (float, PField((defaults or {}).get(n, f.default), **kw))
+            kind: Any = Optional[float] if optional else float
+            out[n] = (kind, PField(None if optional else (defaults or {}).get(n, f.default), **kw))
         return out
 
     def __repr__(self) -> str:

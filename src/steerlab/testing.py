@@ -261,7 +261,7 @@ def _check_ship(spec, kind, name, controller, speed_kn, options, duration, vecto
     if speed_kn is None and spec.speed_range[0] > 0:
         lo, hi = spec.speed_range
         speed_kn = 0.5 * (lo + (hi if math.isfinite(hi) else 2 * lo)) / KNOT
-    setup = build(_scenario(name, controller or {"type": "pid"}, duration, speed_kn, options))
+    setup = build(_scenario(name, controller or {"type": "pid", "gains": "paper"}, duration, speed_kn, options))
     x, ps, w = setup.x0.copy(), setup.ps.copy(), setup.w[0].copy()
     nx = x.shape[0]
     dx = np.full(nx, np.nan)

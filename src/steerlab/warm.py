@@ -26,12 +26,16 @@ def warm_speed_kn(ship_id: str) -> float:
 def warm_scenario(ship_id: str, controller: str):
     """A short scenario of the pair at a speed inside the ship's validity range, with a heading
     change (the step metrics' path of :func:`steerlab.metrics.compute_metrics`)."""
+    from steerlab.control.registry import get_controller
     from steerlab.sim.scenario import scenario_from_dict
 
+    ctrl = {"type": controller}
+    if "gains" in get_controller(controller).config.model_fields:
+        ctrl["gains"] = "paper"          # compiles the same kernel on every ship, design or not
     return scenario_from_dict({
         "name": f"warm-{ship_id}-{controller}", "seed": 0, "dt": 0.1, "duration": WARM_DURATION,
         "ship": {"model": ship_id, "speed_kn": warm_speed_kn(ship_id)},
-        "controller": {"type": controller},
+        "controller": ctrl,
         "guidance": {"psi0_deg": 0.0, "changes": [{"t": 1.0, "psi_deg": 10.0}]}, "environment": {}})
 
 

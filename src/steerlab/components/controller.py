@@ -219,7 +219,8 @@ def controller(type: str, *, ship: Optional[str] = None, speed_kn: Optional[floa
         ... the ship's speed [kn] (default: its design speed, ``ShipSpec.design_speed``) ...
     nomoto : tuple of float, optional
         ``(K [1/s], T [s])``: ... or from a first-order Nomoto model alone (``b2`` defaults
-        to K/T [1/s^2]) ... (or neither, for laws that need no model, e.g. a fixed-gain ``pid``).
+        to K/T [1/s^2]); either sign, the same one (``K < 0``, ``T < 0``: course-unstable) ...
+        (or neither, for a law that needs no model: every gain given, or ``gains="paper"``).
     b2 : float, optional
         Rudder efficiency [1/s^2] for laws that use it (ADRC's ``c0 = "estimate"/"exact"``).
     gear : None, SteeringGear or dict of ``[gear]`` keys

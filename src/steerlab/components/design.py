@@ -92,7 +92,7 @@ class NomotoModel:
     source = "nomoto=(K, T)"
 
     @classmethod
-    def checked(cls, nomoto, length_m: Optional[float], b2: Optional[float]) -> "NomotoModel":
+    def checked(cls, nomoto: Any, length_m: Optional[float], b2: Optional[float]) -> "NomotoModel":
         """The model of ``nomoto=(K, T)``, or :class:`InputError` naming ``nomoto``/``length_m``."""
         try:
             K, T = (float(v) for v in nomoto)

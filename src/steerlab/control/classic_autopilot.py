@@ -39,8 +39,22 @@ throw the ship off course by the disturbance at every turn). The derivative acts
 measured yaw rate relative to the reference's rate, so a set-point step does not kick the
 rudder. Units: ``Kp`` [rad/rad], ``Ki`` [1/s], ``Kd`` [s].
 
-Tuning: by hand, as on board; :mod:`steerlab.control.lq_pd` gives ``Kp``, ``Kd`` from the
-speed-loss criterion (3.1) of the same thesis (its Sec. 5.4 runs set ``Kd`` by eq 3.6).
+Anti-windup: besides the freeze in turns, conditional integration (clamping): the integral
+stops while the order is limited and the error would drive it further out.
+
+Gains (``gains`` in the config; a gain the user gives always wins):
+
+* ``"design"`` (default): the pole placement of :mod:`steerlab.control.pole_placement`
+  (Fossen 2011, Sec. 12.2.7) on the first-order Nomoto design model, the same rule as ``pid``::
+
+      Kp = omega_n^2 / b,   Kd = (2 zeta omega_n - a) / b,   Ki = Kp omega_n / 10
+
+  (``a = 1/T``, ``b = K/T``, ``zeta = 0.9``, ``omega_n`` the shared gear-capped bandwidth;
+  course-unstable ships included);
+* ``"paper"``: steerlab's settings up to now, ``Kp = 1``, ``Ki = 0.002 1/s``, ``Kd = 20 s``
+  (the thesis prints no gains for Fig. 3.3: on board they are set by hand;
+  :mod:`steerlab.control.lq_pd` gives ``Kp``, ``Kd`` from the speed-loss criterion (3.1) of
+  the same thesis, whose Sec. 5.4 runs set ``Kd`` by eq 3.6).
 """
 
 from __future__ import annotations
@@ -54,6 +68,7 @@ from pydantic import Field, create_model
 
 from steerlab.angles import wrap_to_pi
 from steerlab.config_base import FrozenConfig
+from steerlab.control.pole_placement import fill_gains
 from steerlab.control.registry import ControllerSpec
 from steerlab.errors import InputError
 from steerlab.records import Field as RecordField
@@ -153,7 +168,9 @@ ClassicAutopilotConfig = create_model(
     "ClassicAutopilotConfig", __base__=FrozenConfig,
     __doc__='``[controller] type = "classic_autopilot"`` (degrees only at this edge).',
     type=(Literal["classic_autopilot"], ...),
-    **PARAMS.config_fields(("Kp", "Ki", "Kd"), upper={"Kp": 1e4, "Ki": 1e4, "Kd": 1e5}),
+    gains=(Literal["design", "paper"], Field("design", description="gains not given: 'design' (pole placement "
+                                             "on the Nomoto model) or 'paper' (Kp 1, Ki 0.002, Kd 20)")),
+    **PARAMS.config_fields(("Kp", "Ki", "Kd"), upper={"Kp": 1e4, "Ki": 1e4, "Kd": 1e5}, optional=True),
     u_max_deg=(Optional[float], Field(None, gt=0.0, le=90.0, description="'rudder limiter'; default: gear limit")),
     weather_deg=(float, Field(0.0, ge=0.0, le=30.0, description="'weather' dead-band half-width [deg]")),
     weather_on=(Literal["error", "order"], "error"),
@@ -164,8 +181,19 @@ ClassicAutopilotConfig = create_model(
 ClassicAutopilotConfig.__module__ = __name__
 
 
+#: the gains of ``gains = "paper"`` (steerlab's hand settings up to now; the thesis prints none)
+PAPER_GAINS = {n: _default(n) for n in ("Kp", "Ki", "Kd")}
+DESIGN_RULE = ("pole placement on the first-order Nomoto model (Fossen 2011, Sec. 12.2.7), as pid: "
+               "Kp = omega_n^2/b, Kd = (2 zeta omega_n - a)/b, Ki = Kp omega_n/10, zeta = 0.9, omega_n from the "
+               "shared bandwidth rule; integral frozen in turns (van Amerongen 1982, Fig. 3.3)")
+
+
 def build(cfg: ClassicAutopilotConfig, ctx):
-    c = ClassicAutopilot(Kp=cfg.Kp, Ki=cfg.Ki, Kd=cfg.Kd, u_max=ctx.u_max(cfg.u_max_deg),
+    from steerlab.control.pid import designed_gains
+
+    g = fill_gains({"Kp": cfg.Kp, "Ki": cfg.Ki, "Kd": cfg.Kd}, cfg.gains, PAPER_GAINS,
+                   lambda: designed_gains(ctx, "classic_autopilot"))
+    c = ClassicAutopilot(Kp=g["Kp"], Ki=g["Ki"], Kd=g["Kd"], u_max=ctx.u_max(cfg.u_max_deg),
                          weather=rad(cfg.weather_deg), weather_on=cfg.weather_on,
                          lowpass_T=cfg.lowpass_T, course_change=rad(cfg.course_change_deg))
     return c, c.pack()
@@ -175,5 +203,5 @@ CONTROLLER = ControllerSpec(
     name="classic_autopilot",
     description="classic autopilot: PID, rudder limiter, weather dead band, low-pass, integral off in turns",
     update=classic_autopilot_update, n_state=N_STATE, config=ClassicAutopilotConfig, build=build,
-    source="van Amerongen (1982) Sec. 3.1, Fig. 3.3",
-    params=PARAMS)
+    source="van Amerongen (1982) Sec. 3.1, Fig. 3.3; gains: Fossen (2011) Sec. 12.2.7",
+    params=PARAMS, design_rule=DESIGN_RULE)

@@ -85,8 +85,9 @@ class DesignModel:
 
     @property
     def b(self) -> float:
-        """``K/T`` [1/s^2]: the rudder gain of ``r' = -a r + b delta``."""
-        return self.K / self.T
+        """``K/T`` [1/s^2]: the rudder gain of ``r' = -a r + b delta`` (``b2`` for a neutrally
+        stable ship, ``K = T = inf``: ``r' = b2 delta``)."""
+        return self.K / self.T if math.isfinite(self.T) else self.b2
 
     @property
     def unstable(self) -> bool:
@@ -107,6 +108,14 @@ def design_model(ctx, K: float | None = None, T: float | None = None, source: st
         K = K0 if K is None else K
         T = T0 if T is None else T
     K, T = float(K), float(T)
+    if math.isinf(K) and math.isinf(T) and K * T > 0.0 and not given:
+        # a neutrally stable ship (the linear yaw damping is zero: Bech's c1 = 0): r' = b2 delta
+        b2 = float(ctx.b2("exact"))
+        if math.isfinite(b2) and b2 > 0.0:
+            g = ctx.gear
+            return DesignModel(K=K, T=T, b2=b2, delta_max=float(g.delta_max), rate_max=float(g.rate_max),
+                               T_sg=float(g.T_sg), speed=float(ctx.speed),
+                               source=source or "the ship's b2 (neutrally stable: K = T = inf)")
     if not (math.isfinite(K) and K != 0.0):
         raise InputError("controller.K", f"the design model needs a finite, non-zero K [1/s], got {K!r}")
     if not (math.isfinite(T) and T != 0.0):

@@ -24,8 +24,25 @@ response: the closed-loop characteristic polynomial is ``(T s + 1)(T01 s + 1)/T0
 
 The law runs on the PID kernel :func:`steerlab.control.pid.pid_update`: the derivative acts
 on ``r_ref - r`` (the error's derivative without the impulse of a set-point step; with a
-rate-limited reference it is the error's derivative exactly), output limited to ``u_max``.
+rate-limited reference it is the error's derivative exactly), output limited to ``u_max``,
+clamping anti-windup on the integral (conditional integration, :mod:`steerlab.control.pid`).
 ``K``, ``T`` come from the ship's Nomoto model at the design speed unless given.
+
+Settings (``gains`` in the config; a value the user gives always wins):
+
+* ``"design"`` (default): ``T01 = max(1/omega_n, turn / (GEAR_USE delta_max K))`` with
+  ``omega_n`` the shared bandwidth rule (:func:`steerlab.control.design_model.bandwidth`): the
+  loop is no faster than the gear can follow, and the first rudder of the reference turn
+  ``kp * 20 deg`` stays within 70 % of the gear's limit. The rule's steady error is removed by
+  a "permanent helm" integral ``ki = kp / (10 T01)`` (Fossen 2011, Sec. 12.2.7: ``omega/10``;
+  not in the paper, whose rule (19) gives ``ki = 0``), with the kernel's clamping anti-windup
+  (the paper has no integrator, hence no anti-windup);
+* ``"paper"``: ``T01 = 20 s``, ``ki = 0`` (steerlab's setting up to now; the paper uses the
+  rule for its berthing ship).
+
+A course-unstable design model (``T < 0``) cannot be designed by this rule: the cancelled ship
+pole ``-1/T > 0`` stays a closed-loop pole. Such a ship is refused in one line naming
+``controller.type`` and the laws that design it (``pid``, ``lq_pd``).
 """
 
 from __future__ import annotations
@@ -35,11 +52,21 @@ from typing import Literal, Optional
 from pydantic import Field
 
 from steerlab.config_base import FrozenConfig
-from steerlab.control.design_model import nomoto_design_model
+import math
+
+from steerlab.control.design_model import DESIGN_TURN, GEAR_USE, bandwidth, design_model
 from steerlab.control.pid import N_STATE, PID, pid_update
+from steerlab.control.pole_placement import INTEGRAL_DIVISOR
 from steerlab.control.registry import ControllerSpec
 from steerlab.control.pid import PARAMS as PID_PARAMS
-from steerlab.errors import require_finite_range
+from steerlab.errors import InputError, require_finite_range
+
+#: ``T01`` [s] of ``gains = "paper"``
+PAPER_T01 = 20.0
+DESIGN_RULE = ("first-order closed-loop gain shaping on the Nomoto heading model (berthing paper 2019, eqs 17-19): "
+               "kp = 1/(K T01), kd = T/(K T01); T01 = max(1/omega_n, 20 deg/(0.7 delta_max K)) from the shared "
+               "bandwidth rule, ki = kp/(10 T01) with clamping anti-windup (gains = 'paper': T01 = 20 s, ki = 0); "
+               "course-unstable ships refused (use pid or lq_pd)")
 
 
 def gain_shaping_gains(T01: float, a2: float, a1: float, a0: float, b0: float) -> tuple[float, float, float]:
@@ -60,16 +87,34 @@ class GainShapingPIDConfig(FrozenConfig):
     """``[controller] type = "gain_shaping_pid"``."""
 
     type: Literal["gain_shaping_pid"]
-    T01: float = Field(20.0, ge=0.1, le=1e5, description="closed-loop time constant of (18) [s], 0.1-1e5 s")
+    gains: Literal["design", "paper"] = Field("design", description="T01, Ki not given: 'design' (shared "
+                                              "bandwidth, integral) or 'paper' (T01 = 20 s, Ki = 0)")
+    T01: Optional[float] = Field(None, ge=0.1, le=1e5, description="closed-loop time constant of (18) [s], 0.1-1e5 s")
+    Ki: Optional[float] = Field(None, ge=0.0, le=1e4, description="integral gain [1/s]; 'design': kp/(10 T01)")
     K: Optional[float] = Field(None, gt=0.0, le=100.0, description="design K [1/s]; default: ship's Nomoto K")
     T: Optional[float] = Field(None, gt=0.0, le=1e5, description="design T [s]; default: ship's Nomoto T")
     u_max_deg: Optional[float] = Field(None, gt=0.0, le=90.0, description="default: gear limit")
     sample_time: Optional[float] = Field(None, gt=0.0, le=60.0, description="default: dt")
 
 
+def design_T01(m) -> float:
+    """``T01 = max(1/omega_n, turn / (GEAR_USE delta_max K))`` [s] (module doc)."""
+    return max(1.0 / bandwidth(m, law="gain_shaping_pid"), DESIGN_TURN / (GEAR_USE * m.delta_max * m.K))
+
+
 def build(cfg: GainShapingPIDConfig, ctx):
-    K, T = nomoto_design_model(cfg.K, cfg.T, ctx)
-    kp, ki, kd = nomoto_gain_shaping_gains(cfg.T01, K, T)
+    m = design_model(ctx, cfg.K, cfg.T)
+    if not (m.T > 0.0 and math.isfinite(m.T)):
+        raise InputError("controller.type", f"gain_shaping_pid cancels the ship pole -1/T, which stays a closed-loop "
+                         f"pole: the design model (K = {m.K:.4g} 1/s, T = {m.T:.4g} s) is not course-stable; use "
+                         f"type = \"pid\" or \"lq_pd\"")
+    paper = cfg.gains == "paper"
+    T01 = cfg.T01 if cfg.T01 is not None else (PAPER_T01 if paper else design_T01(m))
+    kp, ki, kd = nomoto_gain_shaping_gains(T01, m.K, m.T)
+    if cfg.Ki is not None:
+        ki = cfg.Ki
+    elif not paper:
+        ki = kp / (INTEGRAL_DIVISOR * T01)
     c = PID(Kp=kp, Ki=ki, Kd=kd, u_max=ctx.u_max(cfg.u_max_deg))
     return c, c.pack()
 
@@ -78,4 +123,4 @@ CONTROLLER = ControllerSpec(
     name="gain_shaping_pid", description="PID by first-order closed-loop gain shaping (berthing paper eq 17-19)",
     update=pid_update, n_state=N_STATE, config=GainShapingPIDConfig, build=build,
     source="LOS/ADRC automatic berthing paper (2019), Sec. 3.1, eqs (17)-(19)",
-    params=PID_PARAMS)
+    params=PID_PARAMS, design_rule=DESIGN_RULE)

@@ -47,9 +47,10 @@ Implementation (per sample ``h``, radians):
   359 deg -> 1 deg change is a 2 deg turn); its steady state is exactly ``psi_d``;
 * ``delta_c = sat(H1 eps + H2 I + H3 (psi_p' - r))`` with ``eps = wrap_to_pi(psi_p - psi)``
   -- the derivative of the error uses the pre-filter's own rate, so no set-point kick;
-* ``I <- I + eps h``; the paper has no anti-windup (its Fig. 7 shows the resulting
-  overshoot), so by default neither has steerlab; ``anti_windup = true`` adds the clamping
-  rule of :mod:`steerlab.control.pid`.
+* ``I <- I + eps h``, with the clamping anti-windup of :mod:`steerlab.control.pid`
+  (conditional integration: not while the order is limited and ``eps`` drives it further out)
+  unless ``anti_windup = false``. The paper has no anti-windup (its Fig. 7 shows the resulting
+  overshoot): ``gains = "paper"`` keeps it off.
 
 The course-rate limiter of Fig. 9 (1.2 deg/s in Fig. 8) sits on the desired course before
 the pre-filter. steerlab's guidance already produces exactly that signal: with
@@ -57,16 +58,26 @@ the pre-filter. steerlab's guidance already produces exactly that signal: with
 course, which is what a rate limiter does to a step of the desired course, so the limiter is
 not duplicated here. The controller ignores ``r_ref`` (the pre-filter makes its own rate).
 
-The design ignores the steering gear's rate limit: a fast ``t_r`` on a slow ship needs a large
-``H3``, and a large turn can then rate-limit the rudder into a growing oscillation (e.g.
-``nomoto1`` K = 0.1, T = 50 s, t_r = 53 s, 2.33 deg/s gear, 30 deg turn; t_r = 100 s is fine).
+Settings (``gains`` in the config; a value the user gives always wins):
 
-Requires ``k > 0``, ``T > 0`` and ``t_r < 8.75 T`` (``H3 > 0``; otherwise the pre-filter
-(11) has a negative leading coefficient and is unstable).
+* ``"design"`` (default): ``omega_0`` is the shared bandwidth rule
+  (:func:`steerlab.control.design_model.bandwidth`, capped by the gear's limit, rate and servo
+  lag), i.e. ``t_r = 5 / omega_n``, raised where needed to ``omega_0 >= 1.2 / (1.75 T)`` so
+  that ``H3 > 0``; anti-windup on. The paper's fixed settling time ignores the gear: a fast
+  ``t_r`` on a ship that answers its rudder slowly asks for more rudder and rate than the gear
+  has, and without anti-windup the integral then winds up until the ship spins (before this
+  rule: 7 catalogue ships with ``t_r = 53 s``);
+* ``"paper"``: ``t_r = 53 s`` (the paper's Fig. 7-8 case), no anti-windup.
+
+The pole placement (10) holds for either sign of ``k``, ``T`` (the same one): for a
+course-unstable model (``T < 0``, ``k < 0``) ``H1``, ``H2``, ``H3`` are all positive and the
+whole loop is still ``w0^3 / M(s)``. For ``T > 0`` it requires ``t_r < 8.75 T`` (``H3 > 0``;
+otherwise the pre-filter (11) has a negative leading coefficient and is unstable).
 """
 
 from __future__ import annotations
 
+import math
 from typing import Literal, NamedTuple, Optional
 
 import numba
@@ -75,7 +86,7 @@ from pydantic import Field, create_model
 
 from steerlab.angles import wrap_to_pi
 from steerlab.config_base import FrozenConfig
-from steerlab.control.design_model import nomoto_design_model
+from steerlab.control.design_model import bandwidth, design_model
 from steerlab.control.registry import ControllerSpec
 from steerlab.errors import InputError, require_finite_range
 from steerlab.records import Field as RecordField
@@ -90,8 +101,8 @@ POLYNOMIALS = {"dorf": 2.15, "eq6": 1.0}
 
 PARAMS = Layout("controller", "I_", [
     RecordField("WN", "omega_0", "rad/s", "ITAE natural frequency omega_0 = 5 / t_r, eq (8)", lo=0.0, lo_open=True),
-    RecordField("KM", "k_m", "1/s", "Nomoto gain at the design speed, eq (1)-(2)", lo=0.0, lo_open=True),
-    RecordField("TM", "T_m", "s", "Nomoto time constant at the design speed, eq (1)-(2)", lo=0.0, lo_open=True),
+    RecordField("KM", "k_m", "1/s", "Nomoto gain at the design speed, eq (1)-(2); < 0 with T_m < 0"),
+    RecordField("TM", "T_m", "s", "Nomoto time constant at the design speed, eq (1)-(2); < 0: course-unstable"),
     RecordField("VM", "V_m", "m/s", "design speed V_m of the scheduling, eq (2)", lo=0.0, lo_open=True),
     RecordField("SCHED", "schedule", "-", "1: schedule k, T on the surge speed x[3] by eq (2)", lo=0.0, hi=1.0),
     RecordField("VMIN", "v_min_fraction", "-", "scheduling speed floor, fraction of V_m", lo=0.0, hi=1.0,
@@ -115,11 +126,13 @@ def itae_gains(t_r: float, k: float, T: float, polynomial: str = "dorf") -> tupl
     """PID coefficients ``(H1 [rad/rad], H2 [1/s], H3 [s])`` of eq (10) for ``omega_0 = 5/t_r``.
 
     ``polynomial``: ``"dorf"`` (``c2 = 2.15``, eq 10-11 as printed) or ``"eq6"`` (``c2 = 1``,
-    eq 6 as printed). Raises :class:`InputError` where the design is not possible.
+    eq 6 as printed). ``k``, ``T`` of either sign, the same one. Raises :class:`InputError` where the design is not possible.
     """
     require_finite_range("controller.t_r", t_r, 0.0, lo_open=True)
-    require_finite_range("controller.K", k, 0.0, lo_open=True)
-    require_finite_range("controller.T", T, 0.0, lo_open=True)
+    require_finite_range("controller.K", k)
+    require_finite_range("controller.T", T)
+    if k == 0.0 or T == 0.0 or k / T < 0.0:
+        raise InputError("controller.K", f"k = {k:g} 1/s and T = {T:g} s must be non-zero with one sign")
     if polynomial not in POLYNOMIALS:
         raise InputError("controller.polynomial", f"must be one of {sorted(POLYNOMIALS)}, got {polynomial!r}")
     w0 = 5.0 / t_r
@@ -211,27 +224,53 @@ ItaePIDConfig = create_model(
     "ItaePIDConfig", __base__=FrozenConfig,
     __doc__='``[controller] type = "itae_pid"`` (degrees and knots only at this edge).',
     type=(Literal["itae_pid"], ...),
-    t_r=(float, Field(53.0, ge=1.0, le=1e5, description="2 % settling time [s], 1-1e5 s (paper: 38, 48, 53 s)")),
-    K=(Optional[float], Field(None, gt=0.0, le=100.0, description="design k_m [1/s]; default: ship's Nomoto K")),
-    T=(Optional[float], Field(None, gt=0.0, le=1e5, description="design T_m [s]; default: ship's Nomoto T")),
+    gains=(Literal["design", "paper"], Field("design", description="t_r, anti_windup not given: 'design' (shared "
+                                             "bandwidth, anti-windup) or 'paper' (t_r = 53 s, none)")),
+    t_r=(Optional[float], Field(None, ge=1.0, le=1e5, description="2 % settling time [s], 1-1e5 s "
+                                                                  "(paper: 38, 48, 53 s)")),
+    K=(Optional[float], Field(None, ge=-100.0, le=100.0, description="design k_m [1/s]; default: ship's Nomoto K")),
+    T=(Optional[float], Field(None, ge=-1e5, le=1e5, description="design T_m [s] (< 0: course-unstable); "
+                                                                "default: ship's Nomoto T")),
     design_speed_kn=(Optional[float], Field(None, ge=0.01, le=40.0,
                                             description="V_m of eq (2) [kn]; default: ship.speed_kn")),
     schedule=(bool, True),
     **PARAMS.config_fields(("v_min_fraction",)),
     polynomial=(Literal["dorf", "eq6"], "dorf"),
-    anti_windup=(bool, False),
+    anti_windup=(Optional[bool], Field(None, description="clamping anti-windup; 'design': on, 'paper': off")),
     u_max_deg=(Optional[float], Field(None, gt=0.0, le=90.0, description="default: gear limit")),
     sample_time=(Optional[float], Field(None, gt=0.0, le=60.0, description="default: dt")))
 ItaePIDConfig.__module__ = __name__
 
+#: the settings of ``gains = "paper"`` (Fig. 7-8: t_r = 53 s; the paper has no anti-windup)
+PAPER_T_R = 53.0
+#: ``omega_0 >= H3_MARGIN / (1.75 T)`` for a course-stable model (``H3 > 0`` with a margin)
+H3_MARGIN = 1.2
+DESIGN_RULE = ("ITAE pole placement on the first-order Nomoto model with a set-point pre-filter (Morawski & "
+               "Pomirski, eqs 6-11): H1 = 2.15 w0^2 T/k, H2 = w0^3 T/k, H3 = (1.75 w0 T - 1)/k; w0 = 5/t_r from the "
+               "shared bandwidth rule (>= 1.2/(1.75 T)), clamping anti-windup (gains = 'paper': t_r = 53 s, none)")
+
+
+def design_t_r(m) -> float:
+    """``t_r = 5 / omega_0`` [s], ``omega_0`` the shared bandwidth (>= ``H3_MARGIN / (1.75 T)`` for ``T > 0``)."""
+    w = bandwidth(m, law="itae_pid")
+    if m.T > 0.0:
+        w = max(w, H3_MARGIN / (ITAE_C1 * m.T))
+    return 5.0 / w
+
 
 def build(cfg: ItaePIDConfig, ctx):
     """k_m, T_m from the ship's Nomoto model at the design speed unless given."""
-    K, T = nomoto_design_model(cfg.K, cfg.T, ctx)
+    m = design_model(ctx, cfg.K, cfg.T)
+    if not math.isfinite(m.T):
+        raise InputError("controller.T", f"the ITAE design needs a finite Nomoto T; the ship gives K = {m.K:.4g}, "
+                         f"T = {m.T:.4g} (neutrally stable): give K and T, or use type = \"pid\" or \"lq_pd\"")
+    paper = cfg.gains == "paper"
+    t_r = cfg.t_r if cfg.t_r is not None else (PAPER_T_R if paper else design_t_r(m))
+    aw = cfg.anti_windup if cfg.anti_windup is not None else not paper
     Vm = knots_to_ms(cfg.design_speed_kn) if cfg.design_speed_kn is not None else ctx.speed
-    c = ItaePID(t_r=cfg.t_r, k_m=K, T_m=T, V_m=Vm, schedule=cfg.schedule,
+    c = ItaePID(t_r=t_r, k_m=m.K, T_m=m.T, V_m=Vm, schedule=cfg.schedule,
                 v_min_fraction=cfg.v_min_fraction, polynomial=cfg.polynomial,
-                u_max=ctx.u_max(cfg.u_max_deg), anti_windup=cfg.anti_windup)
+                u_max=ctx.u_max(cfg.u_max_deg), anti_windup=aw)
     return c, c.pack()
 
 
@@ -240,4 +279,4 @@ CONTROLLER = ControllerSpec(
     description="ITAE-robust PID with set-point pre-filter and speed scheduling (Morawski & Pomirski)",
     update=itae_pid_update, n_state=N_STATE, config=ItaePIDConfig, build=build,
     source="Morawski & Pomirski, robust PID course-keeping, eqs (2), (6)-(11), Fig. 9",
-    params=PARAMS)
+    params=PARAMS, design_rule=DESIGN_RULE)

@@ -8,8 +8,24 @@ Control law (discrete, sample time h)::
                               (conditional integration / clamping anti-windup)
 
 The derivative acts on the measured yaw rate, not on the error, so a set-point step does not
-kick the rudder. Units: Kp [rad/rad], Ki [1/s], Kd [s]. Zwierzewicz et al. (2021), Section 7
-compare their ADRC with Kp = 3.81, Kd = 3.95, Ki = 0.00547.
+kick the rudder. Units: Kp [rad/rad], Ki [1/s], Kd [s].
+
+Anti-windup: conditional integration (clamping). The integral advances only while the order is
+inside the limit, or while the error drives the order back inside; it keeps its value (the
+"permanent helm") otherwise.
+
+Gains (``gains`` in the config; a gain the user gives always wins):
+
+* ``"design"`` (default): pole placement on the first-order Nomoto design model
+  (Fossen 2011, Sec. 12.2.7; :mod:`steerlab.control.pole_placement`)::
+
+      Kp = omega_n^2 / b,   Kd = (2 zeta omega_n - a) / b,   Ki = Kp omega_n / 10
+
+  with ``a = 1/T``, ``b = K/T`` of the ship at the design speed (or ``nomoto=(K, T)``, either
+  sign), ``zeta = 0.9`` and ``omega_n`` the shared bandwidth rule
+  (:func:`steerlab.control.design_model.bandwidth`, capped by the gear);
+* ``"paper"``: Zwierzewicz et al. (2021), Section 7, who compare their ADRC with
+  ``Kp = 3.81``, ``Kd = 3.95 s``, ``Ki = 0.00547 1/s`` (the Esso tanker at 16 kn).
 """
 
 from __future__ import annotations
@@ -22,6 +38,7 @@ from pydantic import Field, create_model
 
 from steerlab.angles import wrap_to_pi
 from steerlab.config_base import FrozenConfig
+from steerlab.control.pole_placement import fill_gains, pid_pole_placement
 from steerlab.control.registry import ControllerSpec
 from steerlab.records import Field as RecordField
 from steerlab.records import Layout
@@ -72,19 +89,38 @@ def pid_update(z, p, t, x, ref, h):
 PIDConfig = create_model(
     "PIDConfig", __base__=FrozenConfig, __doc__='``[controller] type = "pid"`` in a scenario (degrees only at this edge).',
     type=(Literal["pid"], ...),
-    **PARAMS.config_fields(("Kp", "Ki", "Kd"), upper={"Kp": 1e4, "Ki": 1e4, "Kd": 1e5}),
+    gains=(Literal["design", "paper"], Field("design", description="gains not given: 'design' (pole placement "
+                                             "on the Nomoto model) or 'paper' (Zwierzewicz et al. 2021)")),
+    **PARAMS.config_fields(("Kp", "Ki", "Kd"), upper={"Kp": 1e4, "Ki": 1e4, "Kd": 1e5}, optional=True),
     u_max_deg=(Optional[float], Field(None, gt=0.0, le=90.0, description="[deg] default: gear limit")),
     sample_time=(Optional[float], Field(None, gt=0.0, le=60.0, description="[s] default: dt")))
 PIDConfig.__module__ = __name__
 
 
+#: the gains of ``gains = "paper"`` (Zwierzewicz et al. 2021, Sec. 7)
+PAPER_GAINS = {n: PARAMS.fields[PARAMS.index(n)].default for n in ("Kp", "Ki", "Kd")}
+DESIGN_RULE = ("pole placement on the first-order Nomoto model (Fossen 2011, Sec. 12.2.7): Kp = omega_n^2/b, "
+               "Kd = (2 zeta omega_n - a)/b, Ki = Kp omega_n/10, a = 1/T, b = K/T, zeta = 0.9, omega_n from the "
+               "shared bandwidth rule; gains = 'paper': Zwierzewicz et al. (2021) Sec. 7")
+
+
+def designed_gains(ctx, law: str = "pid") -> dict:
+    """``{"Kp", "Ki", "Kd"}`` of the pole-placement rule for the design model of ``ctx``."""
+    from steerlab.control.design_model import design_model
+
+    d = pid_pole_placement(design_model(ctx), law=law)
+    return {"Kp": d.Kp, "Ki": d.Ki, "Kd": d.Kd}
+
+
 def build(cfg: PIDConfig, ctx):
-    c = PID(Kp=cfg.Kp, Ki=cfg.Ki, Kd=cfg.Kd, u_max=ctx.u_max(cfg.u_max_deg))
+    g = fill_gains({"Kp": cfg.Kp, "Ki": cfg.Ki, "Kd": cfg.Kd}, cfg.gains, PAPER_GAINS,
+                   lambda: designed_gains(ctx))
+    c = PID(Kp=g["Kp"], Ki=g["Ki"], Kd=g["Kd"], u_max=ctx.u_max(cfg.u_max_deg))
     return c, c.pack()
 
 
 CONTROLLER = ControllerSpec(
     name="pid", description="PID, derivative on measured yaw rate, clamping anti-windup",
     update=pid_update, n_state=N_STATE, config=PIDConfig, build=build,
-    source="Zwierzewicz et al. (2021) Sec. 7 (gains); classic heading PID",
-    params=PARAMS)
+    source="Fossen (2011) Sec. 12.2.7 (pole placement); Zwierzewicz et al. (2021) Sec. 7 (paper gains)",
+    params=PARAMS, design_rule=DESIGN_RULE)

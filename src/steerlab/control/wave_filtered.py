@@ -193,7 +193,7 @@ def wave_filtered(spec: ControllerSpec) -> ControllerSpec:
     return ControllerSpec(
         name=name, description=f"{spec.description}, behind the noise-adaptive wave filter",
         update=kernel, n_state=OFF_Z + spec.n_state, config=cfg_cls, build=build,
-        source=f"{spec.source}; wave filter: van Amerongen (1982) Fig. 4.13-4.14",
+        source=f"{spec.source}; wave filter: van Amerongen (1982) Fig. 4.13-4.14", design_rule=spec.design_rule,
         params=None if spec.params is None else wave_filtered_layout(spec.params),
         recipe=(wave_filtered, (spec,)))
 

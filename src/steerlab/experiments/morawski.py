@@ -100,7 +100,7 @@ def _require_ship():
 
 def controller_config(t_r: float = T_R) -> dict:
     """The paper's controller: ITAE PID designed for the nominal k_m, T_m (no anti-windup)."""
-    return {"type": "itae_pid", "t_r": float(t_r), "K": K_M, "T": T_M, "polynomial": "dorf"}
+    return {"type": "itae_pid", "gains": "paper", "t_r": float(t_r), "K": K_M, "T": T_M, "polynomial": "dorf"}
 
 
 def scenario(step_deg: float, horizon: float, dt: float, rate_deg_s: float, T_sg: float,

@@ -93,7 +93,8 @@ def _scenario(gain: str, filt: bool, duration: float):
     from steerlab.sim.setup import build
 
     ship = _ship()
-    probe = build(scenario_from_dict({"ship": ship, "controller": {"type": "pid"}, "duration": 1.0}))
+    probe = build(scenario_from_dict({"ship": ship, "controller": {"type": "pid", "gains": "paper"},
+                                        "duration": 1.0}))
     U = ship["speed_kn"] * 1852.0 / 3600.0
     K, T = probe.ship.nomoto(U, probe.ship.options(ship.get("options")))
     kp = KP[gain]

@@ -78,7 +78,7 @@ def _scenario(task, ship, speed_kn, gear, environment, ship_options, dt, episode
     if ship_options:
         ship_d["options"] = dict(ship_options)
     d = {"name": f"gym-{task}", "seed": 0, "dt": dt, "duration": episode_s, "ship": ship_d,
-         "gear": dict(gear or {}), "controller": {"type": "pid"}, "guidance": g,
+         "gear": dict(gear or {}), "controller": {"type": "pid", "gains": "paper"}, "guidance": g,
          "environment": {"waves": True} if environment is None else dict(environment)}
     return scenario_from_dict(d)
 

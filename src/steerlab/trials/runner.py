@@ -90,7 +90,7 @@ def _scenario(cond: TrialConditions, duration: float):
         "name": f"trial-{cond.ship}", "seed": 0, "dt": cond.dt, "duration": duration,
         "ship": {"model": cond.ship, "speed_kn": cond.speed_kn, "options": dict(cond.options)},
         "gear": dict(cond.gear_config),
-        "controller": {"type": "pid"},        # placeholder, replaced by the manoeuvre program
+        "controller": {"type": "pid", "gains": "paper"},        # placeholder, replaced by the manoeuvre program
         "guidance": {"psi0_deg": 0.0, "changes": []},
         "environment": {},
     })
