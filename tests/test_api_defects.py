@@ -128,7 +128,8 @@ def test_linearize_command_defaults_to_the_design_speed(capsys):
 
 
 def test_controller_for_a_ship_without_speed_uses_the_design_speed():
-    assert sl.controller("pid", ship="kosoko").speed == pytest.approx(0.5)
+    # the paper's fixed gains: a designed pid refuses Kosoko's default gear (gear.rate_max)
+    assert sl.controller("pid", ship="kosoko", gains="paper").speed == pytest.approx(0.5)
     assert sl.controller("pid", ship="esso").speed == knots_to_ms(16.0)
     with pytest.raises(InputError, match="speed_kn"):
         sl.controller("pid", ship="kosoko", speed_kn=16.0)        # outside its validity range

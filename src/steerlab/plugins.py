@@ -73,7 +73,7 @@ def load_module(ref: str) -> ModuleType:
         if spec is None or spec.loader is None:
             raise InputError(PLUGINS_ENV, f"cannot load {str(path)!r} as a Python module")
         module = importlib.util.module_from_spec(spec)
-        module.__steerlab_plugin__ = True     # another plug-in file of the same name may replace it
+        setattr(module, "__steerlab_plugin__", True)   # another plug-in file of the same name may replace it
         sys.modules[name] = module
         try:
             spec.loader.exec_module(module)

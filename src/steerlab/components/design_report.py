@@ -21,7 +21,7 @@ show (docs/design-report.md):
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any, Optional
 
 import numpy as np
 
@@ -52,7 +52,7 @@ def _second_order(ctx) -> dict:
         return nan
 
 
-def model_section(ctrl: Controller) -> tuple[object, dict]:
+def model_section(ctrl: Controller) -> tuple[Any, dict]:
     """``(DesignModel or None, JSON-able dict)`` of the controller's design context."""
     from steerlab.control.design_model import bandwidth, design_model
 
@@ -77,7 +77,7 @@ def model_section(ctrl: Controller) -> tuple[object, dict]:
 
 def gains_section(ctrl: Controller) -> list[dict]:
     """The packed parameter record by field name: ``{"name", "value", "unit", "doc"}`` each."""
-    layout = ctrl.spec.params
+    layout: Any = ctrl.spec.params
     p = ctrl.params
     if layout is None or getattr(layout, "size", None) != p.shape[0]:
         return [{"name": f"p[{i}]", "value": float(v), "unit": "", "doc": ""} for i, v in enumerate(p)]
@@ -95,15 +95,14 @@ def design_report(ctrl: Controller) -> dict:
     from steerlab.components.loop_analysis import FLOORS, loop_margins
 
     m, model = model_section(ctrl)
-    out = {"controller": ctrl.type, "description": ctrl.spec.description, "source": ctrl.spec.source,
+    out: dict[str, Any] = {"controller": ctrl.type, "description": ctrl.spec.description, "source": ctrl.spec.source,
            "sample_time": ctrl.sample_time, "design_model": model,
            "design_rule": ctrl.spec.design_rule or NO_RULE, "gains": gains_section(ctrl)}
     if m is None:
         out["loop"] = {"available": False, "reason": "no design model: " + model["reason"]}
     else:
-        second = {k: model[k] for k in ("T1", "T2", "T3")}
-        if not all(math.isfinite(v) and v != 0.0 for v in second.values()):
-            second = None
+        reading = {k: model[k] for k in ("T1", "T2", "T3")}
+        second: Optional[dict] = reading if all(math.isfinite(v) and v != 0.0 for v in reading.values()) else None
         try:
             loop = loop_margins(ctrl, m, second)
             loop["available"] = True

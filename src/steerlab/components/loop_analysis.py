@@ -334,7 +334,7 @@ def loop_margins(ctrl: Controller, m: DesignModel, second: Optional[dict] = None
     return out
 
 
-def discrete_bandwidth(sys, dbdrop: float = -3.0) -> float:
+def discrete_bandwidth(sys: Any, dbdrop: float = -3.0) -> float:
     """The first frequency [rad/s] where a stable discrete SISO system's gain is ``dbdrop`` dB
     under its dc gain, as ``control.bandwidth`` defines it (``inf``: it never drops below
     Nyquist; ``nan``: no finite dc gain). ``control.bandwidth`` itself (0.10.2) evaluates a

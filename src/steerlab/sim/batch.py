@@ -31,7 +31,7 @@ keeps a decimated log. Every run is independent and deterministic, so splitting 
 from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
-from typing import TYPE_CHECKING, Any, Callable, Iterable, Optional
+from typing import TYPE_CHECKING, Any, Callable, Iterable, Optional, Sequence
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -256,7 +256,7 @@ class PackedBatch:
         return BatchResult(acc, X, np.arange(n_rec) * rec * self.dt, out_x, out_cmd, out_ref, self.state_names)
 
 
-def simulate_batch(setups: "list[SimSetup | Scenario]", record_every: int | None = None, lanes: int = LANES,
+def simulate_batch(setups: "Sequence[SimSetup | Scenario]", record_every: int | None = None, lanes: int = LANES,
                    progress: Optional[Callable[[int, int], None]] = None) -> BatchResult:
     """Run every setup with the compiled engine, in parallel over the available cores.
 
