@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import copy
 import os
-import time
 from pathlib import Path
 
 import pytest
@@ -167,20 +166,13 @@ def pytest_configure(config):
         signal.signal(signal.SIGINT, signal.default_int_handler)
 
 
-# ------------------------------------------- a worker of their own for the wall-clock tests
+# ---------------------------------------------------- the real-time tests, on one worker
 REALTIME_MODULES = ("tests/test_runtime_*.py", "tests/test_signalk_plugin.py")
 """The tests of the real-time link (ship server and autopilot over loopback sockets, the browser
 bridge, the Signal K server): they wait on the wall clock. They are marked ``realtime``
-(``-m "not realtime"`` leaves them out) and, under ``-n auto``, run on a worker of their own
-beside one per core (``tests/xdist_lanes.py``)."""
-
-#: ``STEERLAB_TEST_LANES=0``: pytest-xdist's own ``-n auto`` and ``load`` scheduling instead
-#: (one worker per core, every test anywhere; ``benchmarks/bench_test_lanes.py`` compares them)
-LANES = os.environ.get("STEERLAB_TEST_LANES", "1") != "0"
-
-#: the CPU niceness of a pytest-xdist worker while it runs a compute test (not ``realtime``):
-#: when a real-time test's processes wake they get a core at once
-COMPUTE_NICENESS = 10
+(``-m "not realtime"`` leaves them out) and ``xdist_group("realtime")``: under pytest-xdist's
+``--dist loadgroup`` (``pyproject.toml``) they run one after another on one worker, never two
+sets of real-time processes at once, while the other worker runs the rest."""
 
 
 def is_realtime(nodeid: str) -> bool:
@@ -191,139 +183,12 @@ def is_realtime(nodeid: str) -> bool:
     return any(fnmatch(module, pattern) for pattern in REALTIME_MODULES)
 
 
-def lanes_wanted(config) -> bool:
-    """Whether this run gets the real-time lane: ``STEERLAB_TEST_LANES`` is not ``0`` and the
-    paths given to pytest may hold real-time tests (none given: the ``testpaths``; a folder; one
-    of :data:`REALTIME_MODULES`). ``pytest tests/test_asa.py`` keeps one worker per core."""
-    if not LANES:
-        return False
-    root = Path(str(config.rootpath)).resolve()
-    for arg in config.args or config.getini("testpaths") or ["."]:
-        path = Path(arg.split("::", 1)[0])
-        if not path.is_absolute():
-            path = Path(str(config.invocation_params.dir)) / path
-        if path.is_dir():
-            return True
-        try:
-            if is_realtime(path.resolve().relative_to(root).as_posix()):
-                return True
-        except ValueError:
-            continue
-    return False
-
-
+@pytest.hookimpl(tryfirst=True)      # before pytest-xdist's worker reads the xdist_group marks
 def pytest_collection_modifyitems(config, items):
     for item in items:
         if is_realtime(item.nodeid):
             item.add_marker(pytest.mark.realtime)
-
-
-@pytest.hookimpl(optionalhook=True)
-def pytest_xdist_auto_num_workers(config):
-    from xdist_lanes import auto_workers
-
-    return auto_workers(config) if lanes_wanted(config) else None
-
-
-@pytest.hookimpl(optionalhook=True)
-def pytest_xdist_make_scheduler(config, log):
-    if config.getvalue("dist") != "load" or not lanes_wanted(config):
-        return None                   # the user chose another distribution, or no lane is needed
-    from xdist.workermanage import parse_tx_spec_config
-    from xdist_lanes import LaneScheduling
-
-    return LaneScheduling(len(parse_tx_spec_config(config)), is_realtime, log.lanesched)
-
-
-@pytest.hookimpl(optionalhook=True)
-def pytest_configure_node(node):
-    """Tells each pytest-xdist worker whether the lanes scheduler runs (the workers' own
-    options do not say which distribution the controller uses)."""
-    node.workerinput["steerlab_lanes"] = node.config.getvalue("dist") == "load" and lanes_wanted(node.config)
-
-
-def under_lanes(config) -> bool:
-    """True in a pytest-xdist worker of a run scheduled by ``tests/xdist_lanes.py``."""
-    return bool(getattr(config, "workerinput", {}).get("steerlab_lanes"))
-
-
-@pytest.hookimpl(tryfirst=True)
-def pytest_runtest_setup(item):
-    """Under the lanes scheduler, a worker runs compute tests at a lower CPU priority
-    (:data:`COMPUTE_NICENESS`) than the real-time tests (see :data:`REALTIME_MODULES`). The
-    priority only goes down: a worker that has run a compute test stays at it."""
-    if not under_lanes(item.config) or not hasattr(os, "nice") or item.get_closest_marker("realtime"):
-        return
-    now = os.getpriority(os.PRIO_PROCESS, 0)
-    if now < COMPUTE_NICENESS:
-        os.nice(COMPUTE_NICENESS - now)
-
-
-# ---------------------------------------------------------------- test times, as they finish
-def pytest_runtest_logreport(report):
-    """With ``STEERLAB_TEST_TIMES=FILE``, append ``seconds phase nodeid`` for every test phase
-    as it finishes (all workers append to the same file): where the suite's time goes, readable
-    while it runs (``sort -rn FILE | head``)."""
-    path = os.environ.get("STEERLAB_TEST_TIMES")
-    # under pytest-xdist the controller gets every worker's reports: write there only
-    if path and report.duration >= 0.05 and not os.environ.get("PYTEST_XDIST_WORKER"):
-        with open(path, "a", encoding="utf-8") as f:
-            f.write(f"{report.duration:.2f} {report.when} {report.nodeid}\n")
-
-
-def _cpu_seconds() -> float:
-    """User + system CPU of this process and of its waited-for children [s]."""
-    import resource
-
-    own, kids = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(resource.RUSAGE_CHILDREN)
-    return own.ru_utime + own.ru_stime + kids.ru_utime + kids.ru_stime
-
-
-@pytest.hookimpl(hookwrapper=True)
-def pytest_runtest_protocol(item, nextitem):
-    """With ``STEERLAB_TEST_CPU=FILE``, append ``cpu_s wall_s nodeid`` for every test (setup,
-    call and teardown together; CPU of the worker and the subprocesses it waited for): which
-    tests use the cores and which wait (sockets, sleeps, other processes' locks)."""
-    path = os.environ.get("STEERLAB_TEST_CPU")
-    if not path or os.name != "posix":
-        yield
-        return
-    c0, t0 = _cpu_seconds(), time.perf_counter()
-    yield
-    cpu, wall = _cpu_seconds() - c0, time.perf_counter() - t0
-    if wall >= 0.05:
-        with open(path, "a", encoding="utf-8") as f:
-            f.write(f"{cpu:.2f} {wall:.2f} {item.nodeid}\n")
-
-
-# ------------------------------------------------------------- compiles, test by test
-class _CompileLog:
-    """numba ``numba:compile`` listener for ``STEERLAB_TEST_COMPILES=FILE``: appends ``seconds
-    worker nodeid function`` for every function numba compiles (not a disk-cache load) while a
-    test runs, so that a suite's compile time can be traced to its tests and combinations
-    compiled by both workers can be found (``sort -k4 FILE``)."""
-
-    def __init__(self, path: str):
-        import numba.core.event as ev
-
-        class Listener(ev.Listener):
-            def on_start(inner, event):
-                inner.t0 = time.perf_counter()
-
-            def on_end(inner, event):
-                disp = event.data.get("dispatcher")
-                name = getattr(getattr(disp, "py_func", None), "__qualname__", "?")
-                module = getattr(getattr(disp, "py_func", None), "__module__", "?")
-                with open(path, "a", encoding="utf-8") as f:
-                    f.write(f"{time.perf_counter() - inner.t0:.2f} {os.environ.get('PYTEST_XDIST_WORKER', '-')} "
-                            f"{os.environ.get('PYTEST_CURRENT_TEST', '-').split(' ')[0]} {module}.{name}\n")
-
-        self.listener = Listener()
-        ev.register("numba:compile", self.listener)
-
-
-if os.environ.get("STEERLAB_TEST_COMPILES"):
-    _COMPILE_LOG = _CompileLog(os.environ["STEERLAB_TEST_COMPILES"])
+            item.add_marker(pytest.mark.xdist_group("realtime"))
 
 
 # ------------------------------------------------- one expensive result for every worker

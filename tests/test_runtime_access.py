@@ -197,6 +197,9 @@ class _Ap:
     def clock(self):
         return 0.0
 
+    def course_refusal(self, t):                  # no route, no chart plotter: a course is applied
+        return None
+
     def adjust(self, d, t):
         self.calls += 1
 

@@ -142,7 +142,10 @@ def test_spoofed_nmea_heading_does_not_move_the_rudder_of_a_signed_link(controll
     rows = [r for r in _read_log(log) if r["t"] > 3.0 and r["link_ok"]]
     ap = ctx["ap"]
     true_psi = math.degrees(ctx["server"].state().psi)              # the ship's own heading at the end
-    assert len(rows) > 20 and ap.nmea_counts["accepted"] > 50     # the spoofed lines arrived and parsed
+    # the spoofed lines arrived and parsed; one is enough, as a line stays fresh for the rest of
+    # the session (nmea_timeout 20 s): how many arrive depends on how busy the machine is
+    assert len(rows) >= 5 and ap.nmea_counts["accepted"] >= 1
+    assert ap.nmea_heading is not None and math.degrees(ap.nmea_heading[0]) == pytest.approx(90.0)
     if not over:    # default: the signed state steers; course kept, rudder near midships (waves only)
         assert all(r["heading_source"] == "state" for r in rows)
         assert max(abs(r["psi_deg"]) for r in rows) < 2.0 and abs(true_psi) < 2.0

@@ -122,6 +122,23 @@ def test_autopilot_put_paths_and_values():
     assert len(calls) == n                                               # refused PUTs change nothing
 
 
+def test_a_heading_put_the_autopilot_would_not_apply_is_refused_409():
+    calls = []
+
+    class Following:
+        def course_refusal(self, t):
+            calls.append(("course_refusal", t))
+            return "following a route (--route): the route is the only course source; target not applied"
+
+        def __getattr__(self, name):
+            return lambda *a: calls.append((name, *a))
+
+    code, text = autopilot_put(Following(), TARGET_HEADING, 0.5, 2.0)
+    assert code == 409 and "--route" in text and calls == [("course_refusal", 2.0)]     # not set
+    assert autopilot_put(Following(), TARGET_HEADING, 7.0, 2.0)[0] == 400               # a bad value first
+    assert autopilot_put(Following(), AUTOPILOT_STATE, "standby", 3.0) == (200, "")    # the state still is
+
+
 def test_signalk_ws_non_loopback_needs_allow_remote(capsys):
     assert main(["serve-ship", "--signalk-ws", "0.0.0.0:3000"]) == 2
     err = capsys.readouterr().err.strip().splitlines()
@@ -129,15 +146,17 @@ def test_signalk_ws_non_loopback_needs_allow_remote(capsys):
 
 
 # ------------------------------------------------------------------ end to end
-async def _with_streams(controller, client):
+async def _with_streams(controller, client, ap_cfg=None, **ap_kw):
+    """Ship server and autopilot (``ap_cfg``, ``ap_kw``: its config and more of its arguments),
+    each with its Signal K stream, while ``client(server, ap)`` runs."""
     server = ShipServer(scenario_from_dict(SCENARIO), ShipServerConfig(speedup=SPEEDUP), signalk_ws=("127.0.0.1", 0))
     srv = asyncio.create_task(server.run())
     while server.signalk_stream is None or server.signalk_stream.server is None:
         await asyncio.sleep(0.001)
         if srv.done():
             srv.result()
-    ap = Autopilot(controller, server.address, AutopilotConfig(speedup=SPEEDUP, watchdog_timeout=3.0),
-                   heading=0.0, signalk_ws=("127.0.0.1", 0))
+    ap = Autopilot(controller, server.address, ap_cfg or AutopilotConfig(speedup=SPEEDUP, watchdog_timeout=3.0),
+                   **{"heading": 0.0, **ap_kw}, signalk_ws=("127.0.0.1", 0))
     apt = asyncio.create_task(ap.run())
     while ap._t0 is None:
         await asyncio.sleep(0.001)
@@ -234,6 +253,114 @@ def test_ship_and_autopilot_signalk_streams(controller):  # noqa: F811
         out["ok"] = True
 
     asyncio.run(_with_streams(controller, client))
+    assert out.get("ok")
+
+
+def _udp_socket():
+    import socket
+
+    sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+    sock.bind(("127.0.0.1", 0))
+    sock.setblocking(False)
+    return sock
+
+
+async def _wait_until(check, what, limit_s=30.0):
+    """Poll ``check()`` until it holds (a hang guard of ``limit_s`` wall seconds, not a timing test)."""
+    end = asyncio.get_running_loop().time() + limit_s
+    while not check():
+        assert asyncio.get_running_loop().time() < end, what
+        await asyncio.sleep(0.005)
+
+
+def test_heading_put_while_following_a_route_is_refused_409(controller, tmp_path):  # noqa: F811
+    """With ``--route`` the route is the only course source: a Signal K heading PUT on the
+    autopilot's stream is answered 409 with the reason (it was answered 200 and ignored), the
+    set course stays the route's; a target sent over UDP (the plug-in's link) is counted
+    ``not_applied``, and the status deltas to ``--signalk-to`` carry the reason the plug-in
+    answers with. The state PUT still works."""
+    from steerlab.runtime.route import route_guidance
+    from steerlab.runtime.signalk import TARGET_REFUSED, parse_delta
+
+    route_file = tmp_path / "route.csv"
+    route_file.write_text("x_n,y_e\n0,0\n2000,0\n")
+    plan = route_guidance(scenario_from_dict(SCENARIO), controller.setup.ship, controller.setup.ps,
+                          route_file, lookahead_L=1.0)
+    status, listen = _udp_socket(), _udp_socket()
+    listen_addr = listen.getsockname()
+    listen.close()                                          # a free port for --signalk-listen
+    out = {}
+
+    async def client(server, ap):
+        await _wait_until(lambda: ap.samples > 2 and ap.course_source == "route", "the route never steered")
+        host, port = ap.signalk_stream.address
+        async with connect(f"ws://{host}:{port}/signalk/v1/stream?subscribe=none") as ws:
+            await ws.recv()
+            await ws.send(json.dumps({"context": "vessels.self", "requestId": "r1",
+                                      "put": {"path": TARGET_HEADING, "value": math.radians(90.0)}}))
+            while "requestId" not in (m := json.loads(await ws.recv())):
+                pass
+            assert m["statusCode"] == 409 and m["state"] == "COMPLETED", m
+            assert "route" in m["message"] and "not applied" in m["message"], m
+            assert ap.signalk_stream.counts["put_refused"] == 1 and ap.signalk_stream.counts["put_ok"] == 0
+            # the plug-in's link: a target delta over UDP, then the status it reads
+            ap_listen = ap._listeners[0].get_extra_info("sockname")
+            status.sendto(json.dumps({"updates": [{"values": [{"path": TARGET_HEADING, "value": 1.5}]}]}).encode(),
+                          ap_listen)
+            await _wait_until(lambda: ap.signalk_counts["not_applied"] == 1, "the UDP target was not counted")
+            await asyncio.sleep(0.3)                        # a few samples: the route still steers
+            assert abs(math.remainder(ap.psi_set - 1.5, 2 * math.pi)) > 0.5 and ap.course_source == "route"
+            loop = asyncio.get_running_loop()
+            values = parse_delta(await asyncio.wait_for(loop.sock_recv(status, 65536), 10))
+            assert "--route" in values[TARGET_REFUSED], values
+            assert await _put(ws, "r2", AUTOPILOT_STATE, "standby") == 200
+            await _wait_until(lambda: ap.mode == "standby", "standby was not applied")
+        out["ok"] = True
+
+    try:
+        asyncio.run(_with_streams(controller, client, route=plan, signalk_listen=listen_addr,
+                                  signalk_to=status.getsockname()))
+    finally:
+        status.close()
+    assert out.get("ok")
+
+
+def test_heading_put_while_a_chart_plotter_steers_is_refused_409_then_applied(controller):  # noqa: F811
+    """A fresh APB course from the chart plotter (``--nmea-listen``) replaces any other at the
+    next sample: a heading PUT meanwhile is answered 409 naming the plotter's sentence; once
+    the plotter is silent for ``nmea_timeout`` the same PUT is answered 200 and applied."""
+    from steerlab.runtime import nmea
+
+    out = {}
+    apb = nmea.render("APB", ["A", "A", "0.00", "R", "N", "V", "V", "50.0", "T", "WP1", "50.0", "T", "50.0", "T"])
+
+    async def client(server, ap):
+        await _wait_until(lambda: ap.samples > 2, "the autopilot never sampled")
+        plotter = _udp_socket()
+        try:
+            plotter.sendto(apb.encode(), ap._listeners[0].get_extra_info("sockname"))
+            await _wait_until(lambda: ap.course_source == "APB", "the plotter's course was not taken")
+        finally:
+            plotter.close()
+        host, port = ap.signalk_stream.address
+        async with connect(f"ws://{host}:{port}/signalk/v1/stream?subscribe=none") as ws:
+            await ws.recv()
+            await ws.send(json.dumps({"requestId": "p1", "put": {"path": TARGET_HEADING, "value": math.radians(15.0)}}))
+            while "requestId" not in (m := json.loads(await ws.recv())):
+                pass
+            assert m["statusCode"] == 409 and "APB" in m["message"] and "--nmea-listen" in m["message"], m
+            assert math.degrees(ap.psi_set) == pytest.approx(50.0)
+            # the plotter falls silent: its course goes stale and the operator's is applied
+            stale_at = ap.nmea_courses["APB"][1] + ap.config.nmea_timeout
+            await _wait_until(lambda: ap.clock() > stale_at + 0.2, "the ship clock stopped")
+            assert await _put(ws, "p2", TARGET_HEADING, math.radians(15.0)) == 200
+            assert math.degrees(ap.psi_set) == pytest.approx(15.0) and ap.course_source == "operator"
+        out["ok"] = True
+
+    # the plotter's course fresh for 20 ship seconds (2 s of wall time at speedup 10): the PUT
+    # is answered well within it on a loaded machine
+    cfg = AutopilotConfig(speedup=SPEEDUP, watchdog_timeout=3.0, nmea_timeout=20.0)
+    asyncio.run(_with_streams(controller, client, ap_cfg=cfg, nmea_listen=("127.0.0.1", 0)))
     assert out.get("ok")
 
 

@@ -101,6 +101,20 @@ def test_handle_action_never_raises():
     assert handle_action(Fake(), '{"action": "adjust", "deg": -10}', 0.0)["ok"] is True
 
 
+def test_course_buttons_while_a_route_steers_are_refused_with_the_reason():
+    adjusted = []
+
+    class Following:
+        def course_refusal(self, t):
+            return "following a route (--route): the route is the only course source; target not applied"
+
+        def adjust(self, d, t):
+            adjusted.append(d)
+
+    reply = handle_action(Following(), '{"action": "adjust", "deg": 10}', 0.0)
+    assert reply["ok"] is False and "--route" in reply["error"] and adjusted == []
+
+
 _NODE_HARNESS = r"""
 // Runs the page's own bridge.js in Node with a stub DOM and Node's real WebSocket client.
 const [port, srcPath] = process.argv.slice(2);

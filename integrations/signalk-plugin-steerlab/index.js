@@ -11,7 +11,9 @@
  *   - status: the autopilot's own deltas, sent each sample to --signalk-to (this plugin's
  *     statusPort): steering.autopilot.state and steering.autopilot.target.headingTrue.
  * Without a status datagram for `offlineTimeout` seconds the device is "off-line" and commands
- * are refused (503). Angles are radians, true heading, as everywhere in Signal K.
+ * are refused (503). While steerlab's status says it would not apply a target heading
+ * (steering.autopilot.steerlab.targetRefused: it follows a route or a chart plotter's course),
+ * setting or adjusting the target is refused (409) with steerlab's reason. Angles are radians, true heading, as everywhere in Signal K.
  * Signal K v1 PUTs on those two paths are handled too (registerPutHandler), with the same checks.
  */
 'use strict'
@@ -21,6 +23,7 @@ const dgram = require('dgram')
 const TWO_PI = 2 * Math.PI
 const TARGET = 'steering.autopilot.target.headingTrue'
 const STATE = 'steering.autopilot.state'
+const REFUSED = 'steering.autopilot.steerlab.targetRefused' // steerlab's reason a target is not applied
 const STATES = [
   { name: 'auto', engaged: true },
   { name: 'standby', engaged: false }
@@ -100,7 +103,7 @@ module.exports = function (app) {
   let sock = null
   let timer = null
   let opts = {}
-  let last = { state: null, target: null, seen: 0 }
+  let last = { state: null, target: null, seen: 0, refused: null }
   let published = {}
   // a command's value wins over status deltas that were already on their way (for SETTLE_MS,
   // or until steerlab reports it), so two quick adjustments add up instead of using a stale base
@@ -137,6 +140,11 @@ module.exports = function (app) {
       sock.send(delta(values), opts.commandPort, opts.host, (err) =>
         err ? reject(fail(502, `cannot reach steerlab: ${err.message}`)) : resolve())
     })
+  }
+
+  /** Refuse a target heading steerlab would not apply (409, its reason). */
+  function checkTargetApplies () {
+    if (online() && last.refused) throw fail(409, last.refused)
   }
 
   function checkDevice (deviceId) {
@@ -188,6 +196,7 @@ module.exports = function (app) {
       if (typeof value !== 'number' || !Number.isFinite(value) || value < -Math.PI || value >= TWO_PI) {
         throw fail(400, 'target must be a heading in radians, -pi <= value < 2 pi')
       }
+      checkTargetApplies()
       const t = wrap(value)
       await send({ [TARGET]: t })
       last.target = t
@@ -200,6 +209,7 @@ module.exports = function (app) {
         throw fail(400, 'adjustment must be in radians, |value| <= pi')
       }
       if (last.target === null) throw fail(409, 'no target heading yet to adjust')
+      checkTargetApplies()
       const t = wrap(last.target + value)
       await send({ [TARGET]: t })
       last.target = t
@@ -236,7 +246,7 @@ module.exports = function (app) {
 
   plugin.start = function (options) {
     opts = { ...{ deviceId: 'steerlab', host: '127.0.0.1', commandPort: 10111, statusHost: '127.0.0.1', statusPort: 10112, offlineTimeout: 3 }, ...(options || {}) }
-    last = { state: null, target: null, seen: 0 }
+    last = { state: null, target: null, seen: 0, refused: null }
     published = {}
     pending = {}
     sock = dgram.createSocket('udp4')
@@ -247,6 +257,7 @@ module.exports = function (app) {
       const t = values[TARGET]
       if (s === undefined && t === undefined) return
       last.seen = Date.now()
+      last.refused = typeof values[REFUSED] === 'string' ? values[REFUSED] : null // absent: applied
       if ((s === 'auto' || s === 'standby' || s === 'alarm') && accept('state', s, (a, b) => a === b)) {
         last.state = s
       }

@@ -97,3 +97,37 @@ test('off-line until steerlab speaks; then commands go out as deltas; bad values
     steerlab.close()
   }
 })
+
+test('a target steerlab would not apply (route, chart plotter) is refused 409 with its reason', async () => {
+  const app = fakeApp()
+  const steerlab = await udp()
+  const statusPort = (await udp().then((s) => { const p = s.address().port; s.close(); return p }))
+  const plugin = makePlugin(app)
+  plugin.start({ commandPort: steerlab.address().port, statusPort, offlineTimeout: 5 })
+  const [provider] = app.registered
+  const got = []
+  steerlab.on('message', (m) => got.push(makePlugin.parseDelta(m)))
+  const status = (values) => steerlab.send(JSON.stringify({
+    context: 'vessels.self', updates: [{ values: Object.entries(values).map(([path, value]) => ({ path, value })) }]
+  }), statusPort, '127.0.0.1')
+  const reason = 'following a route (--route): the route is the only course source; target not applied'
+  try {
+    await sleep(50)
+    status({ 'steering.autopilot.state': 'auto', 'steering.autopilot.target.headingTrue': 1, 'steering.autopilot.steerlab.targetRefused': reason })
+    await sleep(100)
+    await assert.rejects(provider.setTarget(0.5, 'steerlab'), (e) => e.statusCode === 409 && e.message === reason)
+    await assert.rejects(provider.adjustTarget(0.1, 'steerlab'), (e) => e.statusCode === 409 && e.message === reason)
+    await provider.disengage('steerlab') // the state is still steerlab's to take
+    await sleep(100)
+    assert.deepStrictEqual(got.map((d) => Object.keys(d)), [['steering.autopilot.state']])
+    status({ 'steering.autopilot.state': 'standby', 'steering.autopilot.target.headingTrue': 1 }) // the route ended
+    await sleep(100)
+    await provider.setTarget(0.5, 'steerlab')
+    await sleep(100)
+    assert.strictEqual(got.length, 2)
+    assert.strictEqual(got[1]['steering.autopilot.target.headingTrue'], 0.5)
+  } finally {
+    plugin.stop()
+    steerlab.close()
+  }
+})

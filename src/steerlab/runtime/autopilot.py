@@ -281,6 +281,9 @@ class Autopilot:
         if state is not None and state not in ("auto", "standby"):
             self.signalk_counts["bad_field"] += 1
             return
+        if target is not None and self.course_refusal(t) is not None:
+            self.signalk_counts["not_applied"] += 1     # the route or the plotter sets the course
+            target = None
         self.signalk_counts["accepted"] += 1
         if target is not None:
             self.set_course(float(target), t)
@@ -309,6 +312,29 @@ class Autopilot:
             start = self.latest.psi
         self.gd = course_schedule(float(start), [(max(t, 0.0), psi)], self.config.turn_rate)
         self.off_course_armed = False
+
+    def course_refusal(self, t: float) -> str | None:
+        """Why a set course from the operator (bridge page, Signal K PUT or delta) would not be
+        applied at ship time ``t`` [s], or None when it would.
+
+        With a route (``--route``) the route guidance is the only course source; with a fresh
+        course from the chart plotter (``--nmea-listen``: APB/RMB/HTC, not one holding at a
+        reached waypoint) the plotter's course replaces any other at the next sample.
+        """
+        if self.route is not None:
+            return "following a route (--route): the route is the only course source; target not applied"
+        from steerlab.runtime.nmea import COURSE_PRIORITY
+
+        for kind in COURSE_PRIORITY:                     # the choice of _plotter_course, read only
+            c = self.nmea_courses.get(kind)
+            if c is None or t - c[1] > self.config.nmea_timeout:
+                continue
+            _, _, dest, arrived = c
+            if arrived or (kind in self.arrived and dest == self.arrived[kind]):
+                return None                              # holding: the set course stays in effect
+            return (f"the chart plotter's {kind} course sets the course (--nmea-listen); "
+                    "target not applied")
+        return None
 
     def adjust(self, ddeg: float, t: float) -> None:
         """Change the set course by ``ddeg`` degrees (the bridge page's ±1/±10 buttons)."""

@@ -14,7 +14,10 @@ A delta is ``{"context": "vessels.self", "updates": [{"source": {...}, "timestam
 "values": [{"path": ..., "value": ...}, ...]}]}``, one JSON document per UDP datagram (or
 WebSocket message, :mod:`steerlab.runtime.signalk_ws`). :func:`parse_delta` accepts exactly that
 shape and returns ``{path: value}`` or None (never raises). :func:`autopilot_put` applies a
-Signal K PUT request to the autopilot (the writable paths: :data:`WRITABLE`).
+Signal K PUT request to the autopilot (the writable paths: :data:`WRITABLE`); a set course the
+autopilot would not apply (a route or a chart plotter sets the course) is answered 409 with the
+reason, and the autopilot's status deltas over UDP carry that reason as :data:`TARGET_REFUSED`
+(what the Signal K plug-in answers its own requests with).
 """
 
 from __future__ import annotations
@@ -32,6 +35,9 @@ MAX_DELTA_BYTES = 65536
 TARGET_HEADING = "steering.autopilot.target.headingTrue"
 AUTOPILOT_STATE = "steering.autopilot.state"
 WRITABLE = (TARGET_HEADING, AUTOPILOT_STATE)   #: paths a PUT may set on the autopilot
+TARGET_REFUSED = "steering.autopilot.steerlab.targetRefused"
+"""steerlab's own path in the status deltas sent to ``--signalk-to``: why a target heading would
+not be applied now (a string), left out while it would be."""
 SELF_URN = "urn:mrn:signalk:uuid:" + str(uuid.uuid5(uuid.NAMESPACE_URL, "steerlab:self"))
 """The self vessel's identity (Signal K 1.7 "Vessel identity": a URN; fixed, as steerlab serves one vessel)."""
 SELF_ID = "vessels." + SELF_URN      #: what ``GET /signalk/v1/api/self`` and the stream's hello give
@@ -77,7 +83,9 @@ def autopilot_values(ap) -> dict:
 
 
 def autopilot_delta_json(ap, wall: float | None = None) -> str:
-    return json.dumps(delta(autopilot_values(ap), wall))
+    """The status delta sent over UDP (``--signalk-to``): :func:`autopilot_values` and, while a
+    target heading would not be applied, :data:`TARGET_REFUSED` with the reason."""
+    return json.dumps(delta({**autopilot_values(ap), TARGET_REFUSED: ap.course_refusal(ap.clock())}, wall))
 
 
 def parse_delta(data) -> dict | None:
@@ -116,12 +124,17 @@ def autopilot_put(ap, path, value, t: float) -> tuple[int, str]:
 
     ``steering.autopilot.target.headingTrue``: the set course [rad, |value| <= 2 pi];
     ``steering.autopilot.state``: ``"auto"`` (engage) or ``"standby"``. Returns
-    ``(HTTP status code, message)``: 200, 400 (bad value) or 405 (path not writable).
+    ``(HTTP status code, message)``: 200, 400 (bad value), 405 (path not writable) or 409 (a
+    heading the autopilot would not apply: it follows a route or a chart plotter's course; the
+    message says which: :meth:`steerlab.runtime.autopilot.Autopilot.course_refusal`).
     """
     if path == TARGET_HEADING:
         if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) \
                 or abs(value) > 2 * math.pi:
             return 400, "value must be a heading in radians, |value| <= 2 pi"
+        refusal = ap.course_refusal(t)
+        if refusal is not None:
+            return 409, refusal
         ap.set_course(float(value), t)
         return 200, ""
     if path == AUTOPILOT_STATE:

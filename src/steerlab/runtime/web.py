@@ -91,6 +91,9 @@ def handle_action(ap, msg, t: float) -> dict:
         d = m.get("deg")
         if not isinstance(d, (int, float)) or isinstance(d, bool) or float(d) not in ADJUST_STEPS:
             return {"type": "reply", "ok": False, "error": f"deg must be one of {ADJUST_STEPS}"}
+        refusal = ap.course_refusal(t)          # a route or a chart plotter sets the course
+        if refusal is not None:
+            return {"type": "reply", "ok": False, "error": refusal}
         ap.adjust(float(d), t)
     elif action == "ack":
         name = m.get("alarm")
