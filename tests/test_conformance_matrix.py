@@ -42,9 +42,15 @@ HOLD_TARGET = 0.95
 N_RANDOM_PLANTS = 256
 """Random plants drawn (issue 30: at least 200)."""
 TARGET_NOT_MET_YET = pytest.mark.xfail(
-    strict=True, reason="issue 30: the laws' design rules (branches laws-linear, laws-nonlinear) are not merged "
-                        "yet; today's code steers 26 % of the matrix and holds 26 % of the random plants. "
-                        "Delete this mark once they pass (strict: an XPASS fails the run).")
+    strict=True, reason="issue 30's 95 % is not met yet (docs/conformance.md): in calm water 743 of 836 cases "
+                        "steer (89 %; 82 refused in one line, 11 fail), in JONSWAP sea state 5 only 15 of 836 "
+                        "hold the 1 deg band on the 60 s mean heading; of the random-plant lanes 62 % hold "
+                        "(itae_pid and asa ask for speed_kn, 44 fast course-unstable plants are refused for "
+                        "their gear). Strict: an XPASS fails the run, so delete this mark when it is met.")
+CALM_STEER_FLOOR = 0.88
+"""Measured floor (after issue 30's design rules): fraction of calm-water cases that steer."""
+DESIGNED_HOLD_FLOOR = 0.95
+"""Of the random-plant lanes a law designed (not refused), the fraction that must hold the change."""
 KINDS = {"diverged", "spins", "never turns", "limit cycle", "steady offset", "not settled", "rudder reversals"}
 """The failure kinds the judge names (``crashed`` is a defect, asserted absent)."""
 
@@ -205,6 +211,17 @@ def test_matrix_fraction_that_steers_meets_the_target(matrix):
     assert matrix["fraction_steers"] >= STEER_TARGET, by_law
 
 
+@pytest.mark.slow
+def test_calm_water_cases_steer_or_are_refused(matrix):
+    """Calm water: the designs carry (>= CALM_STEER_FLOOR steer) and at most 2 % fail (the rest
+    are refused in one line naming what to give)."""
+    calm = [o for o in matrix["outcomes"] if o["sea"] == CALM]
+    steers = sum(o["verdict"] == J.STEERS for o in calm) / len(calm)
+    fails = [f"{o['ship']} + {o['controller']} ({o['point']}): {o['reason']}" for o in calm if o["verdict"] == J.FAILS]
+    assert steers >= CALM_STEER_FLOOR, steers
+    assert len(fails) <= 0.02 * len(calm), fails
+
+
 # ----------------------------------------------------------------------------- random plants
 def test_plain_plants_are_the_nomoto_models():
     """The NumPy plant's discretisation: first order, r = K delta (1 - exp(-t/T)); second
@@ -251,6 +268,14 @@ def test_random_plants_every_lane_is_judged(plant_outcomes):
             assert o["reason"].split(":", 1)[0] in KINDS, o
         else:
             assert o["verdict"] == J.STEERS and o["reason"] == ""
+
+
+@pytest.mark.slow
+def test_random_plants_a_designed_law_holds_the_change(plant_outcomes):
+    """Every design a law makes from (K, T) alone holds the 20 deg change on >= 95 % of the plants."""
+    designed = [o for o in plant_outcomes if o["verdict"] != J.REFUSED]
+    holds = sum(o["verdict"] == J.STEERS for o in designed) / len(designed)
+    assert holds >= DESIGNED_HOLD_FLOOR, holds
 
 
 @pytest.mark.slow
