@@ -309,9 +309,12 @@ def test_kernel_follows_the_rpm_schedule_option_and_both_give_the_same_bits():
     it vectorises); with one, mmg_rhs. For a record without a schedule the two are one body."""
     from steerlab.ships import mmg
 
-    const = build(scenario_from_dict({"ship": {"model": "kosoko", "speed_kn": 0.97}}))
+    # the paper's ADRC: a designed one refuses Kosoko's full-scale default gear (gear.rate_max)
+    ctrl = {"type": "adrc", "gains": "paper"}
+    const = build(scenario_from_dict({"ship": {"model": "kosoko", "speed_kn": 0.97}, "controller": ctrl}))
     sched = build(scenario_from_dict({"ship": {"model": "kosoko", "speed_kn": 0.97,
-                                               "options": {"rpm_schedule": [[0, 600], [5, 400]]}}}))
+                                               "options": {"rpm_schedule": [[0, 600], [5, 400]]}},
+                                      "controller": ctrl}))
     assert const.ship.rhs is mmg.mmg_rhs_constant_rate and sched.ship.rhs is mmg.mmg_rhs
     assert get_ship("kosoko").rhs is mmg.mmg_rhs                  # the catalogue entry keeps the general one
     rng = np.random.default_rng(7)

@@ -85,7 +85,12 @@ def build_autopilot(args):
     origins = allowed_origins(args)
     check_report_every(args)
     scenario = load_scenario(args.scenario) if args.scenario else default_scenario()
-    ctrl = ControllerRuntime(scenario, args.controller, args.sample_time)
+    if args.route:   # before the controller compiles: a missing file is one line, nothing else
+        try:
+            with open(args.route, "rb"):
+                pass
+        except OSError as err:
+            raise InputError("--route", f"cannot read {args.route!r}: {err.strerror}") from None
     if args.heading is not None:
         require_finite_range("--heading", args.heading, -360.0, 360.0)
     turn = scenario.guidance.rate_max_deg_s if args.turn_rate is None else args.turn_rate
@@ -96,7 +101,8 @@ def build_autopilot(args):
                           turn_rate=rad(turn), max_age=args.max_age,
                           rpm_cmd=math.nan if args.rpm is None else args.rpm, xte_lookahead=args.xte_lookahead,
                           nmea_heading_over_signed=args.nmea_heading_over_signed, input_rate=args.input_rate,
-                          input_burst=max(1.0, args.input_rate))
+                          input_burst=max(1.0, args.input_rate)).validate()
+    ctrl = ControllerRuntime(scenario, args.controller, args.sample_time)   # compiles on first use: checks first
     route = (route_guidance(scenario, ctrl.setup.ship, ctrl.setup.ps, args.route, args.lookahead_L,
                             args.accept_radius) if args.route else None)
     web = parse_hostport(args.web, "--web") if args.web else None
