@@ -148,3 +148,17 @@ def test_designed_from_K_T_alone_holds_a_20_deg_change_on_both_signs(law):
         assert np.all(np.abs(tail - rad(20.0)) < rad(1.0)), (law, K, T, math.degrees(np.max(np.abs(tail - rad(20.0)))))
         held += 1
     assert held >= 3 and held + refused == len(PLANTS)
+
+
+def test_itae_pid_from_nomoto_alone_is_the_unscheduled_design():
+    """No speed to schedule on: eq (2) is off and the record is the unscheduled design's (but V_m),
+    for T of both signs (tests/test_conformance_matrix.py steps it on the random plants)."""
+    import numpy as np
+
+    from steerlab.control.itae_pid import I_SCHED, I_VM
+
+    for K, T in ((0.05, 80.0), (-0.05, -300.0)):
+        c = controller("itae_pid", nomoto=(K, T))
+        assert c.params[I_SCHED] == 0.0
+        with_speed = controller("itae_pid", nomoto=(K, T), speed_kn=10.0, schedule=False)
+        np.testing.assert_array_equal(np.delete(c.params, I_VM), np.delete(with_speed.params, I_VM))

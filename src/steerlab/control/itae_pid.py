@@ -36,7 +36,8 @@ surge speed ``x[3]`` (clamped below at ``v_min_fraction * V_m``), ``V_m`` the de
 (the scenario's approach speed unless ``design_speed_kn`` is given) and ``k_m``, ``T_m``
 the ship's Nomoto model at ``V_m`` (``ctx.nomoto()``) unless given. So ``H1``, ``H2`` scale
 with ``(V_m/V)^2``, and ``H3`` and the pre-filter change too. ``schedule = false`` keeps the
-design-speed gains.
+design-speed gains; so does a design from ``nomoto=(K, T)`` alone, which has no speed to
+schedule on (``sl.controller("itae_pid", nomoto=(K, T))``).
 
 Implementation (per sample ``h``, radians):
 
@@ -268,7 +269,12 @@ def build(cfg: ItaePIDConfig, ctx):
     t_r = cfg.t_r if cfg.t_r is not None else (PAPER_T_R if paper else design_t_r(m))
     aw = cfg.anti_windup if cfg.anti_windup is not None else not paper
     Vm = knots_to_ms(cfg.design_speed_kn) if cfg.design_speed_kn is not None else ctx.speed
-    c = ItaePID(t_r=t_r, k_m=m.K, T_m=m.T, V_m=Vm, schedule=cfg.schedule,
+    schedule = cfg.schedule
+    if not math.isfinite(Vm):
+        # a design from (K, T) alone has no speed to schedule on: fixed gains (eq 2 off);
+        # V_m is then never read by the kernel and is stored as 1 m/s
+        schedule, Vm = False, 1.0
+    c = ItaePID(t_r=t_r, k_m=m.K, T_m=m.T, V_m=Vm, schedule=schedule,
                 v_min_fraction=cfg.v_min_fraction, polynomial=cfg.polynomial,
                 u_max=ctx.u_max(cfg.u_max_deg), anti_windup=aw)
     return c, c.pack()
