@@ -58,6 +58,7 @@ if TYPE_CHECKING:
 
 #: inputs of the linearised controller, in order
 INPUTS = ("psi", "r", "delta", "psi_ref")
+IN_PSI, IN_R, IN_DELTA, IN_PSI_REF = range(len(INPUTS))   #: the inputs' indices, by name
 #: relative step of the central differences (an absolute step for values below 1)
 REL_STEP = 1e-6
 #: points of the frequency grid [1e-6 rad/s, Nyquist) the margins are searched on
@@ -99,15 +100,15 @@ def linearise_law(ctrl: Controller) -> dict:
     nx = len(ctrl.plant_state_names)
     x0 = np.zeros(nx)
     x0[IU] = ctrl.speed if math.isfinite(ctrl.speed) else 0.0
-    slots = (IPSI, IR, nx - 1)
+    slots = ((IN_PSI, IPSI), (IN_R, IR), (IN_DELTA, nx - 1))   # the rudder angle is the plant state's last
 
     def evaluate(z, y):
         zn = np.array(z, dtype=np.float64)
         x = x0.copy()
-        for slot, v in zip(slots, y[:3]):
-            x[slot] = v
+        for i, slot in slots:
+            x[slot] = y[i]
         ref = initial_reference()
-        ref[REF_PSI] = y[3]
+        ref[REF_PSI] = y[IN_PSI_REF]
         u = float(call(zn, p, 0.0, x, ref, h))
         return zn, u
 
