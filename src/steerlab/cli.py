@@ -279,6 +279,7 @@ def main(argv=None) -> int:
     shown_by = _warnings_as_lines()
     try:
         if getattr(args, "out", None):        # every command that writes: --out checked before any work
+            _name_command(args)
             restore = _prepare_out(args.out)
         elif args.command in RUNS_UNTIL_STOPPED:
             restore = _unwind_on_sigterm()
@@ -370,6 +371,19 @@ def _prepare_out(out: str):
 
     prepare_out(out)
     return _unwind_on_sigterm()
+
+
+def _name_command(args) -> None:
+    """Name the running command in the marker of the folders it writes (its subcommand too)."""
+    from steerlab.outputs import set_command
+
+    words = [str(getattr(args, "command", "") or "")]
+    for attr in ("name", "kind", "trial"):
+        value = getattr(args, attr, None)
+        if isinstance(value, str) and len(value) <= 40:
+            words.append(value)
+            break
+    set_command(" ".join(w for w in words if w))
 
 
 def _unwind_on_sigterm():
