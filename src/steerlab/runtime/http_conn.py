@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import functools
 import logging
+import weakref
 from http import HTTPStatus
 
 from websockets.asyncio.server import ServerConnection
@@ -171,8 +172,11 @@ class HttpConnection(ServerConnection):
     :data:`IDLE_TIMEOUT`.
     """
 
+    _live: "weakref.WeakSet[HttpConnection]" = weakref.WeakSet()   # connections not (yet) WebSockets
+
     def __init__(self, protocol, *args, responder=None, idle_timeout: float | None = None, **kwargs):
         self.responder = responder
+        HttpConnection._live.add(self)
         self.idle_timeout = IDLE_TIMEOUT if idle_timeout is None else idle_timeout
         self._idle = None
         protocol.parser = _parse(protocol, self)      # nothing received yet: safe to swap
@@ -218,6 +222,7 @@ class HttpConnection(ServerConnection):
             self._arm()
 
     def upgrading(self) -> None:
+        HttpConnection._live.discard(self)
         if self._idle is not None:
             self._idle.cancel()
             self._idle = None
@@ -235,6 +240,19 @@ class HttpConnection(ServerConnection):
             return None if process_request is None else process_request(connection, request)
 
         await super().handshake(checked, *args, **kwargs)
+
+
+def close_plain_connections(server) -> int:
+    """Abort the keep-alive HTTP connections of ``server`` (a websockets server) that are not
+    WebSockets: websockets' own close waits for their handshake, which a kept-alive connection
+    never starts. Call right after ``server.close()``; returns how many were aborted."""
+    n = 0
+    for conn in list(HttpConnection._live):
+        if getattr(conn, "server", None) is server and conn.protocol.state is CONNECTING \
+                and getattr(conn, "transport", None) is not None:
+            conn.transport.abort()
+            n += 1
+    return n
 
 
 def http_connection(responder, idle_timeout: float | None = None):

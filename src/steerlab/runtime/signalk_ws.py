@@ -52,7 +52,7 @@ from websockets.asyncio.server import broadcast, serve
 from steerlab.errors import InputError
 from steerlab.runtime.access import AccessPolicy, parse_json
 from steerlab.runtime.client_slots import ClientSlots
-from steerlab.runtime.http_conn import CLOSE_TIMEOUT, http_connection, is_upgrade
+from steerlab.runtime.http_conn import CLOSE_TIMEOUT, close_plain_connections, http_connection, is_upgrade
 from steerlab.runtime.path_glob import PathPattern
 from steerlab.runtime.rate_limit import RateLimiter
 from steerlab.runtime.signalk import MAX_DELTA_BYTES, SELF_ID, delta, is_self_context, iso_time
@@ -299,6 +299,7 @@ class SignalKStreamServer:
     async def close(self) -> None:
         if self.server is not None:
             self.server.close()
+            close_plain_connections(self.server)
             await self.server.wait_closed()
 
 

@@ -33,7 +33,7 @@ from websockets.http11 import Response
 from steerlab.errors import InputError
 from steerlab.runtime.access import AccessPolicy, parse_json
 from steerlab.runtime.client_slots import ClientSlots
-from steerlab.runtime.http_conn import CLOSE_TIMEOUT, http_connection, is_upgrade
+from steerlab.runtime.http_conn import CLOSE_TIMEOUT, close_plain_connections, http_connection, is_upgrade
 from steerlab.runtime.rate_limit import RateLimiter
 
 STATIC = {"/": ("bridge.html", "text/html; charset=utf-8"),
@@ -204,4 +204,5 @@ class BridgeServer:
     async def close(self) -> None:
         if self.server is not None:
             self.server.close()
+            close_plain_connections(self.server)
             await self.server.wait_closed()
