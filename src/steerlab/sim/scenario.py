@@ -194,9 +194,17 @@ class EnvironmentConfig(_Frozen):
     wind_rudder: Optional[WindRudderConfig] = None
 
 
+MAX_NAME = 200
+"""Longest scenario ``name`` [characters]: it titles every figure, report and table (a name of
+100 000 characters took 76 s of figure layout, millions hung; now refused in one line)."""
+MAX_DESCRIPTION = 10_000
+"""Longest scenario ``description`` [characters]."""
+
+
 class Scenario(_Frozen):
-    name: str = "scenario"
-    description: str = ""
+    name: str = Field("scenario", max_length=MAX_NAME,
+                      description=f"titles the figures and the report; at most {MAX_NAME} characters")
+    description: str = Field("", max_length=MAX_DESCRIPTION)
     seed: int = Field(0, ge=0, le=2**63 - 1)
     dt: float = Field(0.1, ge=1e-4, le=10.0, description="integration step [s], 1e-4-10 s")
     duration: float = Field(3000.0, gt=0.0, le=1e6, description="[s]")
