@@ -20,7 +20,7 @@ What is compared
   steerlab's self-propulsion rate with R'_0, 11.85 rev/s).
 * **A sensitivity table over the propeller rate** (:data:`SENSITIVITY_RPS`, 10.5-13 rev/s at
   the same conditions): the unpublished rate is the largest unknown (each rev/s less widens
-  advance and tactical diameter by about 0.11 L). For each published value the table gives the
+  the advance by about 0.09 L, the tactical diameter by about 0.06 L). For each published value the table gives the
   rate at which steerlab would meet it (interpolated, reported, never used to tune).
 * **Their full-scale simulation** (Table 6, same transcription, :data:`PUBLISHED_FULL`) against
   ``kvlcc2`` (L = 320 m, 15.5 kn, 2.32 deg/s): steerlab's ``kvlcc2`` is the Froude-scaled
