@@ -118,7 +118,8 @@ def cmd_experiment(args) -> int:
         rows = run(stage, progress=say, quick=args.quick)
     from steerlab.text_table import render_table
 
-    print(render_table(("quantity", "paper", "steerlab", "unit"),
+    # an experiment whose 'paper' column is not a published measurement names its columns (COLUMNS)
+    print(render_table(getattr(EXPERIMENTS[args.name], "COLUMNS", ("quantity", "paper", "steerlab", "unit")),
                        ((r["quantity"], r["paper"], r["steerlab"], r["unit"]) for r in rows), align="lrrl"))
     say(f"wrote {args.out}/comparison.json and the figures")
     return 0
