@@ -298,3 +298,34 @@ def test_actuator_device_vanishing_gives_alarm_and_safe_state(controller, tmp_pa
     rows = _read_log(tmp_path / "ap.csv")
     assert all(r["mode"] == "safe" and r["delta_cmd_deg"] == 0.0 for r in rows if r["t"] >= raised)
     assert not ap.engaged
+
+
+def test_an_implausible_compass_hands_over_to_the_state_heading_with_an_alarm(controller):  # noqa: F811
+    """The autopilot's own wiring of the heading health: a compass that jumps 90 deg is not
+    steered by (counted ``implausible``), the state heading takes over with the alarm, and the
+    compass steers again once its readings agree; a fresh RSA is the measured rudder angle."""
+    from steerlab.runtime import protocol as P
+
+    ap = Autopilot(controller, ("127.0.0.1", 9), AutopilotConfig(input_rate=0.0), heading=0.0)
+    ap.latest = P.State(0.0, 0.0, 0.0, math.radians(1.0), 0.0, 5.0, 0.0, 0.0, math.nan, 0.0, 0)
+    ap.latest_t = 0.0
+    for k in range(5):
+        ap.on_nmea_datagram(_hdg_line(math.radians(2.0)), t=0.1 * k)
+    row = ap.sample(0.5)
+    assert row["heading_source"] == "nmea" and row["psi_deg"] == pytest.approx(2.0, abs=0.06)
+    ap.latest_t = 0.6
+    ap.on_nmea_datagram(_hdg_line(math.radians(92.0)), t=0.6)
+    row = ap.sample(0.625)
+    assert row["heading_source"] == "state" and "heading_nmea" in row["alarms"]
+    assert ap.nmea_counts["implausible"] == 1 and row["nmea_rejected"] == 1
+    for k in range(3):
+        ap.on_nmea_datagram(_hdg_line(math.radians(92.0)), t=0.7 + 0.1 * k)
+    ap.latest_t = 0.9
+    ap.on_nmea_datagram(nmea.render("RSA", ["-3.0", "A", "", "V"]).encode(), t=0.9)
+    row = ap.sample(1.0)
+    assert row["heading_source"] == "nmea" and row["psi_deg"] == pytest.approx(92.0, abs=0.06)
+    assert "heading_nmea" not in row["alarms"]
+    assert ap.ctrl.x[-1] == pytest.approx(math.radians(-3.0))       # the RSA angle, not the state's 0
+    st = ap.status()
+    assert st["heading_sources"] == {"nmea": "fresh"} and st["rudder_feedback"] == pytest.approx(math.radians(-3.0))
+    assert st["actuator"]["name"] == "sim" and st["actuator"]["faults"] == {}
