@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import asyncio
 import math
+from collections import Counter
 import os
 import select
 import subprocess
@@ -327,5 +328,55 @@ def test_an_implausible_compass_hands_over_to_the_state_heading_with_an_alarm(co
     assert "heading_nmea" not in row["alarms"]
     assert ap.ctrl.x[-1] == pytest.approx(math.radians(-3.0))       # the RSA angle, not the state's 0
     st = ap.status()
-    assert st["heading_sources"] == {"nmea": "fresh"} and st["rudder_feedback"] == pytest.approx(math.radians(-3.0))
+    assert st["heading_sources"] == {"nmea": "fresh", "signalk": "unseen"}
+    assert st["rudder_feedback"] == pytest.approx(math.radians(-3.0))
     assert st["actuator"]["name"] == "sim" and st["actuator"]["faults"] == {}
+
+
+def test_signalk_magnetic_heading_needs_and_takes_the_variation(controller):  # noqa: F811
+    from steerlab.runtime.signalk_input import input_values
+
+    ap = Autopilot(controller, ("127.0.0.1", 9), AutopilotConfig(), heading=0.0)
+    counts = Counter()
+    ap.on_signalk_values(input_values({"navigation.headingMagnetic": 1.0}, counts), t=0.0)
+    assert ap.signalk_counts["magnetic"] == 1 and ap.heading_health["signalk"].last is None   # never uncorrected
+    bad = {"navigation.magneticVariation": math.radians(40.0), "navigation.headingTrue": 7.0,
+           "navigation.position": {"latitude": 95.0, "longitude": 0.0}, "steering.rudderAngle": "x"}
+    assert input_values(bad, counts) == {}
+    assert counts == {"accepted": 1, "variation_out_of_range": 1, "out_of_range": 2, "bad_field": 1}
+    ap.on_signalk_values(input_values({"navigation.magneticVariation": math.radians(-4.0),
+                                       "navigation.headingMagnetic": math.radians(100.0),
+                                       "navigation.position": {"latitude": 54.5, "longitude": 18.9}}, counts), t=0.1)
+    assert math.degrees(ap.heading_health["signalk"].good[0]) == pytest.approx(96.0)
+    assert ap.signalk_nav["navigation.position"] == (54.5, 18.9)
+
+
+def test_a_signalk_server_feeding_the_heading_steers_the_ship(controller, tmp_path):  # noqa: F811
+    """serve-ship's Signal K stream (a real WebSocket) as the autopilot's heading source: with
+    no NMEA heading, the ``signalk`` source steers (priority nmea > signalk > state) and the
+    ship reaches the set course."""
+    async def main():
+        server = ShipServer(scenario_from_dict(SCENARIO), ShipServerConfig(speedup=SPEEDUP, centre_after=2.0),
+                            signalk_ws=("127.0.0.1", 0))
+        srv = asyncio.create_task(server.run())
+        while server.signalk_stream is None:
+            await asyncio.sleep(0.005)
+        ap = Autopilot(controller, server.address,
+                       AutopilotConfig(speedup=SPEEDUP, watchdog_timeout=3.0, nmea_timeout=3.0),
+                       heading=math.radians(30.0), log_path=tmp_path / "ap.csv",
+                       signalk_input=tuple(server.signalk_stream.address))
+        try:
+            await asyncio.wait_for(ap.run(40.0), timeout=40.0 / SPEEDUP + 60.0)
+        finally:
+            server.stop()
+            await srv
+        return ap
+
+    ap = asyncio.run(main())
+    rows = _read_log(tmp_path / "ap.csv")
+    steered = [r for r in rows if r["t"] > 3.0 and r["link_ok"]]
+    by_signalk = sum(r["heading_source"] == "signalk" for r in steered)
+    assert by_signalk >= 0.9 * len(steered), (by_signalk, len(steered))
+    assert ap.signalk_source.counts["accepted"] > 100
+    end = [r for r in rows if r["t"] >= 30.0 and r["heading_source"] == "signalk"]
+    assert len(end) > 30 and max(abs(r["psi_deg"] - 30.0) for r in end) < 1.5

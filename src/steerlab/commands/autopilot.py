@@ -70,6 +70,9 @@ def register(sub, formatter_class) -> None:
     p.add_argument("--actuator", default="sim", metavar="NAME[:ARG]",
                    help="rudder drive: 'sim' (COMMAND datagrams to --connect, default), 'serial:PATH[:BAUD]' "
                         "(steerlab's line protocol, docs/runtime.md), or a steerlab.actuators entry point")
+    p.add_argument("--signalk-input", metavar="HOST:PORT",
+                   help="subscribe to this Signal K server's stream for heading (true or magnetic), variation, "
+                        "position, rate of turn and rudder angle")
     p.add_argument("--signalk-listen", metavar="HOST:PORT", help="UDP port for Signal K deltas (target heading, state)")
     p.add_argument("--signalk-to", metavar="HOST:PORT", help="send Signal K autopilot deltas here")
     p.add_argument("--signalk-ws", metavar="HOST:PORT",
@@ -140,7 +143,8 @@ def build_autopilot(args):
                    nmea_listen=hp(args.nmea_listen, "--nmea-listen"), nmea_to=hp(args.nmea_to, "--nmea-to"),
                    signalk_listen=hp(args.signalk_listen, "--signalk-listen"),
                    signalk_to=hp(args.signalk_to, "--signalk-to"), signalk_ws=signalk_ws,
-                   allow_origins=origins, nmea_streams=streams, actuator=actuator)
+                   allow_origins=origins, nmea_streams=streams, actuator=actuator,
+                   signalk_input=hp(args.signalk_input, "--signalk-input"))
     return ap, web
 
 

@@ -175,12 +175,15 @@ class Autopilot:
         TCP client, TCP server); their lines go to :meth:`on_nmea_datagram`.
     actuator : steerlab.runtime.actuator.Actuator or None
         The rudder drive; None: the simulator link (COMMAND datagrams to ``connect``).
+    signalk_input : (host, port) or None
+        Subscribe to this Signal K server's stream for heading, variation, position, rate of
+        turn and rudder angle (:mod:`steerlab.runtime.signalk_input`).
     """
 
     def __init__(self, controller, connect, config: AutopilotConfig = AutopilotConfig(),
                  heading=None, route=None, key=None, log_path=None, engaged=True,
                  nmea_listen=None, signalk_listen=None, signalk_to=None, nmea_to=None, bind=None,
-                 signalk_ws=None, allow_origins=(), nmea_streams=(), actuator=None):
+                 signalk_ws=None, allow_origins=(), nmea_streams=(), actuator=None, signalk_input=None):
         self.ctrl = controller
         self.connect = connect
         self.config = cfg = config.validate()
@@ -220,7 +223,10 @@ class Autopilot:
         self.signalk_counts: Counter = Counter(accepted=0)
         self.nmea_limiter = RateLimiter(cfg.input_rate * cfg.speedup, cfg.input_burst)
         self.signalk_limiter = RateLimiter(cfg.input_rate * cfg.speedup, cfg.input_burst)
-        self.heading_health = {"nmea": HeadingHealth("nmea", cfg.nmea_timeout, cfg.heading_max_rate)}
+        self.heading_health = {n: HeadingHealth(n, cfg.nmea_timeout, cfg.heading_max_rate) for n in ("nmea", "signalk")}
+        self.signalk_input = signalk_input
+        self.signalk_source = None
+        self.signalk_nav: dict = {}    # the newest Signal K input values by path (position, rate of turn)
         self.rmc_variation = None      # (variation [rad], t) of the newest RMC that gave one
         self.rudder_feedback = None    # (rudder angle [rad], t) of the newest RSA
         self.nmea_stream_factories = tuple(nmea_streams)
@@ -300,6 +306,29 @@ class Autopilot:
             self.nmea_courses[kind] = (c["course"], t, c["dest"], c["arrived"])
             if c["arrived"]:
                 self.arrived[kind] = c["dest"]
+
+    def on_signalk_values(self, values: dict, t: float | None = None) -> None:
+        """Checked values of the Signal K input (:func:`steerlab.runtime.signalk_input.input_values`):
+        a true heading, or a magnetic one turned true with the variation in effect, goes to the
+        ``signalk`` heading source; ``navigation.magneticVariation`` is held as an RMC's is; the
+        rudder angle is rudder feedback."""
+        from steerlab.runtime.nmea_magnetic import variation_in_effect
+
+        t = self.clock() if t is None else t
+        self.signalk_nav.update(values)
+        if "navigation.magneticVariation" in values:
+            self.rmc_variation = (values["navigation.magneticVariation"], t)
+        psi = values.get("navigation.headingTrue")
+        if psi is None and "navigation.headingMagnetic" in values:
+            var = variation_in_effect(self.rmc_variation, self.config.variation, t)
+            if var is None:
+                self.signalk_counts["magnetic"] += 1
+            else:
+                psi = values["navigation.headingMagnetic"] + var
+        if psi is not None and not self.heading_health["signalk"].observe(wrap_to_pi(psi), t):
+            self.signalk_counts["implausible"] += 1
+        if "steering.rudderAngle" in values:
+            self.rudder_feedback = (values["steering.rudderAngle"], t)
 
     def on_signalk_datagram(self, data: bytes, addr=None, t: float | None = None) -> None:
         from steerlab.runtime.signalk import parse_delta
@@ -656,6 +685,10 @@ class Autopilot:
                 self.nmea_stream_inputs.append(stream)
                 await stream.start()
             await self.actuator.start(self)
+            if self.signalk_input is not None:
+                from steerlab.runtime.signalk_input import SignalKInput
+
+                self.signalk_source = await SignalKInput(*self.signalk_input, self.on_signalk_values).start()
             if self.signalk_ws is not None:
                 from steerlab.runtime.signalk import autopilot_put
                 from steerlab.runtime.signalk_ws import SignalKStreamServer
@@ -689,6 +722,8 @@ class Autopilot:
                 pass
             for stream in self.nmea_stream_inputs:
                 await stream.close()
+            if self.signalk_source is not None:
+                await self.signalk_source.close()
             for tr in [self.transport, *self._listeners]:
                 if tr is not None:
                     tr.close()

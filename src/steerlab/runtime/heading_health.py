@@ -12,7 +12,8 @@ Each heading input the autopilot can steer by is watched by a :class:`HeadingHea
   ``recover`` readings, and a single glitch never steers the ship).
 
 The autopilot steers by the first **fresh** source of its priority
-(:data:`HEADING_PRIORITY`: the NMEA heading sensor, then the ship-state datagram; on a signed
+(:data:`HEADING_PRIORITY`: the NMEA heading sensor, a Signal K server, then the ship-state
+datagram; on a signed
 link the signed state alone unless ``--nmea-heading-over-signed``), and a seen source of that
 priority that is stale or implausible raises the alarm ``heading_<name>`` (cleared when it is
 fresh again) naming the source that took over. The state datagram's own freshness is the link
@@ -28,9 +29,10 @@ from steerlab.angles import wrap_to_pi
 from steerlab.units import deg, rad
 
 UNSEEN, FRESH, STALE, IMPLAUSIBLE = "unseen", "fresh", "stale", "implausible"
-HEADING_PRIORITY = ("nmea", "state")
+HEADING_PRIORITY = ("nmea", "signalk", "state")
 """Heading sources, first fresh one wins: ``nmea`` (HDT/THS/HDG/HDM from any NMEA input: UDP,
-serial, TCP), ``state`` (the ship-state datagram)."""
+serial, TCP), ``signalk`` (a Signal K server's ``navigation.headingTrue`` or
+``headingMagnetic``, :mod:`steerlab.runtime.signalk_input`), ``state`` (the ship-state datagram)."""
 MAX_TURN_RATE = rad(45.0)
 """Default plausibility limit on a heading's rate of change [rad/s]: 45 deg/s is beyond any
 displacement ship and a small craft's hardest turn; a compass that jumps faster is faulty."""
@@ -125,8 +127,8 @@ class HeadingHealth:
 def select_heading(t: float, order, sources: dict, fallback: float, alarms=None):
     """``(heading [rad], source name)``: the first fresh source of ``order``.
 
-    ``sources`` maps names to :class:`HeadingHealth`; a name without one (``"state"``) is the
-    last resort and always gives ``fallback``. With an ``alarms`` board
+    ``sources`` maps names to :class:`HeadingHealth`; ``"state"`` (no health of its own: the
+    link watchdog's) gives ``fallback``; another name without one is skipped. With an ``alarms`` board
     (:class:`~steerlab.runtime.alarms.AlarmBoard`), each seen source of ``order`` that is
     stale or implausible raises :func:`heading_alarm` (cleared when fresh), naming the source
     that took over.
@@ -136,7 +138,7 @@ def select_heading(t: float, order, sources: dict, fallback: float, alarms=None)
     for name in order:
         h = sources.get(name)
         if h is None:
-            if chosen is None:
+            if chosen is None and name == "state":
                 chosen = (fallback, name)
             continue
         st = h.status(t)
