@@ -2,7 +2,7 @@
 
 ``steerlab autopilot --signalk-input HOST:PORT`` connects (WebSocket,
 ``ws://HOST:PORT/signalk/v1/stream?subscribe=none``, reconnecting every second) and subscribes,
-for ``vessels.self``, to :data:`INPUT_PATHS`: ``navigation.headingTrue`` and
+for ``vessels.self`` with policy ``instant`` (every update as it comes), to :data:`INPUT_PATHS`: ``navigation.headingTrue`` and
 ``navigation.headingMagnetic`` (+ ``navigation.magneticVariation`` to turn it true),
 ``navigation.position``, ``navigation.rateOfTurn`` and ``steering.rudderAngle`` (SI: radians,
 rad/s, degrees of latitude/longitude). Every delta is checked (:func:`input_values`: finite,
@@ -88,7 +88,10 @@ class SignalKInput:
 
         url = f"ws://{self.host}:{self.port}/signalk/v1/stream?subscribe=none"
         said = False
-        sub = json.dumps({"context": "vessels.self", "subscribe": [{"path": p} for p in INPUT_PATHS]})
+        # policy "instant": every update as it comes (the specification's default, "ideal" with a
+        # 1000 ms period, would give the heading once a second, far too late to steer by)
+        sub = json.dumps({"context": "vessels.self",
+                          "subscribe": [{"path": p, "policy": "instant"} for p in INPUT_PATHS]})
         while True:
             try:
                 async with connect(url, open_timeout=10, max_size=1 << 20) as ws:
