@@ -51,7 +51,7 @@ async def _run(controller, log, duration, ap_kwargs, ap_cfg, tasks=(), speedup=S
     ctx = {"server": server, "ap": ap}
     running = [asyncio.create_task(t(ctx)) for t in tasks]
     try:
-        await asyncio.wait_for(ap.run(duration), timeout=duration / speedup + 60.0)   # hang guard
+        await asyncio.wait_for(ap.run(duration), timeout=duration / speedup + 120.0)  # hang guard (0: until stopped)
         for t in running:
             if t.done() and not t.cancelled() and t.exception() is not None:
                 raise t.exception()
@@ -61,6 +61,13 @@ async def _run(controller, log, duration, ap_kwargs, ap_cfg, tasks=(), speedup=S
         server.stop()
         await srv
     return ctx
+
+
+async def _port_open(ap):
+    """Until the autopilot has the serial port open (pyserial empties the input buffer on
+    opening: a line written before would be lost)."""
+    while not ap.nmea_stream_inputs or not ap.nmea_stream_inputs[0].link.connected:
+        await asyncio.sleep(0.005)
 
 
 def test_hdg_compass_on_a_pty_steers_the_ship_to_the_set_course(controller, tmp_path):  # noqa: F811
@@ -75,13 +82,15 @@ def test_hdg_compass_on_a_pty_steers_the_ship_to_the_set_course(controller, tmp_
 
     async def compass(ctx):
         server, ap = ctx["server"], ctx["ap"]
+        await _port_open(ap)
         while True:
             psi = server.state().psi
             true_track.append((ap.clock(), math.degrees(psi)))
             os.write(master, _hdg_line(psi))
             await asyncio.sleep(0.1 / SPEEDUP)                # 10 Hz of ship time
 
-    cfg = AutopilotConfig(speedup=SPEEDUP, watchdog_timeout=3.0, nmea_timeout=3.0)
+    # 5 s of ship time (0.5 s wall) before the compass counts as stale: a loaded machine's stalls
+    cfg = AutopilotConfig(speedup=SPEEDUP, watchdog_timeout=3.0, nmea_timeout=5.0)
     try:
         ctx = asyncio.run(_run(controller, tmp_path / "ap.csv", 40.0,
                                {"nmea_streams": [lambda cb: NmeaSerialInput(path, 4800, cb)]}, cfg,
@@ -93,7 +102,9 @@ def test_hdg_compass_on_a_pty_steers_the_ship_to_the_set_course(controller, tmp_
     steered = [r for r in rows if r["t"] > 2.0 and r["link_ok"]]
     by_compass = sum(r["heading_source"] == "nmea" for r in steered)
     assert by_compass >= 0.9 * len(steered), (by_compass, len(steered))
-    assert ap.nmea_counts["accepted"] > 200 and ap.nmea_counts.get("malformed", 0) == 0
+    written = len(true_track)
+    assert written > 30 and ap.nmea_counts["accepted"] >= written - 5          # every line read, but the last
+    assert ap.nmea_counts.get("malformed", 0) == 0
     end = [psi for t, psi in true_track if t >= 30.0]
     assert len(end) > 30 and max(abs(psi - 30.0) for psi in end) < 1.5, max(abs(psi - 30.0) for psi in end)
     # the compass heading the autopilot read is the true one (not the sensor's magnetic reading)
@@ -113,24 +124,33 @@ def test_garbage_and_a_vanishing_compass_are_counted_and_the_state_heading_takes
 
     async def compass(ctx):
         server, ap = ctx["server"], ctx["ap"]
-        k = 0
-        while ap.clock() < 8.0:
+        await _port_open(ap)
+        marks["rounds"] = 0
+        for k in range(40):
             os.write(master, _hdg_line(server.state().psi))
             if k % 10 == 3:
+                marks["rounds"] += 1
                 os.write(master, b"\x00\xff\xfe$HCHDG,1*ZZ\r\n$HCHDG,garbage*ZZ\r\n%!~#\r\n" + bytes(range(128, 160)) + b"\r\n")
             if k == 5:
                 os.write(master, b"A" * 5000)                                          # no line end
                 os.write(master, b"\r\n")
                 os.write(master, nmea.render("RMC", ["120000", "A", "5430.0000", "N", "01854.0000", "E", "5.0",
                                                      "10.0", "281126", "45.0", "W"], "GP").encode())
-            k += 1
             await asyncio.sleep(0.1 / SPEEDUP)
+        while ap.nmea_counts["accepted"] + ap.nmea_counts["variation_out_of_range"] < 41:
+            await asyncio.sleep(0.002)                   # the last lines read (the hang guard bounds it)
         marks["rejected_before_loss"] = dict(ap.nmea_counts)
         marks["t_gone"] = ap.clock()
         os.close(master)                                 # the device vanishes
         marks["closed"] = True
+        while not ap.alarms.active(heading_alarm("nmea")):
+            await asyncio.sleep(0.01)
+        t_alarm = ap.clock()
+        while ap.clock() < t_alarm + 3.0:                # 3 s of ship time steered by the state heading
+            await asyncio.sleep(0.01)
+        ap.stop()
 
-    cfg = AutopilotConfig(speedup=SPEEDUP, watchdog_timeout=3.0, nmea_timeout=1.0)
+    cfg = AutopilotConfig(speedup=SPEEDUP, watchdog_timeout=3.0, nmea_timeout=3.0)
     stream = {}
 
     def make(cb):
@@ -138,20 +158,21 @@ def test_garbage_and_a_vanishing_compass_are_counted_and_the_state_heading_takes
         return stream["s"]
 
     try:
-        ctx = asyncio.run(_run(controller, tmp_path / "ap.csv", 16.0, {"nmea_streams": [make]}, cfg, [compass]))
+        ctx = asyncio.run(_run(controller, tmp_path / "ap.csv", 0.0, {"nmea_streams": [make]}, cfg, [compass]))
     finally:
         if not marks.get("closed"):
             os.close(master)
     ap = ctx["ap"]
     counts = marks["rejected_before_loss"]
-    assert counts["malformed"] >= 5 and counts["not_ascii"] >= 5 and counts["variation_out_of_range"] == 1
-    assert counts["accepted"] > 50
+    n = marks["rounds"]                              # 2 non-ASCII and 2 malformed lines a round
+    assert n == 4 and counts["malformed"] == 2 * n and counts["not_ascii"] == 2 * n
+    assert counts["variation_out_of_range"] == 1 and counts["accepted"] == 40
     assert stream["s"].counts["lost"] == 1 and stream["s"].counts["overlong"] >= 1
     assert sum("lost" in ln for ln in log_lines) == 1 and all("\n" not in ln for ln in log_lines)
     raised = [t for t, n, w in ap.alarms.history if n == heading_alarm("nmea") and w == "raised"]
     assert raised and raised[-1] >= marks["t_gone"]
     rows = _read_log(tmp_path / "ap.csv")
-    late = [r for r in rows if r["t"] > marks["t_gone"] + 2.0]
+    late = [r for r in rows if r["t"] > raised[-1]]
     assert late and all(r["heading_source"] == "state" and r["mode"] == "auto" for r in late)
     assert all("heading_nmea" in r["alarms"] for r in late)
 
