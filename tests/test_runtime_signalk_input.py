@@ -93,7 +93,7 @@ def test_a_signalk_server_feeding_heading_and_position_steers_the_ship(controlle
     by_signalk = sum(r["heading_source"] == "signalk" for r in steered)
     assert by_signalk >= 0.9 * len(steered), (by_signalk, len(steered), dict(ap.signalk_source.counts))
     end = [r for r in rows if r["t"] >= 30.0 and r["heading_source"] == "signalk"]
-    assert len(end) > 30 and max(abs(r["psi_deg"] - 30.0) for r in end) < 1.5
+    assert len(end) >= 10 and max(abs(r["psi_deg"] - 30.0) for r in end) < 1.5
     lat, lon = ap.signalk_nav["navigation.position"]             # RMC, through the server's parser
     assert abs(lat - DEFAULT_ORIGIN[0]) < 0.05 and abs(lon - DEFAULT_ORIGIN[1]) < 0.05
     assert "steering.rudderAngle" in ap.signalk_nav and "navigation.rateOfTurn" in ap.signalk_nav
