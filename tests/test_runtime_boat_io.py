@@ -275,7 +275,7 @@ def test_actuator_losing_feedback_mid_turn_gives_alarm_and_safe_state(controller
     ctx, rows, drive = _actuator_session(controller, tmp_path, ["--lose-feedback-above", "8"], 7.0)
     ap = ctx["ap"]
     assert "fault injected: feedback lost" in ctx["emulator_out"]
-    assert drive.counts["feedback"] >= 5 and drive.counts.get("malformed", 0) == 0
+    assert drive.counts["feedback"] >= 2 and drive.counts.get("malformed", 0) == 0
     last_feedback = drive.monitor.angle[1]
     assert math.degrees(abs(drive.monitor.angle[0])) > 5.0          # it was turning when lost
     raised = ap.alarms.first_raised(ACTUATOR)
