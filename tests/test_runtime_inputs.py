@@ -67,8 +67,10 @@ def test_good_sentences_are_accepted_and_others_ignored():
     lines = [_r("THS", ["359.99", "A"]), _r("HDT", ["360.0", "T"]), _r("APB", APB_T),
              _r("HTC", ["V", "", "", "H", "N", "", "", "", "", "123.4", "", "", "T"]),
              _r("XTE", ["A", "A", "0.1", "L", "N"]), _r("RSA", ["1.0", "A", "", "V"])]
-    got = nmea.steering_inputs("".join(lines).encode())
-    assert got["accepted"] == 5 and got["ignored"] == 1 and got["rejected"] == 0
+    got = nmea.steering_inputs("".join(lines + [_r("VTG", ["10.0", "T", "", "M", "5.0", "N", "9.3", "K", "A"])]).encode())
+    # RSA is read (rudder feedback, issue 33); VTG is valid but not used
+    assert got["accepted"] == 6 and got["ignored"] == 1 and got["rejected"] == 0
+    assert got["rudder"] == pytest.approx(math.radians(1.0))
     assert got["heading"] == 0.0                                 # 360 deg = north
     assert got["course"] == pytest.approx(math.radians(50.0)) and got["course_source"] == "APB"
     assert got["xte_m"] == pytest.approx(185.2)

@@ -66,8 +66,8 @@ def test_registered_sentences_round_trip():
 def test_steering_inputs_heading_and_plotter_course():
     got = nmea.steering_inputs("".join(nmea.state_sentences(STATE, wall=WALL)).encode())
     assert got["heading"] == pytest.approx(math.radians(350.0)) and got["course"] is None
-    # HDT and THS are read; ROT, RSA, RMC, VTG are valid but not used by the autopilot
-    assert got["accepted"] == 2 and got["ignored"] == 4 and got["rejected"] == 0
+    # HDT, THS and RSA (rudder feedback) are read; ROT, RMC (no variation), VTG are valid but not used
+    assert got["accepted"] == 3 and got["ignored"] == 3 and got["rejected"] == 0
     apb = nmea.render("APB", ["A", "A", "0.10", "R", "N", "V", "V", "45.0", "T", "WP1", "44.0", "T", "50.0", "T"])
     assert nmea.steering_inputs(apb.encode())["course"] == pytest.approx(math.radians(50.0))   # heading to steer
     apb = nmea.render("APB", ["A", "A", "0.10", "R", "N", "V", "V", "45.0", "T", "WP1", "44.0", "T", "", ""])

@@ -12,6 +12,8 @@ EXAMPLES = """examples:
   steerlab autopilot --connect 127.0.0.1:47110 --controller pid --heading 0 --web 127.0.0.1:8080
   steerlab autopilot --connect 127.0.0.1:47110 --controller pid --nmea-listen 127.0.0.1:10111   # follow OpenCPN APB/RMB
   steerlab autopilot --connect 127.0.0.1:47110 --controller pid --signalk-ws 127.0.0.1:3000      # Signal K WebSocket
+  steerlab autopilot --connect 127.0.0.1:47110 --heading 90 --nmea-serial /dev/ttyUSB0:4800 --variation -3.5  # HDG compass
+  steerlab autopilot --connect 127.0.0.1:47110 --heading 90 --nmea-tcp 192.168.1.5:10110 --actuator serial:/dev/ttyUSB1:38400
 
 The controller is designed for the scenario's ship (--scenario, default: the bundled one); use
 the same scenario as serve-ship. Every sample is logged to --log (CSV). docs/runtime.md"""
@@ -56,6 +58,21 @@ def register(sub, formatter_class) -> None:
     p.add_argument("--input-rate", type=float, default=100.0,
                    help="NMEA / Signal K UDP datagrams accepted per source per ship second (burst as many; "
                         "more are counted rate_limited; 0: no limit; default 100)")
+    p.add_argument("--nmea-serial", action="append", default=[], metavar="PATH[:BAUD]",
+                   help="read NMEA 0183 from a serial port (default 4800 baud; repeatable)")
+    p.add_argument("--nmea-tcp", action="append", default=[], metavar="HOST:PORT",
+                   help="read NMEA 0183 from a TCP talker (conventionally port 10110; reconnects; repeatable)")
+    p.add_argument("--nmea-tcp-listen", metavar="HOST:PORT",
+                   help="accept NMEA 0183 talkers on this TCP port (conventionally 10110)")
+    p.add_argument("--variation", type=float, default=None,
+                   help="magnetic variation [deg], > 0 east, within +-30: turns HDM/HDG and magnetic APB/HTC true "
+                        "when neither the HDG sentence nor an RMC gives one")
+    p.add_argument("--actuator", default="sim", metavar="NAME[:ARG]",
+                   help="rudder drive: 'sim' (COMMAND datagrams to --connect, default), 'serial:PATH[:BAUD]' "
+                        "(steerlab's line protocol, docs/runtime.md), or a steerlab.actuators entry point")
+    p.add_argument("--signalk-input", metavar="HOST:PORT",
+                   help="subscribe to this Signal K server's stream for heading (true or magnetic), variation, "
+                        "position, rate of turn and rudder angle")
     p.add_argument("--signalk-listen", metavar="HOST:PORT", help="UDP port for Signal K deltas (target heading, state)")
     p.add_argument("--signalk-to", metavar="HOST:PORT", help="send Signal K autopilot deltas here")
     p.add_argument("--signalk-ws", metavar="HOST:PORT",
@@ -93,6 +110,7 @@ def build_autopilot(args):
             raise InputError("--route", f"cannot read {args.route!r}: {err.strerror}") from None
     if args.heading is not None:
         require_finite_range("--heading", args.heading, -360.0, 360.0)
+    streams, actuator, variation = boat_inputs(args)
     turn = scenario.guidance.rate_max_deg_s if args.turn_rate is None else args.turn_rate
     require_finite_range("--turn-rate", turn, 0.0, 30.0)
     require_finite_range("--off-course-deg", args.off_course_deg, 0.0, 180.0, lo_open=True)
@@ -101,7 +119,8 @@ def build_autopilot(args):
                           turn_rate=rad(turn), max_age=args.max_age,
                           rpm_cmd=math.nan if args.rpm is None else args.rpm, xte_lookahead=args.xte_lookahead,
                           nmea_heading_over_signed=args.nmea_heading_over_signed, input_rate=args.input_rate,
-                          input_burst=max(1.0, args.input_rate)).validate()
+                          input_burst=max(1.0, args.input_rate),
+                          variation=math.nan if variation is None else rad(variation)).validate()
     ctrl = ControllerRuntime(scenario, args.controller, args.sample_time)   # compiles on first use: checks first
     route = (route_guidance(scenario, ctrl.setup.ship, ctrl.setup.ps, args.route, args.lookahead_L,
                             args.accept_radius) if args.route else None)
@@ -124,8 +143,47 @@ def build_autopilot(args):
                    nmea_listen=hp(args.nmea_listen, "--nmea-listen"), nmea_to=hp(args.nmea_to, "--nmea-to"),
                    signalk_listen=hp(args.signalk_listen, "--signalk-listen"),
                    signalk_to=hp(args.signalk_to, "--signalk-to"), signalk_ws=signalk_ws,
-                   allow_origins=origins)
+                   allow_origins=origins, nmea_streams=streams, actuator=actuator,
+                   signalk_input=hp(args.signalk_input, "--signalk-input"))
     return ap, web
+
+
+def boat_inputs(args):
+    """``(nmea stream factories, actuator driver, variation [deg] or None)`` of ``args``
+    (--nmea-serial, --nmea-tcp, --nmea-tcp-listen, --actuator, --variation), every one checked
+    before the controller compiles: a missing device or a bad value is one line."""
+    import os
+
+    from steerlab.errors import InputError
+    from steerlab.runtime.actuator import load_actuator
+    from steerlab.runtime.nmea_magnetic import check_variation_option
+    from steerlab.runtime.nmea_streams import NmeaSerialInput, NmeaTcpClient, NmeaTcpServer
+    from steerlab.runtime.serial_port import parse_serial_spec
+    from steerlab.runtime.udp import is_loopback, parse_hostport
+
+    variation = check_variation_option(args.variation)
+    streams = []
+    for spec in args.nmea_serial:
+        path, baud = parse_serial_spec(spec, "--nmea-serial")
+        if not os.path.exists(path):
+            raise InputError("--nmea-serial", f"no such device {path!r}")
+        streams.append(lambda cb, path=path, baud=baud: NmeaSerialInput(path, baud, cb))
+    for spec in args.nmea_tcp:
+        host, port = parse_hostport(spec, "--nmea-tcp")
+        if port == 0:
+            raise InputError("--nmea-tcp", "port must be in [1, 65535] (NMEA over TCP: conventionally 10110)")
+        streams.append(lambda cb, host=host, port=port: NmeaTcpClient(host, port, cb))
+    if args.nmea_tcp_listen:
+        host, port = parse_hostport(args.nmea_tcp_listen, "--nmea-tcp-listen")
+        if not is_loopback(host):
+            print(f"autopilot: warning: --nmea-tcp-listen on {host} takes heading and course sentences from the "
+                  "network without authentication", file=sys.stderr)
+        streams.append(lambda cb, host=host, port=port: NmeaTcpServer(host, port, cb))
+    actuator = load_actuator(args.actuator)
+    path = getattr(actuator, "path", None)
+    if path is not None and not os.path.exists(path):
+        raise InputError("--actuator", f"no such device {path!r}")
+    return streams, actuator, variation
 
 
 async def run_with_web(ap, web, duration, started=None):

@@ -12,6 +12,7 @@ from dataclasses import dataclass
 LINK = "link"            #: no valid ship state for longer than the watchdog time
 OFF_COURSE = "off_course"  #: heading deviates from the set course by more than the limit
 ARRIVAL = "arrival"      #: the chart plotter's destination waypoint was reached: the last course is held
+ACTUATOR = "actuator"    #: the actuator driver reports a fault: safe action ordered, autopilot disengaged
 
 
 @dataclass

@@ -35,6 +35,15 @@ ship seconds (freshness limits on datagram stamps are in wall seconds). Samples 
 sample) the missed samples are **skipped**, not replayed: one sample runs at once with the
 newest state, at the latest due slot, so the sample clock keeps its phase and the ship never
 gets a burst of orders computed from one old state (``skipped`` counts them).
+
+From the simulator to a boat (issue 33): NMEA also comes over a serial port or TCP
+(``nmea_streams``, :mod:`steerlab.runtime.nmea_streams`); magnetic compasses (HDG/HDM) and
+magnetic plotter courses are turned true with the variation (:mod:`steerlab.runtime.nmea_magnetic`);
+each heading source has a health state and the first fresh one of the priority steers
+(:mod:`steerlab.runtime.heading_health`); an RSA rudder angle, while fresh, is the measured
+rudder angle; orders go out through an actuator driver (:mod:`steerlab.runtime.actuator`,
+the simulator link by default), and a fault it reports while engaged gives the ``actuator``
+alarm and the safe state: the safe action ordered, disengaged.
 """
 
 from __future__ import annotations
@@ -53,7 +62,8 @@ from steerlab.errors import InputError, require_finite_range
 from steerlab.guidance.reference_models import course_reference, course_schedule
 from steerlab.guidance.reference_vector import REF_LEG, REF_PSI, REF_R, REF_XTE, initial_reference
 from steerlab.runtime import protocol as P
-from steerlab.runtime.alarms import ARRIVAL, LINK, OFF_COURSE, AlarmBoard
+from steerlab.runtime.alarms import ACTUATOR, ARRIVAL, LINK, OFF_COURSE, AlarmBoard
+from steerlab.runtime.heading_health import HEADING_PRIORITY, MAX_TURN_RATE, HeadingHealth, select_heading
 from steerlab.runtime.link_filter import LinkFilter
 from steerlab.runtime.rate_limit import RateLimiter
 from steerlab.runtime.signalk import AUTOPILOT_STATE, TARGET_HEADING
@@ -105,6 +115,8 @@ class AutopilotConfig:
     input_rate: float = 100.0           #: NMEA / Signal K UDP datagrams per source per ship second
     input_burst: float = 100.0          #: token bucket size of that limit [datagrams]
     xte_lookahead: float = 500.0        #: cross-track correction lookahead for RMB/XTE [m]
+    variation: float = math.nan         #: configured magnetic variation [rad], > 0 east; NaN: none
+    heading_max_rate: float = MAX_TURN_RATE  #: a heading source changing faster is implausible [rad/s]
 
     def validate(self) -> "AutopilotConfig":
         require_finite_range("--sample-time", self.sample_time, 0.001, 60.0)
@@ -120,6 +132,11 @@ class AutopilotConfig:
         require_finite_range("--xte-lookahead", self.xte_lookahead, 1.0, 1e5)
         require_finite_range("--input-rate", self.input_rate, 0.0, 1e6)
         require_finite_range("--input-burst", self.input_burst, 1.0, 1e6)
+        if not math.isnan(self.variation):
+            from steerlab.runtime.nmea_magnetic import check_variation_option
+
+            check_variation_option(deg(self.variation))
+        require_finite_range("--heading-max-rate", self.heading_max_rate, 0.0, 10.0, lo_open=True)
         return self
 
 
@@ -152,12 +169,21 @@ class Autopilot:
         ship state and autopilot paths each sample; PUT of the target heading and state.
     allow_origins : sequence of str
         Browser origins allowed on the Signal K stream besides loopback pages.
+    nmea_streams : sequence
+        NMEA inputs over byte streams, each a factory ``f(on_datagram)`` of an object with
+        ``async start()`` / ``async close()`` (:mod:`steerlab.runtime.nmea_streams`: serial,
+        TCP client, TCP server); their lines go to :meth:`on_nmea_datagram`.
+    actuator : steerlab.runtime.actuator.Actuator or None
+        The rudder drive; None: the simulator link (COMMAND datagrams to ``connect``).
+    signalk_input : (host, port) or None
+        Subscribe to this Signal K server's stream for heading, variation, position, rate of
+        turn and rudder angle (:mod:`steerlab.runtime.signalk_input`).
     """
 
     def __init__(self, controller, connect, config: AutopilotConfig = AutopilotConfig(),
                  heading=None, route=None, key=None, log_path=None, engaged=True,
                  nmea_listen=None, signalk_listen=None, signalk_to=None, nmea_to=None, bind=None,
-                 signalk_ws=None, allow_origins=()):
+                 signalk_ws=None, allow_origins=(), nmea_streams=(), actuator=None, signalk_input=None):
         self.ctrl = controller
         self.connect = connect
         self.config = cfg = config.validate()
@@ -197,6 +223,20 @@ class Autopilot:
         self.signalk_counts: Counter = Counter(accepted=0)
         self.nmea_limiter = RateLimiter(cfg.input_rate * cfg.speedup, cfg.input_burst)
         self.signalk_limiter = RateLimiter(cfg.input_rate * cfg.speedup, cfg.input_burst)
+        self.heading_health = {n: HeadingHealth(n, cfg.nmea_timeout, cfg.heading_max_rate) for n in ("nmea", "signalk")}
+        self.signalk_input = signalk_input
+        self.signalk_source = None
+        self.signalk_nav: dict = {}    # the newest Signal K input values by path (position, rate of turn)
+        self.rmc_variation = None      # (variation [rad], t) of the newest RMC that gave one
+        self.rudder_feedback = None    # (rudder angle [rad], t) of the newest RSA
+        self.nmea_stream_factories = tuple(nmea_streams)
+        self.nmea_stream_inputs: list = []
+        if actuator is None:
+            from steerlab.runtime.actuator_sim import SimLinkActuator
+
+            actuator = SimLinkActuator()
+        self.actuator = actuator
+        self.actuator_safe = False     # latched by an actuator fault while engaged
         self.track: deque = deque(maxlen=4000)
         self.last_row: dict = {}
         self.nmea_listen = nmea_listen
@@ -242,20 +282,53 @@ class Autopilot:
         if not self.nmea_limiter.allow(addr, time.monotonic()):
             self.nmea_counts["rate_limited"] += 1
             return
+        from steerlab.runtime.nmea_magnetic import variation_in_effect
+
         t = self.clock() if t is None else t
-        got = steering_inputs(data, self.config.xte_lookahead)
+        got = steering_inputs(data, self.config.xte_lookahead,
+                              variation_in_effect(self.rmc_variation, self.config.variation, t))
         self.nmea_counts["accepted"] += got["accepted"]
         if got["ignored"]:
             self.nmea_counts["ignored"] += got["ignored"]
         self.nmea_counts.update(got["reasons"])
+        if got["variation"] is not None:
+            self.rmc_variation = (got["variation"], t)
+        if got["rudder"] is not None:
+            self.rudder_feedback = (got["rudder"], t)
         if got["heading"] is not None:
-            self.nmea_heading = (got["heading"], t)
+            if self.heading_health["nmea"].observe(got["heading"], t):
+                self.nmea_heading = (got["heading"], t)
+            else:
+                self.nmea_counts["implausible"] += 1
         if got["course"] is not None:
             self.nmea_course = (got["course"], t)
         for kind, c in got.get("courses", {}).items():
             self.nmea_courses[kind] = (c["course"], t, c["dest"], c["arrived"])
             if c["arrived"]:
                 self.arrived[kind] = c["dest"]
+
+    def on_signalk_values(self, values: dict, t: float | None = None) -> None:
+        """Checked values of the Signal K input (:func:`steerlab.runtime.signalk_input.input_values`):
+        a true heading, or a magnetic one turned true with the variation in effect, goes to the
+        ``signalk`` heading source; ``navigation.magneticVariation`` is held as an RMC's is; the
+        rudder angle is rudder feedback."""
+        from steerlab.runtime.nmea_magnetic import variation_in_effect
+
+        t = self.clock() if t is None else t
+        self.signalk_nav.update(values)
+        if "navigation.magneticVariation" in values:
+            self.rmc_variation = (values["navigation.magneticVariation"], t)
+        psi = values.get("navigation.headingTrue")
+        if psi is None and "navigation.headingMagnetic" in values:
+            var = variation_in_effect(self.rmc_variation, self.config.variation, t)
+            if var is None:
+                self.signalk_counts["magnetic"] += 1
+            else:
+                psi = values["navigation.headingMagnetic"] + var
+        if psi is not None and not self.heading_health["signalk"].observe(wrap_to_pi(psi), t):
+            self.signalk_counts["implausible"] += 1
+        if "steering.rudderAngle" in values:
+            self.rudder_feedback = (values["steering.rudderAngle"], t)
 
     def on_signalk_datagram(self, data: bytes, addr=None, t: float | None = None) -> None:
         from steerlab.runtime.signalk import parse_delta
@@ -376,10 +449,8 @@ class Autopilot:
         """``(heading [rad], source)``: a fresh NMEA HDT/THS heading, unless the ship state is
         signed (a key) and ``nmea_heading_over_signed`` is off: then the signed state's heading,
         so an unauthenticated sender on the NMEA port cannot steer the ship by a false heading."""
-        fresh = self.nmea_heading is not None and t - self.nmea_heading[1] <= self.config.nmea_timeout
-        if fresh and (not self.key or self.config.nmea_heading_over_signed):
-            return self.nmea_heading[0], "nmea"
-        return self.latest.psi, "state"
+        order = HEADING_PRIORITY if (not self.key or self.config.nmea_heading_over_signed) else ("state",)
+        return select_heading(t, order, self.heading_health, self.latest.psi, self.alarms)
 
     def sample(self, t: float, now: float | None = None) -> dict:
         """Run one sample at ship time ``t`` (the clock reads ``now``, default ``t``).
@@ -397,7 +468,10 @@ class Autopilot:
         if link_ok:
             psi, src = self._heading(t)
             self.steered = (psi, src)
-            x = self.ctrl.measured_state(st.x_n, st.y_e, psi, st.u, st.v, st.r, st.delta)
+            rudder = st.delta
+            if self.rudder_feedback is not None and t - self.rudder_feedback[1] <= cfg.nmea_timeout:
+                rudder = self.rudder_feedback[0]        # a fresh RSA: the rudder's own sensor
+            x = self.ctrl.measured_state(st.x_n, st.y_e, psi, st.u, st.v, st.r, rudder)
             self.track.append((st.x_n, st.y_e))
             if self.route is not None:       # the simulator's guidance kernel, same call
                 self.route.guide(t, x, self.route.gd, self.gz, self.ref, cfg.sample_time)
@@ -436,6 +510,7 @@ class Autopilot:
             self.engaged = False          # reset the controller on the next valid state
         else:
             self.mode = "standby"
+        cmd = self._actuator_guard(t, cmd)
         if cmd is not None:
             self.last_cmd = cmd
         self.cmd_sent = cmd
@@ -461,6 +536,23 @@ class Autopilot:
         }
         self.last_row = row
         return row
+
+    def _actuator_guard(self, t: float, cmd):
+        """The order after the actuator's faults: a fault while engaged (or while the safe state
+        it caused lasts) gives the ``actuator`` alarm, the safe action and disengagement; the
+        safe state ends (standby) when the faults clear."""
+        faults = self.actuator.faults(t)
+        self.alarms.set(ACTUATOR, bool(faults), t, "actuator: " + "; ".join(faults.values()))
+        if faults and (self.engaged or self.actuator_safe):
+            self.actuator_safe = True
+            self.want_engaged = self.engaged = False
+            self.mode = "safe"
+            return 0.0 if self.config.safe_action == "midships" else self.last_cmd
+        if self.actuator_safe:
+            self.actuator_safe = False
+            self.mode = "standby"
+            return None
+        return cmd
 
     def order(self):
         """The datagram body for the last sample's order, or None (standby: nothing sent)."""
@@ -509,13 +601,21 @@ class Autopilot:
             "track": self._track_summary(),
             "off_course_limit": self.config.off_course_limit,
             "ship_status": None if st is None else st.status,
+            "heading_sources": {n: h.status(r.get("t", 0.0)) for n, h in self.heading_health.items()},
+            "variation": self._variation_now(),
+            "rudder_feedback": None if self.rudder_feedback is None else self.rudder_feedback[0],
+            "actuator": {"name": self.actuator.name, "rudder": self.actuator.rudder(r.get("t", 0.0)),
+                         "faults": self.actuator.faults(r.get("t", 0.0))},
         }
+
+    def _variation_now(self):
+        from steerlab.runtime.nmea_magnetic import variation_in_effect
+
+        return variation_in_effect(self.rmc_variation, self.config.variation, self.last_row.get("t", 0.0))
 
     # ------------------------------------------------------------ I/O
     def _send_order(self, t: float) -> None:
-        body = self.order()
-        if body is not None:
-            send(self.transport, self.sender.pack(body, time.time()), self.connect)
+        self.actuator.order(self.order(), t)
         if self.nmea_to is not None:
             from steerlab.runtime.nmea import htd_sentence
 
@@ -580,6 +680,15 @@ class Autopilot:
                         self._listeners.append(await open_udp(cb, addr))
                     except OSError as err:
                         raise InputError(field, f"cannot bind {addr[0]}:{addr[1]}: {err.strerror}") from None
+            for make in self.nmea_stream_factories:
+                stream = make(self.on_nmea_datagram)
+                self.nmea_stream_inputs.append(stream)
+                await stream.start()
+            await self.actuator.start(self)
+            if self.signalk_input is not None:
+                from steerlab.runtime.signalk_input import SignalKInput
+
+                self.signalk_source = await SignalKInput(*self.signalk_input, self.on_signalk_values).start()
             if self.signalk_ws is not None:
                 from steerlab.runtime.signalk import autopilot_put
                 from steerlab.runtime.signalk_ws import SignalKStreamServer
@@ -607,6 +716,14 @@ class Autopilot:
                 k = self._next_sample(k, (loop.time() - t_start) / wall_h)
                 await asyncio.sleep(max(0.0, t_start + k * wall_h - loop.time()))
         finally:
+            try:
+                await self.actuator.close()
+            except Exception:           # a port already gone: nothing more to release
+                pass
+            for stream in self.nmea_stream_inputs:
+                await stream.close()
+            if self.signalk_source is not None:
+                await self.signalk_source.close()
             for tr in [self.transport, *self._listeners]:
                 if tr is not None:
                     tr.close()

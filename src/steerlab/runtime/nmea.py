@@ -12,7 +12,10 @@ Out (ship server, every ``nmea_period``): ``HDT``, ``THS``, ``ROT`` (deg/min, < 
 approximation fine for a few tens of km; course and speed over ground from ``u, v, psi``).
 The autopilot can send ``HTD`` (its set course and rudder order).
 
-In (autopilot): ``HDT``/``THS`` give the heading; ``APB`` ("heading to steer" if given,
+In (autopilot): ``HDT``/``THS`` give the heading, and so do the magnetic compass sentences
+``HDG``/``HDM`` turned true with the magnetic variation (its own field in HDG, the newest RMC's,
+or the configured one: :mod:`steerlab.runtime.nmea_magnetic`); ``RSA`` gives the rudder angle
+(feedback, starboard sensor, > 0 to starboard); ``APB ("heading to steer" if given,
 else "bearing present position to destination"), ``RMB`` (true bearing to destination) and
 ``HTC`` (heading to steer) give the set course. A bearing is corrected for the sentence's own
 cross-track error ``xte`` with direction to steer L/R: ``course = bearing ± atan(xte / lookahead)``.
@@ -22,8 +25,9 @@ Checks (plausibility and range, :func:`steering_inputs`): a line needs a valid c
 sentences the autopilot reads, every direction must be a number in [0, 360] deg (a THS heading of
 1e300 or an HTC course of 1e5 is rejected, as is NaN), a cross-track error at most
 :data:`MAX_XTE_NMI`, status and mode letters from the standard's set (``V``, data invalid, rejects;
-THS modes A/E/M/S), and the course a true one (an APB that gives only magnetic bearings is
-rejected as ``magnetic``, never accepted and ignored). Each rejected line is counted once under its
+THS modes A/E/M/S), and the course a true one or a magnetic one with a known variation (an APB or HTC that gives only
+magnetic bearings while no variation is known is rejected as ``magnetic``, never accepted and
+ignored). Each rejected line is counted once under its
 reason (:data:`REJECT_REASONS`), lines past :data:`MAX_LINES` in one datagram too; nothing raises.
 
 Course source priority (:data:`COURSE_PRIORITY`): **APB > RMB > HTC**. A plotter that sends
@@ -45,6 +49,7 @@ from pynmea2 import TalkerSentence
 
 from steerlab.units import KNOT, deg, rad
 from steerlab.guidance.los import los_heading
+from steerlab.runtime.nmea_magnetic import MagneticRejected, compass_heading, rmc_variation, true_from_magnetic
 
 EARTH_RADIUS = 6_371_000.0
 MAX_LINE = 96
@@ -222,7 +227,8 @@ REJECT_REASONS = {
     "bad_field": "a number that does not parse, or a status/mode/unit letter outside the standard's set",
     "out_of_range": f"a direction outside [0, 360] deg or a cross-track error above {MAX_XTE_NMI:g} nmi",
     "invalid_status": "the sender flags the data invalid (status or mode V)",
-    "magnetic": "a magnetic direction only (the autopilot steers true courses)",
+    "magnetic": "a magnetic direction only and no magnetic variation known (HDG's own, RMC's or --variation)",
+    "variation_out_of_range": "a magnetic variation or compass deviation beyond +-30 deg",
     "not_heading_mode": "HTC with manual override in use or a steering mode other than heading/track (H, S, T)",
 }
 """Why a line was rejected (the keys of the rejection counts, :func:`steering_inputs`)."""
@@ -267,10 +273,11 @@ def _xte_checked(magnitude, unit: str | None, steer) -> float | None:
     return m * (1000.0 if unit == "K" else 1852.0)
 
 
-def _course_from(s, lookahead: float):
+def _course_from(s, lookahead: float, variation=None):
     """The set course [rad] of an APB, RMB or HTC sentence; raises :class:`Rejected` with the
     reason when the sentence is flagged invalid, magnetic only, out of range or not a heading
-    command (a plotter's course is never silently dropped)."""
+    command (a plotter's course is never silently dropped). A magnetic direction is turned true
+    with ``variation`` [deg, > 0 east] when it is known."""
     kind = type(s).__name__
     if kind == "APB":
         _status_ok(s.status_gen, s.status_cycle_lock)
@@ -278,13 +285,20 @@ def _course_from(s, lookahead: float):
         kinds = (s.heading_to_dest_type, s.bearing_type, s.bearing_pres_dest_type)
         if any(k not in ("T", "M", "", None) for k in kinds):
             raise Rejected("bad_field")
-        if s.heading_to_dest_type == "T" and _direction(s.heading_to_dest, False) is not None:
-            return rad(_direction(s.heading_to_dest))
+        def usable(kind_letter):
+            return kind_letter == "T" or (kind_letter == "M" and variation is not None)
+
+        def true_deg(value, kind_letter):
+            return value if kind_letter == "T" else true_from_magnetic(value, variation)
+
+        if usable(s.heading_to_dest_type) and _direction(s.heading_to_dest, False) is not None:
+            return rad(true_deg(_direction(s.heading_to_dest), s.heading_to_dest_type))
         # the LOS law steers by the leg's course (origin -> destination), as the simulator does
-        if s.bearing_type == "T" and _direction(s.bearing_to_dest, False) is not None:
-            return _corrected(_direction(s.bearing_to_dest), xte, s.dir_steer, lookahead)
-        if s.bearing_pres_dest_type == "T":
-            return _corrected(_direction(s.bearing_pres_dest), xte, s.dir_steer, lookahead)
+        if usable(s.bearing_type) and _direction(s.bearing_to_dest, False) is not None:
+            return _corrected(true_deg(_direction(s.bearing_to_dest), s.bearing_type), xte, s.dir_steer, lookahead)
+        if usable(s.bearing_pres_dest_type):
+            return _corrected(true_deg(_direction(s.bearing_pres_dest), s.bearing_pres_dest_type), xte,
+                              s.dir_steer, lookahead)
         raise Rejected("magnetic" if "M" in kinds else "missing_field")
     if kind == "RMB":
         _status_ok(s.status)
@@ -296,7 +310,9 @@ def _course_from(s, lookahead: float):
         if s.override == "A" or (s.steering_mode or "") not in ("H", "S", "T"):
             raise Rejected("not_heading_mode")
         if s.heading_reference == "M":
-            raise Rejected("magnetic")
+            if variation is None:
+                raise Rejected("magnetic")
+            return rad(true_from_magnetic(_direction(s.heading_to_steer), variation))
         return rad(_direction(s.heading_to_steer))
     return None
 
@@ -312,10 +328,13 @@ def _arrival(s) -> tuple[str, bool]:
     return "", False
 
 
-def _heading_from(s):
-    """Heading [deg] of an HDT or THS sentence, checked (raises :class:`Rejected`); None for
-    other sentences."""
+def _heading_from(s, variation=None):
+    """True heading [deg] of an HDT, THS, HDG or HDM sentence, checked (raises
+    :class:`Rejected` or :class:`~steerlab.runtime.nmea_magnetic.MagneticRejected`); None for
+    other sentences. ``variation`` [deg, > 0 east]: the one in effect for HDG/HDM."""
     kind = type(s).__name__
+    if kind in ("HDG", "HDM"):
+        return compass_heading(s, _direction(s.heading), variation)[0]
     if kind == "HDT":
         if (s.hdg_true or "T") != "T":
             raise Rejected("bad_field")
@@ -337,10 +356,24 @@ def _xte_from(s):
     return None if x is None else x * (1.0 if s.correction_dir == "L" else -1.0)
 
 
-USED = ("HDT", "THS", "APB", "RMB", "HTC", "XTE")   #: the sentences the autopilot reads
+def _rudder_from(s):
+    """Rudder angle [deg] of an RSA sentence (starboard or single sensor; > 0 to starboard, the
+    steerlab sign), checked: status ``A``, at most 90 deg either way."""
+    _status_ok(s.rsa_starboard_status)
+    if s.rsa_starboard is None or not str(s.rsa_starboard).strip():
+        raise Rejected("missing_field")
+    v = _num(s.rsa_starboard)
+    if v is None:
+        raise Rejected("bad_field")
+    if abs(v) > 90.0:
+        raise Rejected("out_of_range")
+    return v
 
 
-def steering_inputs(data: bytes, lookahead: float = 500.0) -> dict:
+USED = ("HDT", "THS", "HDG", "HDM", "APB", "RMB", "HTC", "XTE", "RSA")   #: the sentences the autopilot reads
+
+
+def steering_inputs(data: bytes, lookahead: float = 500.0, variation: float | None = None) -> dict:
     """Heading [rad] and set course [rad] (the last heading; the course of the highest-priority
     source in the datagram, :data:`COURSE_PRIORITY`), or None.
 
@@ -351,9 +384,16 @@ def steering_inputs(data: bytes, lookahead: float = 500.0) -> dict:
     rejections by reason (:data:`REJECT_REASONS`: range, status, magnetic-only...), ``rejected``
     is their total. Lines past :data:`MAX_LINES` are counted (``too_many_lines``), not parsed.
     Never raises.
+
+    ``variation`` [rad, > 0 east] is the magnetic variation in effect (a fresh RMC's or the
+    configured one; None: unknown) for HDG/HDM and magnetic APB/HTC; an RMC line that carries
+    one (counted ``accepted``) applies to the lines after it and is returned as ``variation``
+    [rad]. ``rudder`` [rad] is the last RSA rudder angle (> 0 to starboard), or None.
     """
     out = {"heading": None, "course": None, "course_source": None, "courses": {}, "xte_m": None,
+           "rudder": None, "variation": None,
            "accepted": 0, "ignored": 0, "rejected": 0, "reasons": Counter()}
+    var_deg = None if variation is None else deg(variation)
     reasons = out["reasons"]
     try:
         text = bytes(data).decode("ascii")
@@ -370,14 +410,31 @@ def steering_inputs(data: bytes, lookahead: float = 500.0) -> dict:
             reasons["malformed"] += 1
             continue
         kind = type(s).__name__
+        if kind == "RMC":
+            try:
+                v = rmc_variation(s)
+            except MagneticRejected as why:
+                reasons[why.reason] += 1
+                continue
+            except Exception:
+                reasons["bad_field"] += 1
+                continue
+            if v is None:
+                out["ignored"] += 1
+            else:
+                var_deg = v
+                out["variation"] = rad(v)
+                out["accepted"] += 1
+            continue
         if kind not in USED:
             out["ignored"] += 1
             continue
         try:
-            h = _heading_from(s)
-            c = _course_from(s, lookahead)
+            h = _heading_from(s, var_deg)
+            c = _course_from(s, lookahead, var_deg)
             x = _xte_from(s) if kind == "XTE" else None
-        except Rejected as why:
+            rud = _rudder_from(s) if kind == "RSA" else None
+        except (Rejected, MagneticRejected) as why:
             reasons[why.reason] += 1
             continue
         except Exception:                   # a field pynmea2 could not give: never raise
@@ -391,6 +448,8 @@ def steering_inputs(data: bytes, lookahead: float = 500.0) -> dict:
             out["courses"][kind] = {"course": c, "dest": dest, "arrived": arrived}
         if x is not None:
             out["xte_m"] = x
+        if rud is not None:
+            out["rudder"] = rad(rud)
     for kind in COURSE_PRIORITY:
         if kind in out["courses"]:
             out["course"], out["course_source"] = out["courses"][kind]["course"], kind
