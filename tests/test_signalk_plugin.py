@@ -302,10 +302,11 @@ def test_signalk_nmea0183_parser_decodes_steerlab_sentences():
 def test_plugin_unit_tests_pass_under_node():
     """The plugin's own node:test suite (stand-in server app and steerlab): off-line refusal,
     commands as deltas, stale status not undoing an adjustment, bad values refused, a target
-    steerlab would not apply refused 409 with its reason."""
+    steerlab would not apply refused 409 with its reason; the signed link (unsigned and forged statuses
+    ignored and counted, commands signed) and steerlab's alarms as notifications, raised and cleared."""
     res = subprocess.run(["node", "--test", "test/"], cwd=PLUGIN, capture_output=True, text=True, timeout=120)
     assert res.returncode == 0, res.stdout[-3000:] + res.stderr[-2000:]
-    assert "# fail 0" in res.stdout and "# pass 4" in res.stdout
+    assert "# fail 0" in res.stdout and "# pass 5" in res.stdout
 
 
 def _start_server(tmp_path, cfg, http_port):
