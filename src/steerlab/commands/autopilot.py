@@ -75,6 +75,27 @@ def register(sub, formatter_class) -> None:
     p.set_defaults(func=run)
 
 
+def _checked_settings(args, scenario):
+    """``--mode``, ``--profiles`` and ``--profile`` checked before the controller compiles: the
+    :class:`~steerlab.runtime.controller_settings.ControllerSettings` (every profile validated
+    against the runtime scenario's schema)."""
+    from steerlab.errors import InputError
+    from steerlab.runtime.controller_runtime import runtime_scenario
+    from steerlab.runtime.controller_settings import ControllerSettings, load_profiles
+    from steerlab.runtime.steering_modes import mode_refusal
+
+    if args.mode is not None:
+        why = mode_refusal(args.mode, bool(args.route), bool(args.nmea_listen))
+        if why is not None:
+            raise InputError("--mode", why)
+    rt = runtime_scenario(scenario, args.controller, args.sample_time)
+    settings = ControllerSettings(rt.model_dump()["controller"], load_profiles(args.profiles) if args.profiles else None)
+    settings.check(rt)
+    if args.profile is not None and args.profile not in settings.names():
+        raise InputError("--profile", f"unknown profile {args.profile!r}; known: {', '.join(settings.names())}")
+    return settings
+
+
 def build_autopilot(args):
     """The :class:`~steerlab.runtime.autopilot.Autopilot` (and web bind) for parsed ``args``."""
     from steerlab.commands.serve_ship import allowed_origins, check_report_every
@@ -111,6 +132,7 @@ def build_autopilot(args):
                           rpm_cmd=math.nan if args.rpm is None else args.rpm, xte_lookahead=args.xte_lookahead,
                           nmea_heading_over_signed=args.nmea_heading_over_signed, input_rate=args.input_rate,
                           input_burst=max(1.0, args.input_rate)).validate()
+    settings = _checked_settings(args, scenario)
     ctrl = ControllerRuntime(scenario, args.controller, args.sample_time)   # compiles on first use: checks first
     route = (route_guidance(scenario, ctrl.setup.ship, ctrl.setup.ps, args.route, args.lookahead_L,
                             args.accept_radius) if args.route else None)
@@ -128,17 +150,6 @@ def build_autopilot(args):
         if value and not is_loopback(hp(value, opt)[0]):
             print(f"autopilot: warning: {opt} on {hp(value, opt)[0]} takes {what} from the network "
                   "without authentication", file=sys.stderr)
-    from steerlab.runtime.controller_settings import ControllerSettings, load_profiles
-    from steerlab.runtime.steering_modes import mode_refusal
-
-    if args.mode is not None:
-        why = mode_refusal(args.mode, bool(args.route), bool(args.nmea_listen))
-        if why is not None:
-            raise InputError("--mode", why)
-    settings = ControllerSettings(ctrl.settings, load_profiles(args.profiles) if args.profiles else None)
-    settings.check(ctrl.scenario)
-    if args.profile is not None and args.profile not in settings.names():
-        raise InputError("--profile", f"unknown profile {args.profile!r}; known: {', '.join(settings.names())}")
     ap = Autopilot(ctrl, connect, cfg, heading=None if args.heading is None else rad(args.heading),
                    route=route, key=key, log_path=args.log, engaged=not args.standby,
                    nmea_listen=hp(args.nmea_listen, "--nmea-listen"), nmea_to=hp(args.nmea_to, "--nmea-to"),

@@ -161,20 +161,25 @@ class Autopilot:
     state_file : path or None
         Where the set course, mode, profile and gains are kept across restarts
         (:mod:`steerlab.runtime.pilot_state`).
+    plotter_input : bool or None
+        Whether a chart plotter's course sentences can arrive (mode ``plotter`` available);
+        None: when ``nmea_listen`` is given (an NMEA transport of another kind sets it True).
     """
 
     def __init__(self, controller, connect, config: AutopilotConfig = AutopilotConfig(),
                  heading=None, route=None, key=None, log_path=None, engaged=True,
                  nmea_listen=None, signalk_listen=None, signalk_to=None, nmea_to=None, bind=None,
-                 signalk_ws=None, allow_origins=(), mode=None, settings=None, state_file=None):
+                 signalk_ws=None, allow_origins=(), mode=None, settings=None, state_file=None,
+                 plotter_input=None):
         self.ctrl = controller
         self.connect = connect
         self.config = cfg = config.validate()
         if abs(cfg.sample_time - controller.h) > 1e-12:
             raise InputError("--sample-time", "differs from the controller's sample time")
         self.route_plan = route        # the route loaded (--route), followed in mode "route"
-        self.steering_mode = default_mode(route is not None, nmea_listen is not None) if mode is None else mode
-        why = mode_refusal(self.steering_mode, route is not None, nmea_listen is not None)
+        self.plotter_input = (nmea_listen is not None) if plotter_input is None else bool(plotter_input)
+        self.steering_mode = default_mode(route is not None, self.plotter_input) if mode is None else mode
+        why = mode_refusal(self.steering_mode, route is not None, self.plotter_input)
         if why is not None:
             raise InputError("--mode", why)
         self.route = route if self.steering_mode == ROUTE else None    # the route steering now
@@ -366,13 +371,13 @@ class Autopilot:
 
     def available_modes(self) -> tuple:
         """The steering modes this autopilot can switch to (:mod:`steerlab.runtime.steering_modes`)."""
-        return available_modes(self.route_plan is not None, self.nmea_listen is not None)
+        return available_modes(self.route_plan is not None, self.plotter_input)
 
     def set_mode(self, mode, t: float) -> str | None:
         """Switch the steering mode at ship time ``t`` [s]; returns why it cannot (nothing
         changed) or None. Leaving ``route`` holds the course the route was steering (the
         reference slews on from where it is); leaving ``plotter`` clears its arrival alarm."""
-        why = mode_refusal(mode, self.route_plan is not None, self.nmea_listen is not None)
+        why = mode_refusal(mode, self.route_plan is not None, self.plotter_input)
         if why is not None or mode == self.steering_mode:
             return why
         prev, self.steering_mode = self.steering_mode, mode

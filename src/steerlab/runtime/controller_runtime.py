@@ -80,11 +80,15 @@ class ControllerRuntime:
         if "sample_time" in self.settings:
             d["controller"]["sample_time"] = self.h
         sc = scenario_from_dict(d)                # validation: one InputError naming the field
-        dz = design(sc)
-        s = realise(dz, sc.seed)
-        kernel = controller_step(s.controller.update)
-        x0 = s.x0.copy()
-        kernel(np.asarray(s.z0, dtype=float).copy(), s.pc, 0.0, x0, np.zeros(2), self.h)   # compiled before it steers
+        try:
+            dz = design(sc)
+            s = realise(dz, sc.seed)
+            kernel = controller_step(s.controller.update)
+            kernel(np.asarray(s.z0, dtype=float).copy(), s.pc, 0.0, s.x0.copy(), np.zeros(2), self.h)   # compiled now
+        except InputError:
+            raise
+        except (ValueError, ArithmeticError, TypeError) as err:   # a design the law cannot make
+            raise InputError("controller", f"the design path refused these settings: {err}") from None
         self.scenario, self.setup, self._design, self.p = sc, s, dz.ctrl, s.pc
         self.name, self.kernel, self.delta_max = s.controller.name, kernel, dz.gear.delta_max
         self.z = np.asarray(s.z0, dtype=float).copy()
