@@ -147,6 +147,19 @@ def test_modes_switch_at_run_time_and_a_course_that_does_not_apply_says_why():
     assert values[MODE] == "plotter" and values["steering.autopilot.steerlab.modes"] == ["compass", "plotter"]
 
 
+def test_a_plotter_course_on_an_undeclared_nmea_input_switches_to_plotter_unless_a_mode_was_chosen():
+    ap = _ap(_runtime(), heading=0.0)
+    assert ap.steering_mode == "compass" and "needs a chart plotter" in ap.set_mode("plotter", 0.0)
+    ap.on_nmea_datagram(_apb(30.0).encode(), t=0.0)
+    _step(ap, 0.0)
+    assert ap.steering_mode == "plotter" and math.degrees(ap.psi_set) == pytest.approx(30.0)
+    chosen = _ap(_runtime(), heading=0.0)
+    assert chosen.set_mode("compass", 0.0) is None
+    chosen.on_nmea_datagram(_apb(30.0).encode(), t=0.0)
+    _step(chosen, 0.0)
+    assert chosen.steering_mode == "compass" and chosen.psi_set == 0.0 and "plotter" in chosen.available_modes()
+
+
 def _apb(deg):
     return nmea.render("APB", ["A", "A", "0.00", "R", "N", "V", "V", f"{deg:.1f}", "T", "WP1",
                                f"{deg:.1f}", "T", f"{deg:.1f}", "T"])

@@ -183,6 +183,7 @@ class Autopilot:
         if why is not None:
             raise InputError("--mode", why)
         self.route = route if self.steering_mode == ROUTE else None    # the route steering now
+        self._mode_chosen = mode is not None     # by --mode or at run time (else the default)
         self.gz = None if route is None else route.gz0.copy()
         self.key = key
         self.sender = P.Sender(key)
@@ -284,6 +285,12 @@ class Autopilot:
             self.nmea_courses[kind] = (c["course"], t, c["dest"], c["arrived"])
             if c["arrived"]:
                 self.arrived[kind] = c["dest"]
+        if got.get("courses") and not self.plotter_input:
+            # a chart plotter's course on an NMEA input not declared as one: the plotter mode is
+            # there now, and taken unless the operator chose a mode
+            self.plotter_input = True
+            if not self._mode_chosen and self.steering_mode == COMPASS:
+                self.steering_mode = PLOTTER
 
     def on_signalk_datagram(self, data: bytes, addr=None, t: float | None = None) -> None:
         """A Signal K delta on ``--signalk-listen`` (the plug-in's commands): signed with the
@@ -378,6 +385,8 @@ class Autopilot:
         changed) or None. Leaving ``route`` holds the course the route was steering (the
         reference slews on from where it is); leaving ``plotter`` clears its arrival alarm."""
         why = mode_refusal(mode, self.route_plan is not None, self.plotter_input)
+        if why is None:
+            self._mode_chosen = True
         if why is not None or mode == self.steering_mode:
             return why
         prev, self.steering_mode = self.steering_mode, mode

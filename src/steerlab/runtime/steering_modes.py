@@ -14,7 +14,9 @@ Standby (no rudder orders) is the autopilot's *state*, not a mode (``auto`` / ``
 effect on engagement. A mode is *available* only with its source (a route loaded, an NMEA port
 open); :func:`mode_refusal` says why one is not. The start mode (:func:`default_mode`) is what
 the command line implies: ``route`` with ``--route``, else ``plotter`` with ``--nmea-listen``,
-else ``compass``.
+else ``compass``. A chart plotter's course arriving on an NMEA input the autopilot was not told
+of makes ``plotter`` available and, unless the operator chose a mode, switches to it (reported
+as such): the course it then steers is the plotter's, and the mode says so.
 """
 
 from __future__ import annotations
