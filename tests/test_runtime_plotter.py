@@ -17,11 +17,6 @@ from steerlab.runtime.autopilot import Autopilot, AutopilotConfig
 from test_runtime_autopilot_logic import H, _feed, ctrl  # noqa: F401  (fixture)
 
 
-NMEA_INPUT = ("127.0.0.1", 0)
-"""An NMEA input (never opened here: sentences are fed to ``on_nmea_datagram``): the chart
-plotter's mode needs one (:mod:`steerlab.runtime.steering_modes`)."""
-
-
 def apb(steer_deg, dest="WP1", arrived=False, perp=False, status="A"):
     return nmea.render("APB", [status, "A", "0.00", "R", "N", "A" if arrived else "V", "A" if perp else "V",
                                f"{steer_deg:.1f}", "T", dest, f"{steer_deg:.1f}", "T", f"{steer_deg:.1f}", "T"])
@@ -46,7 +41,7 @@ def test_one_datagram_with_apb_and_rmb_gives_apb_whatever_the_order():
 
 
 def test_apb_and_rmb_in_turns_do_not_alternate_the_course(ctrl):  # noqa: F811
-    ap = Autopilot(ctrl, ("127.0.0.1", 9), AutopilotConfig(nmea_timeout=2.0), heading=0.0, nmea_listen=NMEA_INPUT)
+    ap = Autopilot(ctrl, ("127.0.0.1", 9), AutopilotConfig(nmea_timeout=2.0), heading=0.0)
     courses = []
     for k in range(40):                               # APB and RMB datagrams in turns, 5 s
         t = k * H
@@ -68,7 +63,7 @@ def test_apb_and_rmb_in_turns_do_not_alternate_the_course(ctrl):  # noqa: F811
 
 @pytest.mark.parametrize("flag", ["circle", "perpendicular", "rmb"])
 def test_arrival_holds_the_last_course_and_raises_the_alarm_until_the_next_leg(ctrl, flag):  # noqa: F811
-    ap = Autopilot(ctrl, ("127.0.0.1", 9), AutopilotConfig(), heading=0.0, nmea_listen=NMEA_INPUT)
+    ap = Autopilot(ctrl, ("127.0.0.1", 9), AutopilotConfig(), heading=0.0)
 
     def send(t, steer, dest, arrived):
         line = rmb(steer, dest, arrived) if flag == "rmb" else \
@@ -93,7 +88,7 @@ def test_at_the_routes_end_the_ship_sails_on_instead_of_circling_the_waypoint(ct
     ship that turns at 3 deg/s towards the set course at 5 m/s: after the waypoint the distance
     to it grows without bound (the last course is held), where chasing the flipped bearing
     would keep the ship within a few hundred metres of it."""
-    ap = Autopilot(ctrl, ("127.0.0.1", 9), AutopilotConfig(), heading=0.0, nmea_listen=NMEA_INPUT)
+    ap = Autopilot(ctrl, ("127.0.0.1", 9), AutopilotConfig(), heading=0.0)
     wp_n, wp_e, radius, speed = 1000.0, 50.0, 100.0, 5.0
     x = y = 0.0
     psi = 0.0
@@ -121,7 +116,7 @@ def test_at_the_routes_end_the_ship_sails_on_instead_of_circling_the_waypoint(ct
 def test_status_shows_the_heading_steered_by_and_the_sources(ctrl):  # noqa: F811
     """The bridge page's data: the heading the controller used (NMEA HDT here, not the state's)
     with its source, and what set the set course."""
-    ap = Autopilot(ctrl, ("127.0.0.1", 9), AutopilotConfig(), heading=0.0, nmea_listen=NMEA_INPUT)
+    ap = Autopilot(ctrl, ("127.0.0.1", 9), AutopilotConfig(), heading=0.0)
     _feed(ap, 0.0, psi=math.radians(10.0))
     ap.sample(0.0)
     s = ap.status()
@@ -142,7 +137,7 @@ def test_status_shows_the_heading_steered_by_and_the_sources(ctrl):  # noqa: F81
 
 
 def test_status_track_is_the_autopilots_own_history_thinned(ctrl):  # noqa: F811
-    ap = Autopilot(ctrl, ("127.0.0.1", 9), AutopilotConfig(), heading=0.0, nmea_listen=NMEA_INPUT)
+    ap = Autopilot(ctrl, ("127.0.0.1", 9), AutopilotConfig(), heading=0.0)
     assert ap.status()["track"] == []
     for k in range(1000):                             # a ship going north-north-east, one state a sample
         t = k * H

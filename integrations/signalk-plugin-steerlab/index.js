@@ -20,7 +20,7 @@
  * source for (steering.autopilot.steerlab.mode / .modes); PUT mode switches it, a mode it lacks
  * the source for is refused (409, why). Profiles and gains (steering.autopilot.steerlab.profile /
  * .gains) are v1 PUT paths. steerlab answers every command in its next status
- * (steering.autopilot.steerlab.reply: {id, code, message}); the request gets that answer, so a
+ * (steering.autopilot.steerlab.reply: [{id, code, message}], its last 8); the request gets that answer, so a
  * command steerlab refused is never answered 200.
  *
  * Alarms: steerlab's active alarms (steering.autopilot.steerlab.alarms) become Signal K
@@ -506,9 +506,9 @@ module.exports = function (app) {
       if (Array.isArray(values[MODES_AVAILABLE])) last.modes = values[MODES_AVAILABLE].filter((m) => ALL_MODES.includes(m))
       if (ALL_MODES.includes(values[MODE]) && accept('mode', values[MODE], (a, b) => a === b)) last.mode = values[MODE]
       if (Array.isArray(values[PROFILES])) last.profiles = values[PROFILES].filter((p) => typeof p === 'string')
-      if (REPLY in values) {
+      if (Array.isArray(values[REPLY])) { // steerlab's answers to the last commands
         last.replies = true
-        onReply(values[REPLY])
+        for (const r of values[REPLY]) onReply(r)
       }
       if (Array.isArray(values[ALARMS])) syncAlarms(values[ALARMS])
       if ((s === 'auto' || s === 'standby' || s === 'alarm') && accept('state', s, (a, b) => a === b)) {

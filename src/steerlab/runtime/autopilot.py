@@ -234,7 +234,7 @@ class Autopilot:
         self.state_file = state_file
         self.signalk_link = None       # SignedDeltaFilter on --signalk-listen when keyed (run)
         self.signalk_signer = None     # DeltaSigner of the status to --signalk-to when keyed (run)
-        self.signalk_reply = None      # the answer to the plug-in's last command, in the status
+        self.signalk_replies: deque = deque(maxlen=8)   # answers to the plug-in's last commands, in the status
         self.bind = bind or local_bind_for(connect[0])   # loopback peer: loopback socket, same family
         self.transport = None
         self._t0 = None
@@ -319,7 +319,7 @@ class Autopilot:
         outcome, reply = apply_commands(self, values, t)
         self.signalk_counts[outcome] += 1
         if reply is not None:
-            self.signalk_reply = reply
+            self.signalk_replies.append(reply)
 
     # ------------------------------------------------------------ operator actions
     def set_course(self, psi: float, t: float, source: str = "operator") -> None:

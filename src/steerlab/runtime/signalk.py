@@ -20,7 +20,8 @@ steerlab's own paths (its autopilot's status and commands on the plug-in's link)
     steering.autopilot.steerlab.alarms       the active alarms: [{"name", "message", "state"}]
     steering.autopilot.steerlab.targetRefused  why a target heading would not be applied now
     steering.autopilot.steerlab.commandId    in a command: its number, answered in the status by
-    steering.autopilot.steerlab.reply        {"id", "code" (HTTP-like: 200, 400, 409), "message"}
+    steering.autopilot.steerlab.reply        the answers to the last 8: [{"id", "code" (HTTP-like:
+                                             200, 400, 409), "message"}] (a list, maybe empty)
 
 A delta is ``{"context": "vessels.self", "updates": [{"source": {...}, "timestamp": ISO 8601,
 "values": [{"path": ..., "value": ...}, ...]}]}``, one JSON document per UDP datagram (or
@@ -119,7 +120,7 @@ def autopilot_delta_json(ap, wall: float | None = None) -> str:
     :data:`TARGET_REFUSED` with the reason."""
     return json.dumps(delta({**autopilot_values(ap), **status_values(ap),
                              TARGET_REFUSED: ap.course_refusal(ap.clock()),
-                             REPLY: getattr(ap, "signalk_reply", None) or {"id": 0, "code": 200, "message": ""}}, wall))
+                             REPLY: list(getattr(ap, "signalk_replies", ()))}, wall))
 
 
 COMMAND_ORDER = (MODE, PROFILE, GAINS, TARGET_HEADING, AUTOPILOT_STATE)
