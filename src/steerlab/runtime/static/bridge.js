@@ -112,7 +112,7 @@
       ul.appendChild(li);
     }
     $("steering-mode").textContent = s.steering_mode || "-";
-    for (const b of document.querySelectorAll("[data-mode]")) {
+    for (const b of modeButtons()) {
       b.className = b.dataset.mode === s.steering_mode ? "on" : "";
       b.disabled = !(s.modes || []).includes(b.dataset.mode);
     }
@@ -128,9 +128,11 @@
     drawTrack(s);
   }
 
+  const modeButtons = () => Array.from(document.querySelectorAll("[data-mode]")).filter((b) => b.dataset.mode);
+
   // options of a select, rebuilt only when they change (a select the user has open keeps its state)
   function fillSelect(sel, values, chosen) {
-    const have = Array.from(sel.options).map((o) => o.value);
+    const have = Array.from(sel.options || []).map((o) => o.value);
     if (have.join("\n") !== values.join("\n")) {
       sel.textContent = "";
       for (const v of values) { const o = document.createElement("option"); o.value = v; o.textContent = v; sel.appendChild(o); }
@@ -154,7 +156,7 @@
   $("standby").onclick = () => send({ action: "standby" });
   $("ack").onclick = () => send({ action: "ack" });
   for (const b of document.querySelectorAll("[data-adjust]")) b.onclick = () => send({ action: "adjust", deg: Number(b.dataset.adjust) });
-  for (const b of document.querySelectorAll("[data-mode]")) b.onclick = () => send({ action: "mode", mode: b.dataset.mode });
+  for (const b of modeButtons()) b.onclick = () => send({ action: "mode", mode: b.dataset.mode });
   $("profile").onchange = () => send({ action: "profile", profile: $("profile").value });
   $("gain-set").onclick = () => {
     const v = Number($("gain-value").value);
