@@ -683,6 +683,11 @@ class Autopilot:
                 self.signalk_stream = await SignalKStreamServer(
                     *self.signalk_ws, on_put=lambda path, v: autopilot_put(self, path, v, self.clock()),
                     allow_origins=self.allow_origins).start()
+            # the whole controller registry loaded now, not inside the loop: the first refused
+            # setting's message (the scenario schema's) reads it, which blocked the loop ~2 s
+            from steerlab.control.registry import CONTROLLERS
+
+            self._registry_loaded = "" in CONTROLLERS
             self._t0 = time.monotonic()
             if started is not None:
                 started(self)
