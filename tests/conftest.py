@@ -116,7 +116,8 @@ def scenario():
 
 
 # ---------------------------------------------------------------- real parts must run in CI
-REAL_PART_FILES = ("test_runtime_browser.py", "test_runtime_browser_rebinding.py", "test_signalk_plugin.py")
+REAL_PART_FILES = ("test_runtime_browser.py", "test_runtime_browser_rebinding.py", "test_runtime_browser_phone.py",
+                   "test_signalk_plugin.py")
 """Tests of real parts (Debian's chromium, a real signalk-server, its NMEA 0183 parser, node).
 Locally they skip with a reason where a part is missing; with ``STEERLAB_REQUIRE_REAL_PARTS=1``
 (set by ``.ci/run``, which installs the parts) a skip of any of them fails the run."""

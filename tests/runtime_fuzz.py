@@ -87,22 +87,37 @@ def link_message(rng: random.Random) -> bytes:
     return bytes(d) + rng.randbytes(rng.randrange(0, 3))
 
 
+_SIGNALK_SIGNER = []
+
+
 def signalk_message(rng: random.Random) -> bytes:
     """One generated Signal K UDP datagram (seeded): a delta of a writable path with a value of
-    any type, or a hostile message (``test_runtime_web_fuzz._fuzz_message``)."""
+    any type, or a hostile message (``test_runtime_web_fuzz._fuzz_message``). The autopilot is
+    keyed, so its Signal K link is signed (:mod:`steerlab.runtime.signalk_link`): 9 in 10 are
+    signed with :data:`KEY` (their content reaches the checks), the rest are not (refused
+    ``unauthenticated``)."""
     import json
+    import time
 
-    from steerlab.runtime.signalk import AUTOPILOT_STATE, TARGET_HEADING
+    from steerlab.runtime.signalk import AUTOPILOT_STATE, GAINS, MODE, PROFILE, TARGET_HEADING
+    from steerlab.runtime.signalk_link import DeltaSigner
     from test_runtime_web_fuzz import _fuzz_message
 
     if rng.random() < 0.5:
-        value = rng.choice((0.3, -0.3, 7.0, -1e308, 1e300, "auto", "standby", "alarm", None, True, [1], {"v": 2}))
-        path = rng.choice((TARGET_HEADING, AUTOPILOT_STATE, "navigation.headingTrue", "", "a" * 300))
-        return json.dumps({"context": rng.choice(("vessels.self", "vessels.x", "*", 5)),
-                           "updates": [{"values": [{"path": path, "value": value}]}]}).encode()
-    msg = _fuzz_message(rng)
-    msg = msg.encode("utf-8", "surrogatepass") if isinstance(msg, str) else msg
-    return msg[:60_000]
+        value = rng.choice((0.3, -0.3, 7.0, -1e308, 1e300, "auto", "standby", "alarm", None, True, [1], {"v": 2},
+                            "route", {"Kp": -1.0}, {"Kp": 1e308}))
+        path = rng.choice((TARGET_HEADING, AUTOPILOT_STATE, MODE, PROFILE, GAINS, "navigation.headingTrue", "",
+                           "a" * 300))
+        msg = json.dumps({"context": rng.choice(("vessels.self", "vessels.x", "*", 5)),
+                          "updates": [{"values": [{"path": path, "value": value}]}]}).encode()
+    else:
+        msg = _fuzz_message(rng)
+        msg = (msg.encode("utf-8", "surrogatepass") if isinstance(msg, str) else msg)[:60_000]
+    if rng.random() < 0.1:
+        return msg
+    if not _SIGNALK_SIGNER:
+        _SIGNALK_SIGNER.append(DeltaSigner(KEY))
+    return _SIGNALK_SIGNER[0].sign(msg.decode("utf-8", "replace"), time.time())
 
 
 class _Meter:

@@ -28,12 +28,24 @@ SCENARIO_TOML = runtime_scenario_toml("cli-runtime", 60.0, waves=False)
     (["autopilot", "--connect", "127.0.0.1:47110", "--route", "missing.csv"], "--route"),
     (["autopilot", "--connect", "127.0.0.1:47110", "--heading", "nan"], "--heading"),
     (["autopilot", "--connect", "127.0.0.1:47110", "--watchdog", "-1"], "--watchdog"),
+    (["autopilot", "--connect", "127.0.0.1:47110", "--mode", "wind"], "--mode"),
+    (["autopilot", "--connect", "127.0.0.1:47110", "--mode", "route"], "--mode"),
+    (["autopilot", "--connect", "127.0.0.1:47110", "--profile", "storm"], "--profile"),
+    (["autopilot", "--connect", "127.0.0.1:47110", "--profiles", "missing.toml"], "--profiles"),
 ])
 def test_bad_input_one_line_exit_2(argv, field, capsys, monkeypatch):
     monkeypatch.delenv("STEERLAB_TEST_UNSET_VAR", raising=False)
     assert main(argv) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and err[0].startswith("steerlab: error: ") and field in err[0]
+
+
+def test_a_profile_out_of_range_is_one_line_naming_profile_and_field(tmp_path, capsys):
+    (tmp_path / "p.toml").write_text("[rough]\nKp = -2.0\n")
+    assert main(["autopilot", "--connect", "127.0.0.1:47110", "--controller", "pid",
+                 "--profiles", str(tmp_path / "p.toml")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "--profiles.rough.Kp" in err[0], err
 
 
 def _free_port() -> int:

@@ -57,14 +57,14 @@ def _free_port(kind=socket.SOCK_STREAM) -> int:
         return s.getsockname()[1]
 
 
-def _config_dir(tmp: Path, command_port: int, status_port: int) -> Path:
+def _config_dir(tmp: Path, command_port: int, status_port: int, **plugin_options) -> Path:
     cfg = tmp / "signalk"
     shutil.copytree(PLUGIN, cfg / "node_modules" / "signalk-plugin-steerlab",
                     ignore=shutil.ignore_patterns("node_modules", "test"))
     (cfg / "plugin-config-data").mkdir(parents=True)
     (cfg / "plugin-config-data" / "signalk-plugin-steerlab.json").write_text(json.dumps(
         {"enabled": True, "configuration": {"commandPort": command_port, "statusPort": status_port,
-                                            "offlineTimeout": 3}}))
+                                            "offlineTimeout": 3, **plugin_options}}))
     (cfg / "settings.json").write_text(json.dumps(
         {"interfaces": {"tcp": False, "nmea-tcp": False, "appstore": False, "mfd_webapp": False, "wasm": False},
          "mdns": False, "ssl": False, "pipedProviders": []}))
@@ -100,9 +100,11 @@ def _until(cond, limit_s: float, what: str):
 class _Steerlab:
     """Ship server + autopilot (standby) in a background event loop."""
 
-    def __init__(self, controller, command_port, status_port):
+    def __init__(self, controller, command_port, status_port, key=None, **ap_kwargs):
         self.loop = asyncio.new_event_loop()
-        self.server = ShipServer(scenario_from_dict(SCENARIO), ShipServerConfig(speedup=SPEEDUP, centre_after=2.0))
+        self.server = ShipServer(scenario_from_dict(SCENARIO), ShipServerConfig(speedup=SPEEDUP, centre_after=2.0),
+                                 key=key)
+        self.key, self.ap_kwargs = key, ap_kwargs
         self.ap = None
         self.controller = controller
         self.ports = command_port, status_port
@@ -117,7 +119,7 @@ class _Steerlab:
             self.ap = Autopilot(self.controller, self.server.address,
                                 AutopilotConfig(speedup=SPEEDUP, watchdog_timeout=3.0), heading=None,
                                 engaged=False, signalk_listen=("127.0.0.1", self.ports[0]),
-                                signalk_to=("127.0.0.1", self.ports[1]))
+                                signalk_to=("127.0.0.1", self.ports[1]), key=self.key, **self.ap_kwargs)
             try:
                 await self.ap.run(0.0)
             finally:
@@ -300,7 +302,193 @@ def test_signalk_nmea0183_parser_decodes_steerlab_sentences():
 def test_plugin_unit_tests_pass_under_node():
     """The plugin's own node:test suite (stand-in server app and steerlab): off-line refusal,
     commands as deltas, stale status not undoing an adjustment, bad values refused, a target
-    steerlab would not apply refused 409 with its reason."""
+    steerlab would not apply refused 409 with its reason; the signed link (unsigned and forged statuses
+    ignored and counted, commands signed) and steerlab's alarms as notifications, raised and cleared."""
     res = subprocess.run(["node", "--test", "test/"], cwd=PLUGIN, capture_output=True, text=True, timeout=120)
     assert res.returncode == 0, res.stdout[-3000:] + res.stderr[-2000:]
-    assert "# fail 0" in res.stdout and "# pass 4" in res.stdout
+    assert "# fail 0" in res.stdout and "# pass 5" in res.stdout
+
+
+def _start_server(tmp_path, cfg, http_port):
+    env = {**os.environ, "PORT": str(http_port), "SIGNALK_DISABLE_SERVER_UPDATES": "1"}
+    log = open(tmp_path / "signalk-server.log", "wb")
+    server = subprocess.Popen(["node", str(SERVER_BIN), "-c", str(cfg)], env=env, stdout=log,
+                              stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL)
+    return server, log
+
+
+def _notification(port, name):
+    """The notification ``notifications.steering.autopilot.<name>`` the server holds (value or None)."""
+    status, body = _request(port, "GET", f"/signalk/v1/api/vessels/self/notifications/steering/autopilot/{name}")
+    return body.get("value") if status == 200 and isinstance(body, dict) else None
+
+
+def _on_loop(sl, fn):
+    """Run ``fn()`` on steerlab's event loop (its thread) and wait for it."""
+    done = threading.Event()
+    sl.loop.call_soon_threadsafe(lambda: (fn(), done.set()))
+    assert done.wait(10)
+
+
+@needs_server
+def test_signalk_server_modes_alarms_gains_and_a_signed_status_link(tmp_path):
+    """Every steering mode driven through a real signalk-server, its report checked against what
+    steerlab steers; steerlab's alarms as Signal K notifications, raised and cleared; gains and
+    profiles through Signal K PUTs (steerlab's own verdict, never 200 for a refused one); the
+    status link signed with the link key: a forged status changes nothing the server reports."""
+    from steerlab.runtime import nmea
+    from steerlab.runtime.controller_runtime import ControllerRuntime
+    from steerlab.runtime.controller_settings import ControllerSettings
+    from steerlab.runtime.route import route_guidance
+
+    key = b"a shared key for the signal k test"
+    (tmp_path / "key").write_bytes(key + b"\n")
+    ctrl = ControllerRuntime(scenario_from_dict(SCENARIO), "pid", 0.125)
+    route_file = tmp_path / "route.csv"
+    route_file.write_text("x_n,y_e\n0,0\n0,3000\n")        # due east
+    plan = route_guidance(scenario_from_dict(SCENARIO), ctrl.setup.ship, ctrl.setup.ps, route_file, lookahead_L=1.0)
+    nmea_port = _free_port(socket.SOCK_DGRAM)
+    command_port, status_port, http_port = _free_port(socket.SOCK_DGRAM), _free_port(socket.SOCK_DGRAM), _free_port()
+    cfg = _config_dir(tmp_path, command_port, status_port, keyFile=str(tmp_path / "key"))
+    server, log = _start_server(tmp_path, cfg, http_port)
+    sl = _Steerlab(ctrl, command_port, status_port, key=key, route=plan, nmea_listen=("127.0.0.1", nmea_port),
+                   settings=ControllerSettings(ctrl.settings, {"rough": {"Kp": 2.5, "Kd": 10.0}}))
+    sl.thread.start()
+    dev = f"{API}/steerlab"
+    v1 = "/signalk/v1/api/vessels/self/steering/autopilot"
+    plotter = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+    forger = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+
+    def apb(deg, dest="WP1", arrived=False):
+        line = nmea.render("APB", ["A", "A", "0.00", "R", "N", "A" if arrived else "V", "V", f"{deg:.1f}", "T",
+                                   dest, f"{deg:.1f}", "T", f"{deg:.1f}", "T"])
+        plotter.sendto(line.encode(), ("127.0.0.1", nmea_port))
+
+    def api():
+        return _request(http_port, "GET", dev)[1]
+
+    def agree():
+        """The provider's mode and target are steerlab's."""
+        d = api()
+        return (d.get("mode") == sl.ap.steering_mode and sl.ap.psi_set is not None
+                and d.get("target") is not None and abs(math.remainder(d["target"] - sl.ap.psi_set, 2 * math.pi)) < 1e-9)
+
+    try:
+        def listed():
+            if server.poll() is not None:
+                raise AssertionError("signalk-server exited: " + (tmp_path / "signalk-server.log").read_text()[-2000:])
+            try:
+                return _request(http_port, "GET", API)
+            except OSError:
+                return None
+        _until(listed, 120.0, "signalk-server and the plugin")
+        _until(lambda: api().get("state") == "standby", 30.0, "steerlab on-line over the signed link")
+        d = api()
+        assert d["mode"] == "route" and d["options"]["modes"] == ["compass", "route", "plotter"]
+        assert sl.ap.signalk_counts["accepted"] == 0
+
+        # route: engaged, steering the route; a target is refused 409 with the reason
+        assert _request(http_port, "POST", f"{dev}/engage")[0] == 200
+        _until(lambda: sl.ap.mode == "auto" and sl.ap.course_source == "route", 10.0, "steering the route")
+        _until(agree, 10.0, "provider and steerlab agree (route)")
+        status, body = _request(http_port, "PUT", f"{dev}/target", {"value": 10, "units": "deg"})
+        assert status == 409 and "mode route" in body["message"], body
+        assert sl.ap.course_source == "route"
+
+        # compass: a target applies; the API's mode and target are steerlab's
+        status, body = _request(http_port, "PUT", f"{dev}/mode", {"value": "compass"})
+        assert status == 200, body
+        assert sl.ap.steering_mode == "compass"                  # applied before the answer came
+        status, body = _request(http_port, "PUT", f"{dev}/target", {"value": 45, "units": "deg"})
+        assert status == 200, body
+        assert abs(math.degrees(sl.ap.psi_set) - 45.0) < 1e-6
+        _until(agree, 10.0, "provider and steerlab agree (compass)")
+        # out-of-range targets are refused, never clamped into a course
+        for value in (-1e308, 1e308, -math.pi):
+            status, body = _request(http_port, "PUT", f"{dev}/target", {"value": value})
+            assert status == 400, (value, status, body)
+        assert _request(http_port, "PUT", f"{dev}/target", None, raw=b'{"value": NaN}')[0] == 400
+        assert _request(http_port, "PUT", f"{v1}/target/headingTrue", {"value": -1e308})[0] == 400
+        assert abs(math.degrees(sl.ap.psi_set) - 45.0) < 1e-6
+
+        # plotter: the plotter's APB steers; a target is refused; arrival is a notification
+        assert _request(http_port, "PUT", f"{dev}/mode", {"value": "plotter"})[0] == 200
+        for _ in range(3):
+            apb(80.0)
+        _until(lambda: sl.ap.course_source == "APB" and abs(math.degrees(sl.ap.psi_set) - 80.0) < 1e-6,
+               10.0, "the plotter's course")
+        _until(agree, 10.0, "provider and steerlab agree (plotter)")
+        status, body = _request(http_port, "PUT", f"{dev}/target/adjust", {"value": 1, "units": "deg"})
+        assert status == 409 and "mode plotter" in body["message"], body
+        assert _request(http_port, "POST", f"{dev}/courseCurrentPoint")[0] == 200   # the plotter's destination
+        status, body = _request(http_port, "POST", f"{dev}/courseNextPoint")
+        assert status == 409 and "advance" in body["message"], body
+        apb(80.0, arrived=True)
+        _until(lambda: (_notification(http_port, "waypointArrival") or {}).get("state") == "alert", 10.0,
+               "the arrival notification")
+        apb(95.0, dest="WP2")                                     # the plotter advanced: cleared
+        _until(lambda: (_notification(http_port, "waypointArrival") or {}).get("state") == "normal", 10.0,
+               "the arrival notification cleared")
+        # unknown mode: 400 naming it; mode and course unchanged
+        status, body = _request(http_port, "PUT", f"{dev}/mode", {"value": "wind"})
+        assert status == 400 and "mode must be one of" in body["message"], body
+        assert sl.ap.steering_mode == "plotter"
+
+        # any alarm steerlab raises (here one of a driver's kind) is a notification while it lasts
+        _on_loop(sl, lambda: sl.ap.alarms.set("actuator_fault", True, sl.ap.clock(), "rudder feedback lost"))
+        _until(lambda: (_notification(http_port, "actuatorFault") or {}).get("state") == "alarm", 10.0,
+               "the actuator-fault notification")
+        assert "rudder feedback lost" in _notification(http_port, "actuatorFault")["message"]
+        _on_loop(sl, lambda: sl.ap.alarms.set("actuator_fault", False, sl.ap.clock()))
+        _until(lambda: _notification(http_port, "actuatorFault")["state"] == "normal", 10.0, "cleared")
+
+        # gains and profiles through Signal K PUTs, answered with steerlab's verdict
+        status, body = _request(http_port, "PUT", f"{v1}/steerlab/gains", {"value": {"Kp": 3.0}})
+        assert status == 200 and body["statusCode"] == 200, body
+        assert sl.ap.ctrl.p[0] == 3.0 and sl.ap.settings.gains == {"Kp": 3.0}
+        status, body = _request(http_port, "PUT", f"{v1}/steerlab/gains", {"value": {"Kp": -1.0}})
+        assert status == 400 and "Kp" in body["message"], body
+        status, body = _request(http_port, "PUT", f"{v1}/steerlab/profile", {"value": "rough"})
+        assert status == 200, body
+        assert sl.ap.settings.profile == "rough" and sl.ap.ctrl.p[0] == 2.5
+        assert _request(http_port, "PUT", f"{v1}/steerlab/profile", {"value": "storm"})[0] == 400
+
+        # a forged (unsigned) status claiming standby changes nothing the server reports
+        _until(lambda: api().get("state") == "auto", 5.0, "engaged")
+        forged = json.dumps({"context": "vessels.self", "updates": [{"values": [
+            {"path": "steering.autopilot.state", "value": "standby"},
+            {"path": "steering.autopilot.target.headingTrue", "value": 3.0},
+            {"path": "steering.autopilot.steerlab.mode", "value": "compass"}]}]}).encode()
+        for _ in range(20):
+            forger.sendto(forged, ("127.0.0.1", status_port))
+            time.sleep(0.02)
+        time.sleep(0.5)
+        d = api()
+        assert d["state"] == "auto" and d["mode"] == "plotter" and abs(d["target"] - math.radians(95.0)) < 1e-9, d
+        _until(lambda: (_request(http_port, "GET", f"{v1}/steerlab/linkRejected")[1] or {}).get("value", 0) >= 20,
+               5.0, "the forged statuses counted")
+        # a forged command to steerlab is refused and counted there too
+        forger.sendto(json.dumps({"updates": [{"values": [{"path": "steering.autopilot.state",
+                                                           "value": "standby"}]}]}).encode(), sl.ap.signalk_listen)
+        _until(lambda: sl.ap.signalk_counts["unauthenticated"] >= 1, 5.0, "the forged command counted")
+        assert sl.ap.mode == "auto"
+
+        # steerlab gone while engaged: an emergency notification; a forged status cannot revive it
+        sl.stop()
+        _until(lambda: (_notification(http_port, "offline") or {}).get("state") == "emergency", 10.0,
+               "the autopilot-gone notification")
+        forger.sendto(forged.replace(b'"standby"', b'"auto"'), ("127.0.0.1", status_port))
+        time.sleep(1.5)
+        assert api()["state"] == "off-line"
+        assert _request(http_port, "POST", f"{dev}/engage")[0] == 503
+        assert sl.error is None
+    finally:
+        plotter.close()
+        forger.close()
+        sl.stop()
+        server.terminate()
+        try:
+            server.wait(timeout=20)
+        except subprocess.TimeoutExpired:
+            server.kill()
+        log.close()

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import argparse
 import math
+import re
 import sys
 import textwrap
 from pathlib import Path
@@ -269,9 +270,27 @@ def _version() -> str:
     return f"steerlab {__version__}"
 
 
+_NEGATIVE_LIST = re.compile(r"^-[0-9.][0-9.eE+-]*(,[-+0-9.eE]+)+$")
+
+
+def join_negative_lists(argv: list) -> list:
+    """``--opt -33.9,151.2`` as ``--opt=-33.9,151.2``: argparse takes a value that starts with
+    ``-`` and is not a plain number (a comma list, e.g. a southern or western ``--origin``) for
+    an option and refuses it ("expected one argument"). Only a comma list of numbers right after
+    a long option without ``=`` is joined; everything else is left as it is."""
+    out = []
+    for tok in argv:
+        if out and isinstance(tok, str) and _NEGATIVE_LIST.match(tok) and out[-1].startswith("--") \
+                and "=" not in out[-1] and out[-1] != "--":
+            out[-1] = f"{out[-1]}={tok}"
+        else:
+            out.append(tok)
+    return out
+
+
 def main(argv=None) -> int:
     parser = build_parser()
-    args = parser.parse_args(argv)
+    args = parser.parse_args(join_negative_lists(sys.argv[1:] if argv is None else list(argv)))
     if not getattr(args, "quiet", False):
         from steerlab.jit import drivers
 

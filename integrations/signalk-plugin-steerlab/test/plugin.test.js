@@ -131,3 +131,61 @@ test('a target steerlab would not apply (route, chart plotter) is refused 409 wi
     steerlab.close()
   }
 })
+
+test('signed link: unsigned and forged statuses are ignored and counted; alarms become notifications', async () => {
+  const fs = require('node:fs')
+  const os = require('node:os')
+  const path = require('node:path')
+  const app = fakeApp()
+  app.messages = []
+  app.handleMessage = (id, d) => { for (const u of d.updates) for (const v of u.values) app.messages.push([v.path, v.value]) }
+  const key = Buffer.from('a key of at least sixteen bytes')
+  const keyFile = path.join(fs.mkdtempSync(path.join(os.tmpdir(), 'sl-')), 'key')
+  fs.writeFileSync(keyFile, Buffer.concat([key, Buffer.from('\n')]))
+  const steerlab = await udp()
+  const statusPort = (await udp().then((s) => { const p = s.address().port; s.close(); return p }))
+  const plugin = makePlugin(app)
+  plugin.start({ commandPort: steerlab.address().port, statusPort, offlineTimeout: 1, keyFile })
+  const [provider] = app.registered
+  const signer = { session: 1, seq: 0 }
+  const text = (values) => JSON.stringify({ updates: [{ values: Object.entries(values).map(([p, value]) => ({ path: p, value })) }] })
+  const signed = (values) => steerlab.send(makePlugin.signDatagram(key, signer, text(values)), statusPort, '127.0.0.1')
+  const got = []
+  steerlab.on('message', (m) => got.push(m))
+  try {
+    await sleep(50)
+    steerlab.send(text({ 'steering.autopilot.state': 'auto' }), statusPort, '127.0.0.1') // unsigned
+    steerlab.send(makePlugin.signDatagram(Buffer.from('another key, sixteen+ bytes'), { session: 2, seq: 0 },
+      text({ 'steering.autopilot.state': 'auto' })), statusPort, '127.0.0.1') // wrong key
+    await sleep(100)
+    assert.strictEqual(await provider.getState('steerlab'), 'off-line')
+    signed({
+      'steering.autopilot.state': 'standby',
+      'steering.autopilot.target.headingTrue': 1,
+      'steering.autopilot.steerlab.mode': 'compass',
+      'steering.autopilot.steerlab.alarms': [{ name: 'off_course', message: 'off by 12 deg', state: 'alarm' },
+        { name: 'sensor_fault', message: 'compass stale', state: 'alarm' }]
+    })
+    await sleep(100)
+    assert.strictEqual(await provider.getState('steerlab'), 'standby')
+    const alarm = app.updates.find(([, info]) => info.alarm)
+    assert.strictEqual(alarm[1].alarm.path, 'heading')
+    assert.strictEqual(alarm[1].alarm.value.state, 'alarm')
+    const raised = app.messages.find(([p]) => p === 'notifications.steering.autopilot.sensorFault')
+    assert.strictEqual(raised[1].state, 'alarm')
+    assert.deepStrictEqual(app.messages.find(([p]) => p === 'steering.autopilot.steerlab.linkRejected'),
+      ['steering.autopilot.steerlab.linkRejected', 2])
+    signed({ 'steering.autopilot.state': 'standby', 'steering.autopilot.steerlab.alarms': [] }) // both ended
+    await sleep(100)
+    assert.strictEqual(app.messages.filter(([p]) => p === 'notifications.steering.autopilot.sensorFault').pop()[1].state, 'normal')
+    assert.strictEqual(app.updates.filter(([, info]) => info.alarm).pop()[1].alarm.value.state, 'normal')
+    await provider.engage('steerlab') // commands are signed
+    await sleep(100)
+    assert.ok(makePlugin.verifyDatagram(key, got[0], new Map(), 3000, Date.now()).text.includes('"auto"'))
+    await sleep(2300) // silent: the autopilot-gone notification
+    assert.strictEqual(app.messages.filter(([p]) => p === 'notifications.steering.autopilot.offline').pop()[1].state, 'emergency')
+  } finally {
+    plugin.stop()
+    steerlab.close()
+  }
+})

@@ -78,9 +78,39 @@ def register(sub, formatter_class) -> None:
     p.add_argument("--signalk-ws", metavar="HOST:PORT",
                    help="serve the Signal K stream here (WebSocket; ship and autopilot paths; PUT target heading/state)")
     p.add_argument("--web", metavar="HOST:PORT", help="serve the bridge page here (e.g. 127.0.0.1:8080)")
+    p.add_argument("--mode", help="steering mode at start: compass, route (needs --route) or plotter (needs "
+                                  "--nmea-listen); default: route with --route, else plotter with --nmea-listen, "
+                                  "else compass; switchable at run time (docs/runtime.md)")
+    p.add_argument("--profiles", metavar="FILE.toml",
+                   help="named controller profiles (one table of [controller] settings each, e.g. [calm], [rough]); "
+                        "chosen at run time from the bridge page or Signal K")
+    p.add_argument("--profile", help="profile at start (default: 'scenario', the scenario's own settings)")
+    p.add_argument("--state-file", metavar="PATH",
+                   help="keep the set course, mode, profile and gains here; a restart resumes them")
     add_link_security(p)
     p.add_argument("--quiet", action="store_true")
     p.set_defaults(func=run)
+
+
+def _checked_settings(args, scenario):
+    """``--mode``, ``--profiles`` and ``--profile`` checked before the controller compiles: the
+    :class:`~steerlab.runtime.controller_settings.ControllerSettings` (every profile validated
+    against the runtime scenario's schema)."""
+    from steerlab.errors import InputError
+    from steerlab.runtime.controller_runtime import runtime_scenario
+    from steerlab.runtime.controller_settings import ControllerSettings, load_profiles
+    from steerlab.runtime.steering_modes import mode_refusal
+
+    if args.mode is not None:
+        why = mode_refusal(args.mode, bool(args.route), bool(args.nmea_listen))
+        if why is not None:
+            raise InputError("--mode", why)
+    rt = runtime_scenario(scenario, args.controller, args.sample_time)
+    settings = ControllerSettings(rt.model_dump()["controller"], load_profiles(args.profiles) if args.profiles else None)
+    settings.check(rt)
+    if args.profile is not None and args.profile not in settings.names():
+        raise InputError("--profile", f"unknown profile {args.profile!r}; known: {', '.join(settings.names())}")
+    return settings
 
 
 def build_autopilot(args):
@@ -121,6 +151,7 @@ def build_autopilot(args):
                           nmea_heading_over_signed=args.nmea_heading_over_signed, input_rate=args.input_rate,
                           input_burst=max(1.0, args.input_rate),
                           variation=math.nan if variation is None else rad(variation)).validate()
+    settings = _checked_settings(args, scenario)
     ctrl = ControllerRuntime(scenario, args.controller, args.sample_time)   # compiles on first use: checks first
     route = (route_guidance(scenario, ctrl.setup.ship, ctrl.setup.ps, args.route, args.lookahead_L,
                             args.accept_radius) if args.route else None)
@@ -144,7 +175,23 @@ def build_autopilot(args):
                    signalk_listen=hp(args.signalk_listen, "--signalk-listen"),
                    signalk_to=hp(args.signalk_to, "--signalk-to"), signalk_ws=signalk_ws,
                    allow_origins=origins, nmea_streams=streams, actuator=actuator,
-                   signalk_input=hp(args.signalk_input, "--signalk-input"))
+                   signalk_input=hp(args.signalk_input, "--signalk-input"),
+                   mode=args.mode, settings=settings, state_file=args.state_file)
+    if args.profile is not None:
+        try:
+            ap.configure(0.0, profile=args.profile)
+        except InputError as err:
+            raise InputError("--profile", f"profile {args.profile!r}: {err}") from None
+    if args.state_file:
+        from steerlab.runtime.pilot_state import read_state, resume
+
+        doc, why = read_state(args.state_file)
+        if why is not None:
+            print(f"autopilot: warning: --state-file {args.state_file!r} not used: {why}", file=sys.stderr)
+        elif doc is not None:
+            for note in resume(ap, doc, keep_course=args.heading is not None or bool(args.route),
+                               keep_mode=args.mode is not None, keep_profile=args.profile is not None):
+                print(f"autopilot: warning: --state-file: {note}", file=sys.stderr)
     return ap, web
 
 

@@ -14,6 +14,15 @@ OFF_COURSE = "off_course"  #: heading deviates from the set course by more than 
 ARRIVAL = "arrival"      #: the chart plotter's destination waypoint was reached: the last course is held
 ACTUATOR = "actuator"    #: the actuator driver reports a fault: safe action ordered, autopilot disengaged
 
+SEVERITY = {ARRIVAL: "alert"}
+"""Signal K notification state of an alarm (specification 1.7, "Notifications": ``alert`` <
+``warn`` < ``alarm`` < ``emergency``); an alarm not listed is an ``alarm``."""
+
+
+def severity(name: str) -> str:
+    """The Signal K notification state an active alarm ``name`` is raised with."""
+    return SEVERITY.get(name, "alarm")
+
 
 @dataclass
 class Alarm:

@@ -66,7 +66,7 @@ from steerlab.runtime.alarms import ACTUATOR, ARRIVAL, LINK, OFF_COURSE, AlarmBo
 from steerlab.runtime.heading_health import HEADING_PRIORITY, MAX_TURN_RATE, HeadingHealth, select_heading
 from steerlab.runtime.link_filter import LinkFilter
 from steerlab.runtime.rate_limit import RateLimiter
-from steerlab.runtime.signalk import AUTOPILOT_STATE, TARGET_HEADING
+from steerlab.runtime.steering_modes import COMPASS, MODES, PLOTTER, ROUTE, available_modes, default_mode, mode_refusal
 from steerlab.runtime.udp import local_bind_for, open_udp, send
 from steerlab.units import deg, rad
 
@@ -178,18 +178,39 @@ class Autopilot:
     signalk_input : (host, port) or None
         Subscribe to this Signal K server's stream for heading, variation, position, rate of
         turn and rudder angle (:mod:`steerlab.runtime.signalk_input`).
+    mode : str or None
+        Steering mode at start (:mod:`steerlab.runtime.steering_modes`); None: what the
+        arguments imply (``route`` with a route, else ``plotter`` with ``nmea_listen``, else
+        ``compass``). Switchable at run time (:meth:`set_mode`).
+    settings : steerlab.runtime.controller_settings.ControllerSettings or None
+        Named profiles and gains changeable at run time (:meth:`configure`).
+    state_file : path or None
+        Where the set course, mode, profile and gains are kept across restarts
+        (:mod:`steerlab.runtime.pilot_state`).
+    plotter_input : bool or None
+        Whether a chart plotter's course sentences can arrive (mode ``plotter`` available);
+        None: when ``nmea_listen`` or an NMEA stream (serial, TCP) is given.
     """
 
     def __init__(self, controller, connect, config: AutopilotConfig = AutopilotConfig(),
                  heading=None, route=None, key=None, log_path=None, engaged=True,
                  nmea_listen=None, signalk_listen=None, signalk_to=None, nmea_to=None, bind=None,
-                 signalk_ws=None, allow_origins=(), nmea_streams=(), actuator=None, signalk_input=None):
+                 signalk_ws=None, allow_origins=(), nmea_streams=(), actuator=None, signalk_input=None,
+                 mode=None, settings=None, state_file=None, plotter_input=None):
         self.ctrl = controller
         self.connect = connect
         self.config = cfg = config.validate()
         if abs(cfg.sample_time - controller.h) > 1e-12:
             raise InputError("--sample-time", "differs from the controller's sample time")
-        self.route = route
+        self.route_plan = route        # the route loaded (--route), followed in mode "route"
+        self.plotter_input = ((nmea_listen is not None or bool(nmea_streams)) if plotter_input is None
+                              else bool(plotter_input))
+        self.steering_mode = default_mode(route is not None, self.plotter_input) if mode is None else mode
+        why = mode_refusal(self.steering_mode, route is not None, self.plotter_input)
+        if why is not None:
+            raise InputError("--mode", why)
+        self.route = route if self.steering_mode == ROUTE else None    # the route steering now
+        self._mode_chosen = mode is not None     # by --mode or at run time (else the default)
         self.gz = None if route is None else route.gz0.copy()
         self.key = key
         self.sender = P.Sender(key)
@@ -246,6 +267,15 @@ class Autopilot:
         self.signalk_ws = signalk_ws
         self.signalk_stream = None
         self.allow_origins = tuple(allow_origins)
+        if settings is None:
+            from steerlab.runtime.controller_settings import ControllerSettings
+
+            settings = ControllerSettings(getattr(controller, "settings", {}))
+        self.settings = settings
+        self.state_file = state_file
+        self.signalk_link = None       # SignedDeltaFilter on --signalk-listen when keyed (run)
+        self.signalk_signer = None     # DeltaSigner of the status to --signalk-to when keyed (run)
+        self.signalk_replies: deque = deque(maxlen=8)   # answers to the plug-in's last commands, in the status
         self.bind = bind or local_bind_for(connect[0])   # loopback peer: loopback socket, same family
         self.transport = None
         self._t0 = None
@@ -306,6 +336,12 @@ class Autopilot:
             self.nmea_courses[kind] = (c["course"], t, c["dest"], c["arrived"])
             if c["arrived"]:
                 self.arrived[kind] = c["dest"]
+        if got.get("courses") and not self.plotter_input:
+            # a chart plotter's course on an NMEA input not declared as one: the plotter mode is
+            # there now, and taken unless the operator chose a mode
+            self.plotter_input = True
+            if not self._mode_chosen and self.steering_mode == COMPASS:
+                self.steering_mode = PLOTTER
 
     def on_signalk_values(self, values: dict, t: float | None = None) -> None:
         """Checked values of the Signal K input (:func:`steerlab.runtime.signalk_input.input_values`):
@@ -331,39 +367,33 @@ class Autopilot:
             self.rudder_feedback = (values["steering.rudderAngle"], t)
 
     def on_signalk_datagram(self, data: bytes, addr=None, t: float | None = None) -> None:
-        from steerlab.runtime.signalk import parse_delta
+        """A Signal K delta on ``--signalk-listen`` (the plug-in's commands): signed with the
+        link's key when there is one (:mod:`steerlab.runtime.signalk_link`; else refused and
+        counted by reason), then applied by :func:`steerlab.runtime.signalk.apply_commands`;
+        the answer goes back in the next status delta (``steering.autopilot.steerlab.reply``)."""
+        from steerlab.runtime.signalk import apply_commands, parse_delta
 
         if not self.signalk_limiter.allow(addr, time.monotonic()):
             self.signalk_counts["rate_limited"] += 1
             return
         t = self.clock() if t is None else t
+        if self.key:
+            if self.signalk_link is None:
+                from steerlab.runtime.signalk_link import SignedDeltaFilter
+
+                self.signalk_link = SignedDeltaFilter(self.key, max(self.config.max_age, 2.0))
+            data, why = self.signalk_link.accept(data, time.time())
+            if data is None:
+                self.signalk_counts[why] += 1
+                return
         values = parse_delta(data)
         if values is None:
             self.signalk_counts["malformed"] += 1
             return
-        target = values.get(TARGET_HEADING)
-        state = values.get(AUTOPILOT_STATE)
-        if target is None and state is None:
-            self.signalk_counts["ignored"] += 1
-            return
-        # the same checks as a PUT (a heading in radians, |value| <= 2 pi; "auto" or "standby")
-        if target is not None and (isinstance(target, bool) or not isinstance(target, (int, float))
-                                   or not math.isfinite(target) or abs(target) > 2 * math.pi):
-            self.signalk_counts["out_of_range"] += 1
-            return
-        if state is not None and state not in ("auto", "standby"):
-            self.signalk_counts["bad_field"] += 1
-            return
-        if target is not None and self.course_refusal(t) is not None:
-            self.signalk_counts["not_applied"] += 1     # the route or the plotter sets the course
-            target = None
-        self.signalk_counts["accepted"] += 1
-        if target is not None:
-            self.set_course(float(target), t)
-        if state == "auto":
-            self.engage(t)
-        elif state == "standby":
-            self.standby(t)
+        outcome, reply = apply_commands(self, values, t)
+        self.signalk_counts[outcome] += 1
+        if reply is not None:
+            self.signalk_replies.append(reply)
 
     # ------------------------------------------------------------ operator actions
     def set_course(self, psi: float, t: float, source: str = "operator") -> None:
@@ -394,8 +424,11 @@ class Autopilot:
         course from the chart plotter (``--nmea-listen``: APB/RMB/HTC, not one holding at a
         reached waypoint) the plotter's course replaces any other at the next sample.
         """
-        if self.route is not None:
-            return "following a route (--route): the route is the only course source; target not applied"
+        if self.steering_mode == ROUTE:
+            return ("mode route: following a route (--route), the route is the only course source; "
+                    "target not applied (switch to mode compass to steer a set course)")
+        if self.steering_mode != PLOTTER:
+            return None
         from steerlab.runtime.nmea import COURSE_PRIORITY
 
         for kind in COURSE_PRIORITY:                     # the choice of _plotter_course, read only
@@ -405,8 +438,8 @@ class Autopilot:
             _, _, dest, arrived = c
             if arrived or (kind in self.arrived and dest == self.arrived[kind]):
                 return None                              # holding: the set course stays in effect
-            return (f"the chart plotter's {kind} course sets the course (--nmea-listen); "
-                    "target not applied")
+            return (f"mode plotter: the chart plotter's {kind} course sets the course (--nmea-listen); "
+                    "target not applied (switch to mode compass to steer a set course)")
         return None
 
     def adjust(self, ddeg: float, t: float) -> None:
@@ -416,6 +449,51 @@ class Autopilot:
 
     def engage(self, t: float) -> None:
         self.want_engaged = True
+
+    def available_modes(self) -> tuple:
+        """The steering modes this autopilot can switch to (:mod:`steerlab.runtime.steering_modes`)."""
+        return available_modes(self.route_plan is not None, self.plotter_input)
+
+    def set_mode(self, mode, t: float) -> str | None:
+        """Switch the steering mode at ship time ``t`` [s]; returns why it cannot (nothing
+        changed) or None. Leaving ``route`` holds the course the route was steering (the
+        reference slews on from where it is); leaving ``plotter`` clears its arrival alarm."""
+        why = mode_refusal(mode, self.route_plan is not None, self.plotter_input)
+        if why is None:
+            self._mode_chosen = True
+        if why is not None or mode == self.steering_mode:
+            return why
+        prev, self.steering_mode = self.steering_mode, mode
+        self.route = self.route_plan if mode == ROUTE else None
+        if prev == ROUTE and self.psi_set is not None:
+            start = float(self.ref[REF_PSI]) if self.gd is not None else self.psi_set
+            self.gd = course_schedule(start, [(max(t, 0.0), self.psi_set)], self.config.turn_rate)
+            self.course_source = "route (held)"
+        elif prev == ROUTE:
+            self.gd = None
+        if mode != PLOTTER:
+            self.alarms.set(ARRIVAL, False, t)
+        self.off_course_armed = False
+        return None
+
+    def configure(self, t: float, profile: str | None = None, gains: dict | None = None) -> dict:
+        """Change the controller's settings at ship time ``t`` [s]: a named ``profile`` (its
+        gains replace any given before) and/or ``gains`` on top of the profile in effect
+        (:mod:`steerlab.runtime.controller_settings`). The controller is rebuilt through the
+        design path and starts its next sample as a fresh controller with those settings would
+        (its state reset from the measured state, as at engagement). Bad settings raise
+        :class:`InputError` naming the field; nothing changes then. Returns the settings in effect."""
+        from steerlab.runtime.controller_settings import check_gains
+
+        st = self.settings
+        new_profile = st.profile if profile is None else profile
+        new_gains = {} if profile is not None else dict(st.gains)
+        if gains is not None:
+            new_gains.update(check_gains(gains))
+        applied = self.ctrl.reconfigure(st.resolve(new_profile, new_gains))
+        st.profile, st.gains = new_profile, new_gains
+        self.engaged = False             # the next sample resets the controller, as at engagement
+        return applied
 
     def standby(self, t: float) -> None:
         self.want_engaged = False
@@ -479,7 +557,8 @@ class Autopilot:
                 self.gd = self.route.gd
                 self.course_source = "route"
             else:
-                course, source, holding = self._plotter_course(t)
+                course, source, holding = (self._plotter_course(t) if self.steering_mode == PLOTTER
+                                           else (None, None, False))
                 if course is not None:
                     self.set_course(course, t, source)
                 if source is not None:               # a stale plotter leaves the alarm as it was
@@ -597,7 +676,7 @@ class Autopilot:
             "alarms": self.alarms.snapshot(), "controller": self.ctrl.name,
             "link": {k: v for k, v in self.filter.counts.items()},
             "nmea": dict(self.nmea_counts), "signalk": dict(self.signalk_counts),
-            "route": self.route.route.tolist() if self.route is not None else [],
+            "route": self.route_plan.route.tolist() if self.route_plan is not None else [],
             "track": self._track_summary(),
             "off_course_limit": self.config.off_course_limit,
             "ship_status": None if st is None else st.status,
@@ -606,6 +685,9 @@ class Autopilot:
             "rudder_feedback": None if self.rudder_feedback is None else self.rudder_feedback[0],
             "actuator": {"name": self.actuator.name, "rudder": self.actuator.rudder(r.get("t", 0.0)),
                          "faults": self.actuator.faults(r.get("t", 0.0))},
+            "steering_mode": self.steering_mode, "modes": list(self.available_modes()),
+            "profile": self.settings.profile, "profiles": self.settings.names(),
+            "gains": dict(self.settings.gains), "settings": dict(getattr(self.ctrl, "settings", {})),
         }
 
     def _variation_now(self):
@@ -626,7 +708,15 @@ class Autopilot:
         if self.signalk_to is not None:
             from steerlab.runtime.signalk import autopilot_delta_json
 
-            send(self.transport, autopilot_delta_json(self, time.time()).encode(), self.signalk_to)
+            wall = time.time()
+            data = autopilot_delta_json(self, wall).encode()
+            if self.key:                  # signed like the ship link: a forged status is refused
+                if self.signalk_signer is None:
+                    from steerlab.runtime.signalk_link import DeltaSigner
+
+                    self.signalk_signer = DeltaSigner(self.key)
+                data = self.signalk_signer.sign(data.decode(), wall)
+            send(self.transport, data, self.signalk_to)
         if self.signalk_stream is not None:
             from steerlab.runtime.signalk import autopilot_values, state_values
 
@@ -671,6 +761,13 @@ class Autopilot:
         loop = asyncio.get_running_loop()
         self._stop = asyncio.Event()
         self._open_log()
+        keeper = None
+        if self.state_file is not None:
+            import sys
+
+            from steerlab.runtime.pilot_state import StateKeeper
+
+            keeper = StateKeeper(self.state_file, warn=lambda m: print(m, file=sys.stderr, flush=True))
         try:
             self.transport = await open_udp(self.on_state_datagram, self.bind)
             for addr, cb, field in ((self.nmea_listen, self.on_nmea_datagram, "--nmea-listen"),
@@ -696,6 +793,11 @@ class Autopilot:
                 self.signalk_stream = await SignalKStreamServer(
                     *self.signalk_ws, on_put=lambda path, v: autopilot_put(self, path, v, self.clock()),
                     allow_origins=self.allow_origins).start()
+            # the whole controller registry loaded now, not inside the loop: the first refused
+            # setting's message (the scenario schema's) reads it, which blocked the loop ~2 s
+            from steerlab.control.registry import CONTROLLERS
+
+            self._registry_loaded = "" in CONTROLLERS
             self._t0 = time.monotonic()
             if started is not None:
                 started(self)
@@ -713,9 +815,13 @@ class Autopilot:
                 row = self.sample(t, self.clock())
                 self._send_order(t)
                 self._write_log(row)
+                if keeper is not None:
+                    keeper.update(self)
                 k = self._next_sample(k, (loop.time() - t_start) / wall_h)
                 await asyncio.sleep(max(0.0, t_start + k * wall_h - loop.time()))
         finally:
+            if keeper is not None:
+                keeper.update(self, force=True)
             try:
                 await self.actuator.close()
             except Exception:           # a port already gone: nothing more to release

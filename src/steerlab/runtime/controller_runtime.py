@@ -60,6 +60,40 @@ class ControllerRuntime:
         self.z = np.asarray(s.z0, dtype=float).copy()
         self.delta_max = gear.delta_max
         self.kernel(self.z.copy(), self.p, 0.0, s.x0.copy(), np.zeros(2), self.h)   # load or compile now
+        self.settings = self.scenario.model_dump()["controller"]   #: the ``[controller]`` settings in effect
+
+    def reconfigure(self, settings: dict) -> dict:
+        """Steer on with the controller ``settings`` (a full ``[controller]`` table of the same
+        type) built through the same path as at start (schema validation, ``design``,
+        ``realise``): afterwards this runtime is what ``ControllerRuntime`` of a scenario with
+        those settings would be. Call :meth:`reset` before the next :meth:`update` (its state
+        then starts as a fresh controller's). Bad settings (a field outside its range, an
+        unknown field, another type) raise :class:`InputError` naming the field and change
+        nothing. Returns the settings in effect (defaults filled in)."""
+        from steerlab.sim.scenario import scenario_from_dict
+        from steerlab.sim.setup import design, realise
+
+        if settings.get("type", self.settings["type"]) != self.settings["type"]:
+            raise InputError("controller.type", f"stays {self.settings['type']!r} at run time")
+        d = self.scenario.model_dump()
+        d["controller"] = {**settings, "type": self.settings["type"]}
+        if "sample_time" in self.settings:
+            d["controller"]["sample_time"] = self.h
+        sc = scenario_from_dict(d)                # validation: one InputError naming the field
+        try:
+            dz = design(sc)
+            s = realise(dz, sc.seed)
+            kernel = controller_step(s.controller.update)
+            kernel(np.asarray(s.z0, dtype=float).copy(), s.pc, 0.0, s.x0.copy(), np.zeros(2), self.h)   # compiled now
+        except InputError:
+            raise
+        except (ValueError, ArithmeticError, TypeError) as err:   # a design the law cannot make
+            raise InputError("controller", f"the design path refused these settings: {err}") from None
+        self.scenario, self.setup, self._design, self.p = sc, s, dz.ctrl, s.pc
+        self.name, self.kernel, self.delta_max = s.controller.name, kernel, dz.gear.delta_max
+        self.z = np.asarray(s.z0, dtype=float).copy()
+        self.settings = sc.model_dump()["controller"]
+        return dict(self.settings)
 
     def measured_state(self, x_n, y_e, psi, u, v, r, delta) -> np.ndarray:
         """The plant-state vector the kernels expect (model-specific extra states are 0)."""

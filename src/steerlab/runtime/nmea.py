@@ -109,7 +109,10 @@ def render(sentence_type: str, fields, talker: str = TALKER) -> str:
 
 
 def _f(x: float, nd: int = 1) -> str:
-    return f"{x:.{nd}f}"
+    """``x`` with ``nd`` decimals; a value that rounds to zero is ``0.0``, never ``-0.0`` (a
+    rudder angle of -0.01 deg near midships)."""
+    text = f"{x:.{nd}f}"
+    return text[1:] if text.startswith("-") and float(text) == 0.0 else text
 
 
 def compass_field(angle: float, nd: int = 1) -> str:

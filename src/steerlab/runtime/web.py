@@ -7,6 +7,9 @@ actions as JSON::
 
     {"action": "engage"}  {"action": "standby"}  {"action": "adjust", "deg": +1 | -1 | +10 | -10}
     {"action": "ack"}     {"action": "ack", "alarm": "link"}
+    {"action": "mode", "mode": "compass" | "route" | "plotter"}     (steerlab.runtime.steering_modes)
+    {"action": "profile", "profile": "rough"}  {"action": "gains", "gains": {"Kp": 2.5}}
+                                              (steerlab.runtime.controller_settings)
 
 and answers each with ``{"type": "reply", "ok": true|false, "error": ...}``. Requests whose
 ``Host`` does not name this server (DNS rebinding) and WebSockets from another site's page are
@@ -96,6 +99,23 @@ def handle_action(ap, msg, t: float) -> dict:
         if refusal is not None:
             return {"type": "reply", "ok": False, "error": refusal}
         ap.adjust(float(d), t)
+    elif action == "mode":
+        why = ap.set_mode(m.get("mode"), t)
+        if why is not None:
+            return {"type": "reply", "ok": False, "error": why}
+    elif action in ("profile", "gains"):
+        from steerlab.errors import InputError
+
+        try:
+            if action == "profile":
+                if not isinstance(m.get("profile"), str):
+                    return {"type": "reply", "ok": False,
+                            "error": f"profile must be a name, one of {', '.join(ap.settings.names())}"}
+                ap.configure(t, profile=m["profile"])
+            else:
+                ap.configure(t, gains=m.get("gains"))
+        except InputError as err:
+            return {"type": "reply", "ok": False, "error": str(err)}
     elif action == "ack":
         name = m.get("alarm")
         if name is not None and not isinstance(name, str):

@@ -111,10 +111,33 @@
       li.dataset.alarm = a.name;
       ul.appendChild(li);
     }
+    $("steering-mode").textContent = s.steering_mode || "-";
+    for (const b of modeButtons()) {
+      b.className = b.dataset.mode === s.steering_mode ? "on" : "";
+      b.disabled = !(s.modes || []).includes(b.dataset.mode);
+    }
+    fillSelect($("profile"), s.profiles || [], s.profile);
+    const names = Object.keys(s.settings || {}).filter((n) => n !== "type" && n !== "sample_time" &&
+      (typeof s.settings[n] === "number" || s.settings[n] === null));
+    fillSelect($("gain-name"), names, null);
+    $("settings").textContent = Object.entries(s.settings || {}).filter(([n]) => names.includes(n))
+      .map(([n, v]) => n + " = " + (v === null ? "-" : v)).join(", ");
     const k = s.link || {};
     $("counts").textContent = "states accepted " + (k.accepted || 0) + ", rejected " +
       Object.entries(k).filter(([n]) => n !== "accepted").reduce((acc, [, v]) => acc + v, 0);
     drawTrack(s);
+  }
+
+  const modeButtons = () => Array.from(document.querySelectorAll("[data-mode]")).filter((b) => b.dataset.mode);
+
+  // options of a select, rebuilt only when they change (a select the user has open keeps its state)
+  function fillSelect(sel, values, chosen) {
+    const have = Array.from(sel.options || []).map((o) => o.value);
+    if (have.join("\n") !== values.join("\n")) {
+      sel.textContent = "";
+      for (const v of values) { const o = document.createElement("option"); o.value = v; o.textContent = v; sel.appendChild(o); }
+    }
+    if (chosen !== null && document.activeElement !== sel) sel.value = chosen;
   }
 
   function send(obj) { if (ws && ws.readyState === 1) ws.send(JSON.stringify(obj)); }
@@ -133,5 +156,12 @@
   $("standby").onclick = () => send({ action: "standby" });
   $("ack").onclick = () => send({ action: "ack" });
   for (const b of document.querySelectorAll("[data-adjust]")) b.onclick = () => send({ action: "adjust", deg: Number(b.dataset.adjust) });
+  for (const b of modeButtons()) b.onclick = () => send({ action: "mode", mode: b.dataset.mode });
+  $("profile").onchange = () => send({ action: "profile", profile: $("profile").value });
+  $("gain-set").onclick = () => {
+    const v = Number($("gain-value").value);
+    if ($("gain-value").value === "" || !Number.isFinite(v)) { $("reply").textContent = "refused: enter a number"; return; }
+    send({ action: "gains", gains: { [$("gain-name").value]: v } });
+  };
   connect();
 })();
