@@ -19,6 +19,55 @@ import sys
 import time
 
 
+TEACHER_KP, TEACHER_KD = 1.5, 60.0
+"""The PD teacher of ``--warm-start pd``: ``delta = Kp e - Kd r`` (Kp [rad/rad], Kd [s]), a stable
+law for the Esso tanker at 16 kn (the tanker is course-unstable: a policy that starts from zero
+drifts away, and PPO alone learned slowly from there within the budget)."""
+
+
+def teacher(obs, scales):
+    """The PD teacher's actions for normalised observations ``obs`` (N, 4); ``scales`` their divisors."""
+    import numpy as np
+
+    e, r, dmax = obs[:, 0] * scales[0], obs[:, 1] * scales[1], scales[2]
+    return np.clip((TEACHER_KP * e - TEACHER_KD * r) / dmax, -1.0, 1.0)[:, None]
+
+
+def imitate_pd(model, venv, rollout=400, noise=0.3, iters=1500, seed=0):
+    """Fit the actor's mean to the PD teacher (mean-squared error, Adam) on the states the teacher
+    visits with exploration noise ``noise`` (in action units): behaviour cloning as a warm start."""
+    import numpy as np
+    import torch
+
+    from steerlab.control.policy_observation import obs_scales
+
+    scales = obs_scales(venv.venv.core.delta_max)
+    rng = np.random.default_rng(seed)
+    obs = venv.reset()
+    xs, ys = [], []
+    for _ in range(rollout):
+        act = teacher(obs, scales)
+        xs.append(obs)
+        ys.append(act)
+        obs, _, _, _ = venv.step(np.clip(act + noise * rng.standard_normal(act.shape), -1.0, 1.0))
+    x = torch.as_tensor(np.concatenate(xs), dtype=torch.float32)
+    y = torch.as_tensor(np.concatenate(ys), dtype=torch.float32)
+    pol = model.policy
+    opt = torch.optim.Adam(list(pol.mlp_extractor.policy_net.parameters()) + list(pol.action_net.parameters()),
+                           lr=1e-3)
+    g = torch.Generator().manual_seed(seed)
+    for _ in range(iters):
+        idx = torch.randint(0, x.shape[0], (1024,), generator=g)
+        mean = pol.action_net(pol.mlp_extractor.forward_actor(pol.extract_features(x[idx])))
+        loss = torch.mean((mean - y[idx]) ** 2)
+        opt.zero_grad()
+        loss.backward()
+        opt.step()
+    print(f"warm start: actor fitted to the PD teacher on {x.shape[0]} states, mse {float(loss.detach()):.2e}", flush=True)
+    venv.seed(seed)
+    venv.reset()
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--steps", type=int, default=1_500_000, help="PPO timesteps (all ships together)")
@@ -26,6 +75,8 @@ def main(argv=None) -> int:
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--ship", default="esso")
     ap.add_argument("--out", default="out/policy.npz")
+    ap.add_argument("--warm-start", choices=("none", "pd"), default="pd",
+                    help="pd: first fit the actor to a PD teacher by regression (seconds), then PPO (default)")
     ap.add_argument("--checkpoint-every", type=int, default=0,
                     help="also export the policy (and print progress) every this many timesteps (0: at the end only)")
     a = ap.parse_args(argv)
@@ -48,6 +99,8 @@ def main(argv=None) -> int:
                 gae_lambda=0.95, ent_coef=0.0, seed=a.seed, device="cpu", verbose=0,
                 policy_kwargs={"net_arch": [32, 32], "log_std_init": -1.0})
     t0, c0 = time.perf_counter(), time.process_time()
+    if a.warm_start == "pd":
+        imitate_pd(model, venv)
     callback = None
     if a.checkpoint_every > 0:
         from stable_baselines3.common.callbacks import BaseCallback
