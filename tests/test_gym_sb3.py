@@ -43,7 +43,7 @@ def test_sb3_adapter_matches_dummy_vec_env_of_single_envs_bit_for_bit_through_au
     assert ends == 2 * n
 
 
-def test_ppo_trains_a_few_hundred_steps_through_the_public_adapter():
+def test_ppo_trains_a_few_hundred_steps_through_the_public_adapter(tmp_path):
     import torch
     from stable_baselines3 import PPO
 
@@ -55,8 +55,24 @@ def test_ppo_trains_a_few_hundred_steps_through_the_public_adapter():
                 policy_kwargs={"net_arch": [8, 8]}, device="cpu")
     model.learn(total_timesteps=256)
     assert model.num_timesteps >= 256
-    act, _ = model.predict(venv.reset(), deterministic=True)
+    obs = venv.reset()
+    act, _ = model.predict(obs, deterministic=True)
     assert act.shape == (8, 1) and np.all(np.abs(act) <= 1.0)
+    # exported in one call, the policy controller's kernel gives torch's deterministic action
+    from steerlab.control.policy import pack_policy, policy_update
+    from steerlab.control.policy_file import load_policy
+    from steerlab.gym.policy_export import export_policy
+    from steerlab.ships.state import IPSI, IR
+
+    pol = load_policy(export_policy(model, tmp_path / "tiny.npz"))
+    dmax = venv.venv.core.delta_max
+    p = pack_policy(pol.layers, pol.activation, dmax, dmax)
+    core = venv.venv.core
+    for i in range(8):
+        x, ref = core.X[i].copy(), core.REF[i].copy()
+        assert x[IPSI] != 0.0 and np.isfinite(x[IR])
+        u = policy_update(np.zeros(200), p, 0.0, x, ref, 1.0)
+        assert u == pytest.approx(float(act[i, 0]) * dmax, rel=1e-5, abs=1e-6)   # float32 torch vs float64
 
 
 def test_same_step_reset_lanes_and_thread_policy_of_the_native_env():

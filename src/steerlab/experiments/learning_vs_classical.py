@@ -72,7 +72,7 @@ def conditions(quick: bool = False):
 
 
 def measure(n_seeds: int = 10, seed: int = SEED, quick: bool = False, duration: float = DURATION,
-            progress: Optional[Callable] = None) -> list[dict]:
+            progress: Optional[Callable[[str], None]] = None) -> list[dict]:
     """One record per (condition, law): each metric's per-run values and their mean and 95 % interval."""
     from steerlab.sim.batch import simulate_batch
     from steerlab.sim.setup import build
@@ -93,7 +93,7 @@ def measure(n_seeds: int = 10, seed: int = SEED, quick: bool = False, duration: 
                 rec[k] = {"mean": mean, "ci95": [lo, hi], "runs": v.tolist()}
             out.append(rec)
         if progress is not None:
-            progress(c + 1, len(conds))
+            progress(f"condition {c + 1}/{len(conds)}: {ship} {sea_name} {task}")
     return out
 
 
@@ -133,7 +133,7 @@ def run(out_dir, progress=None, quick: bool = False, n_seeds: Optional[int] = No
     for r in records:
         for k, unit, label in METRICS:
             s = r[k]
-            rows.append({"quantity": f"{r['ship']} {r['sea']} {r['task']}: {label} ({r['law']})", "paper": None,
+            rows.append({"quantity": f"{r['ship']} {r['sea']} {r['task']}: {label} ({r['law']})", "paper": "-",
                          "steerlab": s["mean"], "unit": unit,
                          "note": f"95% CI [{s['ci95'][0]:.4g}, {s['ci95'][1]:.4g}], n = {r['n']}, seeds "
                                  f"{seed}..{seed + r['n'] - 1}"})
