@@ -72,7 +72,7 @@ def conditions(quick: bool = False):
 
 
 def measure(n_seeds: int = 10, seed: int = SEED, quick: bool = False, duration: float = DURATION,
-            progress: Optional[Callable[[str], None]] = None) -> list[dict]:
+            progress: Optional[Callable[[str], None]] = None, laws=LAWS) -> list[dict]:
     """One record per (condition, law): each metric's per-run values and their mean and 95 % interval."""
     from steerlab.sim.batch import simulate_batch
     from steerlab.sim.setup import build
@@ -81,7 +81,7 @@ def measure(n_seeds: int = 10, seed: int = SEED, quick: bool = False, duration: 
     out = []
     conds = list(conditions(quick))
     for c, (ship, kn, sea_name, sea, task) in enumerate(conds):
-        for law in LAWS:
+        for law in laws:
             setups = [build(scenario(law, ship, kn, sea, task, seed + i, duration)) for i in range(n_seeds)]
             m = simulate_batch(setups).metrics
             vals = {"mean_abs_e_deg": np.asarray(m["iae_deg_s"], float) / duration}

@@ -23,7 +23,8 @@ is the sea ``steerlab run`` gives that seed.
 engine's vectorised groups and does the whole step - actions checked, autoresets, plants,
 guidance, observations, rewards - in one compiled call
 (``step`` of :func:`steerlab.gym.plant_batch.env_kernels`, :meth:`Episodes.step_autoreset`), spread
-over the threads from :data:`THREADS_FROM` ships on; the single environment steps its ship
+over ``threads`` threads from :data:`THREADS_FROM` ships on (default one thread: the env
+never switches to threads by itself); the single environment steps its ship
 with the scalar kernel; the numbers are the same.
 """
 
@@ -59,8 +60,9 @@ THREADS_FROM = 512
 it, one call in the calling thread. A step of 1024 ships at the default ``control_dt`` takes
 some 165-175 us on one core of the 2-core development VM (0.17 us per ship; 260-285 us before
 the step was made cheaper, 2026-11-26), about 100 us on two TBB threads with a core free; see
-``benchmarks/README.md`` for what the threads give there. ``numba.set_num_threads(1)`` keeps
-the env on one thread."""
+``benchmarks/README.md`` for what the threads give there. Used only when threads are asked
+(``threads=k`` or ``None``: numba's count); the default ``threads=1`` keeps the env on one
+thread at every N (issue 34: the automatic switch ran at 0.65x one thread under load)."""
 from steerlab.gym.plant_batch import N_OBS, OBS_DELTA, OBS_E, OBS_NAMES, OBS_UNITS  # noqa: E402,F401  (the layout, declared there)
 from steerlab.guidance.reference_vector import REF_XTE  # noqa: E402
 

@@ -6,10 +6,11 @@ gives a :class:`SteeringVectorEnv`: spaces, reward and episodes as the single
 advanced by the batch engine's vectorised groups of ``LANES`` ships in one compiled call
 (``step`` of :func:`steerlab.gym.plant_batch.env_kernels`: actions checked, autoresets, plants,
 guidance, observations and rewards; the single environment steps its ship with the scalar
-kernel, with the same numbers); from 512 ships on (:data:`~steerlab.gym.episodes.THREADS_FROM`)
-the call is split into ranges of whole groups spread over ``numba.get_num_threads()``
-threads by numba's ``prange`` (on TBB, or a layer the user chose: :mod:`steerlab.jit.threading_layer`),
-after every action has been checked (same numbers whatever the split). ``reset(seed=s)`` seeds ship i with ``s + i`` (as gymnasium's
+kernel, with the same numbers); asked for threads (``threads=k``, or ``None``: numba's
+count), from 512 ships on (:data:`~steerlab.gym.episodes.THREADS_FROM`) the call is split into
+ranges of whole groups spread over them by numba's ``prange`` (on TBB, or a layer the user
+chose: :mod:`steerlab.jit.threading_layer`), after every action has been checked (same numbers
+whatever the split). ``reset(seed=s)`` seeds ship i with ``s + i`` (as gymnasium's
 ``SyncVectorEnv``; or ``seed=[s0, s1, ...]``, one per ship), so ship i's episodes equal a
 single environment's after ``reset(seed=s + i)``. Autoreset: gymnasium's ``NEXT_STEP`` mode
 (the step after an episode ends resets that ship to its next episode and ignores its action;
