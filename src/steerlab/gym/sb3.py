@@ -21,7 +21,7 @@ policy step 70x slower (87 ms against 1.25 ms, issue 34).
 
 from __future__ import annotations
 
-from typing import Any, Iterable, Optional, Sequence
+from typing import Any, Optional, Sequence
 
 import numpy as np
 
@@ -114,4 +114,4 @@ def make_sb3_vec_env(env: str = "steerlab/CourseKeeping-v0", num_envs: int = 8, 
     return SB3VecEnv(num_envs, task=task, **kw)
 
 
-__all__: Iterable[str] = ("SB3VecEnv", "make_sb3_vec_env")
+__all__ = ["SB3VecEnv", "make_sb3_vec_env"]
