@@ -6,7 +6,9 @@ Usage::
     python benchmarks/bench_env.py                       # N = 1, 64, 1024
     python benchmarks/bench_env.py --n 1,64 --steps 150 --repeats 5 --json
     python benchmarks/bench_env.py --control-dt 0.1     # one RK4 step per env step
-    python benchmarks/bench_env.py --threads 1          # the native env on one thread
+    python benchmarks/bench_env.py --threads 2          # the native env on two threads from 512 ships
+    python benchmarks/bench_env.py --sb3 --n 8,64       # as SB3 sees it: steerlab.gym.sb3 vs DummyVecEnv
+    python benchmarks/bench_env.py --sb3 --subproc --n 8   # ... and SubprocVecEnv (one process per env)
 
 Workload: ``steerlab/CourseKeeping-v0`` with its defaults (Esso tanker at 16 kn, gear 35 deg /
 2.33 deg/s, eq-39 waves, dt 0.1 s, control_dt 1 s = 10 RK4 steps per env step) but episodes of
@@ -24,8 +26,15 @@ wall clock and by the process's CPU time (``time.process_time``, all the process
 ``reset_ms`` is the median wall time of one reset of all N native ships without a seed (what
 an autoreset round costs).
 
-Threads: the native env spreads a step (and a reset) of ``THREADS_FROM`` = 512 ships or more
-over ``numba.get_num_threads()`` threads (the cores, or ``--threads``) with numba's
+``--sb3``: env-steps/s as Stable-Baselines3 sees them (``VecEnv.step``, what PPO's rollout
+calls): steerlab's adapter (:mod:`steerlab.gym.sb3`, same-step autoreset on the native env, the
+normalised observation and the ``"autopilot"`` reward terms) against SB3's ``DummyVecEnv`` over N
+single environments of the same settings (and ``SubprocVecEnv`` with ``--subproc``: one process
+per env), ``--repeats`` alternating timings, medians.
+
+Threads: the native env runs on one thread unless asked (issue 34: an automatic switch to two
+threads from 512 ships ran at 0.65x one thread with the cores busy); ``--threads k`` asks it to
+spread a step (and a reset) of ``THREADS_FROM`` = 512 ships or more over k threads with numba's
 ``prange`` (:meth:`steerlab.gym.episodes.Episodes.step_autoreset`) on the threading layer
 steerlab asks for (:mod:`steerlab.jit.threading_layer`: TBB, else workqueue, unless
 ``NUMBA_THREADING_LAYER`` says otherwise; ``layer`` in the output); ``threads`` in the table
@@ -76,15 +85,66 @@ def _reset_ms(env, n, repeats):
     return 1e3 * float(np.median(times))
 
 
-def measure(n, steps=150, repeats=5, control_dt=1.0, min_s=0.2):
+def _time_sb3(venv, acts, min_s=0.0):
+    """``(wall, cpu)`` seconds per ``len(acts)`` SB3 steps after ``seed(0); reset()``."""
+    wall = cpu = 0.0
+    blocks = 0
+    while blocks == 0 or wall < min_s:
+        venv.seed(0)
+        venv.reset()
+        w0, c0 = time.perf_counter(), time.process_time()
+        for a in acts:
+            venv.step(a)
+        wall += time.perf_counter() - w0
+        cpu += time.process_time() - c0
+        blocks += 1
+    return wall / blocks, cpu / blocks
+
+
+def measure_sb3(n, steps=150, repeats=5, control_dt=1.0, min_s=0.2, subproc=False):
+    """One row for ``n`` ships as SB3 sees them (module docstring)."""
+    import gymnasium as gym
+    from stable_baselines3.common.vec_env import DummyVecEnv, SubprocVecEnv
+
+    import steerlab.gym  # noqa: F401
+    from steerlab.gym.sb3 import make_sb3_vec_env
+
+    kw = {"episode_s": 120 * control_dt, "control_dt": control_dt, "observation": "normalised",
+          "reward": "autopilot"}
+    envs = {"adapter": make_sb3_vec_env("steerlab/CourseKeeping-v0", n, **kw),
+            "dummy": DummyVecEnv([lambda: gym.make("steerlab/CourseKeeping-v0", **kw) for _ in range(n)])}
+    if subproc:
+        envs["subproc"] = SubprocVecEnv([lambda: gym.make("steerlab/CourseKeeping-v0", **kw) for _ in range(n)])
+    acts = np.random.default_rng(0).uniform(-1, 1, size=(steps, n, 1)).astype(np.float32)
+    for env in envs.values():
+        _time_sb3(env, acts[:5])
+    t = {k: [] for k in envs}
+    for _ in range(repeats):
+        for k, env in envs.items():
+            t[k].append(_time_sb3(env, acts, min_s=min_s))
+    row = {"n": n, "control_dt": control_dt, "steps": steps, "repeats": repeats}
+    for k, times in t.items():
+        wall, cpu = np.median(np.array(times), axis=0)
+        row[f"{k}_env_steps_per_s"] = n * steps / wall
+        row[f"{k}_env_steps_per_cpu_s"] = n * steps / cpu
+    row["ratio_vs_dummy"] = row["adapter_env_steps_per_s"] / row["dummy_env_steps_per_s"]
+    if subproc:
+        row["ratio_vs_subproc"] = row["adapter_env_steps_per_s"] / row["subproc_env_steps_per_s"]
+    for env in envs.values():
+        env.close()
+    return row
+
+
+def measure(n, steps=150, repeats=5, control_dt=1.0, min_s=0.2, threads=1):
     """One row of the table for ``n`` ships (see the module docstring)."""
     import gymnasium as gym
 
     import steerlab.gym  # noqa: F401  (registers the ids)
 
     kw = {"episode_s": 120 * control_dt, "control_dt": control_dt}
-    native = gym.make_vec("steerlab/CourseKeeping-v0", num_envs=n, vectorization_mode="vector_entry_point", **kw)
-    threads = native.unwrapped.core._threads(n)
+    native = gym.make_vec("steerlab/CourseKeeping-v0", num_envs=n, vectorization_mode="vector_entry_point",
+                          threads=threads, **kw)
+    threads = native.unwrapped.core._threads(n)        # what the env used at this N
     sync = gym.vector.SyncVectorEnv([lambda: gym.make("steerlab/CourseKeeping-v0", **kw) for _ in range(n)])
     acts = np.random.default_rng(0).uniform(-1, 1, size=(steps, n, 1)).astype(np.float32)
     for env in (native, sync):                           # warm-up: compiles, touches the memory
@@ -117,8 +177,9 @@ def main(argv=None) -> int:
     ap.add_argument("--min-time", type=float, default=0.2,
                     help="each timing repeats its block of steps until this many seconds (small N)")
     ap.add_argument("--threads", type=int, default=None,
-                    help="threads of the native env from 512 ships on (numba.set_num_threads; default: "
-                         "numba's number, the cores)")
+                    help="threads of the native env from 512 ships on (default: 1, the env's default)")
+    ap.add_argument("--sb3", action="store_true", help="time SB3's VecEnv.step: the adapter against DummyVecEnv")
+    ap.add_argument("--subproc", action="store_true", help="with --sb3: SubprocVecEnv too")
     ap.add_argument("--json", action="store_true")
     a = ap.parse_args(argv)
     import numba
@@ -133,9 +194,22 @@ def main(argv=None) -> int:
             return 2
         numba.set_num_threads(a.threads)
     rows = []
+    if a.sb3:
+        for n in (int(v) for v in a.n.split(",")):
+            r = measure_sb3(n, a.steps, a.repeats, a.control_dt, a.min_time, a.subproc)
+            rows.append(r)
+            if not a.json:
+                extra = (f"   SubprocVecEnv {r['subproc_env_steps_per_s']:10.3g}   ratio {r['ratio_vs_subproc']:6.1f}x"
+                         if a.subproc else "")
+                print(f"N={n:5d}  SB3 adapter {r['adapter_env_steps_per_s']:10.3g} env-steps/s   DummyVecEnv "
+                      f"{r['dummy_env_steps_per_s']:10.3g}   ratio {r['ratio_vs_dummy']:6.1f}x{extra}", flush=True)
+        if a.json:
+            print(json.dumps({"workload": "SB3 VecEnv.step, steerlab/CourseKeeping-v0 normalised/autopilot",
+                              "load_average_1min": os.getloadavg()[0], "rows": rows}, indent=2))
+        return 0
     load0 = os.getloadavg()
     for n in (int(v) for v in a.n.split(",")):
-        r = measure(n, a.steps, a.repeats, a.control_dt, a.min_time)
+        r = measure(n, a.steps, a.repeats, a.control_dt, a.min_time, threads=a.threads or 1)
         rows.append(r)
         if not a.json:
             print(f"N={n:5d}  threads {r['threads']}  native {r['native_env_steps_per_s']:10.3g} env-steps/s   "

@@ -117,8 +117,9 @@ def scenario():
 
 # ---------------------------------------------------------------- real parts must run in CI
 REAL_PART_FILES = ("test_runtime_browser.py", "test_runtime_browser_rebinding.py", "test_runtime_browser_phone.py",
-                   "test_signalk_plugin.py")
-"""Tests of real parts (Debian's chromium, a real signalk-server, its NMEA 0183 parser, node).
+                   "test_signalk_plugin.py", "test_gym_sb3.py")
+"""Tests of real parts (Debian's chromium, a real signalk-server, its NMEA 0183 parser, node;
+Stable-Baselines3 with torch's CPU build).
 Locally they skip with a reason where a part is missing; with ``STEERLAB_REQUIRE_REAL_PARTS=1``
 (set by ``.ci/run``, which installs the parts) a skip of any of them fails the run."""
 
@@ -143,7 +144,7 @@ def pytest_terminal_summary(terminalreporter, exitstatus, config):
             terminalreporter.write_line(f"  {s}", red=True)
         config._steerlab_real_parts_skipped = True
     else:
-        terminalreporter.write_line("real parts: browser, Signal K server and NMEA parser tests ran (none skipped)")
+        terminalreporter.write_line("real parts: browser, Signal K server, NMEA parser and SB3 tests ran (none skipped)")
 
 
 def pytest_sessionfinish(session, exitstatus):

@@ -144,13 +144,16 @@ def test_the_threaded_step_runs_on_workqueue_too():
 
 
 def test_the_vector_env_threads_only_where_threads_pay(monkeypatch):
-    """From THREADS_FROM ships numba's threads, unless the layer is one where a threaded step is
-    slower than one call (workqueue); an explicit ``threads`` is kept either way."""
+    """One thread by default at every N (issue 34); asked for numba's threads (``threads=None``),
+    from THREADS_FROM ships on, unless the layer is one where a threaded step is slower than one
+    call (workqueue); an explicit ``threads`` is kept either way."""
     from steerlab.gym import episodes
     from steerlab.jit.threading_layer import num_threads
 
     core = episodes.Episodes(2, episode_s=4.0, vectorised=True)
     big = episodes.THREADS_FROM
+    assert core.threads == 1 and core._threads(big) == 1 and core._threads(100 * big) == 1
+    core.threads = None
     for pay, want in ((True, num_threads()), (False, 1)):
         monkeypatch.setattr(episodes, "threads_pay", lambda pay=pay: pay)
         assert core._threads(big - 1) == 1 and core._threads(big) == want

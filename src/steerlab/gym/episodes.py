@@ -23,7 +23,8 @@ is the sea ``steerlab run`` gives that seed.
 engine's vectorised groups and does the whole step - actions checked, autoresets, plants,
 guidance, observations, rewards - in one compiled call
 (``step`` of :func:`steerlab.gym.plant_batch.env_kernels`, :meth:`Episodes.step_autoreset`), spread
-over the threads from :data:`THREADS_FROM` ships on; the single environment steps its ship
+over ``threads`` threads from :data:`THREADS_FROM` ships on (default one thread: the env
+never switches to threads by itself); the single environment steps its ship
 with the scalar kernel; the numbers are the same.
 """
 
@@ -59,9 +60,11 @@ THREADS_FROM = 512
 it, one call in the calling thread. A step of 1024 ships at the default ``control_dt`` takes
 some 165-175 us on one core of the 2-core development VM (0.17 us per ship; 260-285 us before
 the step was made cheaper, 2026-11-26), about 100 us on two TBB threads with a core free; see
-``benchmarks/README.md`` for what the threads give there. ``numba.set_num_threads(1)`` keeps
-the env on one thread."""
-from steerlab.gym.plant_batch import N_OBS, OBS_NAMES, OBS_UNITS  # noqa: E402,F401  (the layout, declared there)
+``benchmarks/README.md`` for what the threads give there. Used only when threads are asked
+(``threads=k`` or ``None``: numba's count); the default ``threads=1`` keeps the env on one
+thread at every N (issue 34: the automatic switch ran at 0.65x one thread under load)."""
+from steerlab.gym.plant_batch import N_OBS, OBS_DELTA, OBS_E, OBS_NAMES, OBS_UNITS  # noqa: E402,F401  (the layout, declared there)
+from steerlab.guidance.reference_vector import REF_XTE  # noqa: E402
 
 
 def _scenario(task, ship, speed_kn, gear, environment, ship_options, dt, episode_s, change_deg, change_t,
@@ -91,7 +94,8 @@ class Episodes:
                  ship_options: Optional[Mapping[str, Any]] = None, dt: float = 0.1, control_dt: float = 1.0,
                  episode_s: float = 300.0, lam: float = 0.1, initial_offset_deg: float = 10.0,
                  change_deg: float = 20.0, change_t: float = 10.0, guidance: Optional[Mapping[str, Any]] = None,
-                 reward: str = "speed_loss", vectorised: bool = False) -> None:
+                 reward: Union[str, Mapping[str, float]] = "speed_loss", observation: str = "raw",
+                 threads: Optional[int] = 1, vectorised: bool = False) -> None:
         from steerlab.environment.sea import uses_sea
         from steerlab.gym.plant_batch import REWARDS, env_kernels
         from steerlab.guidance.reference_models import course_guide
@@ -100,9 +104,21 @@ class Episodes:
 
         if task not in TASKS:
             raise InputError("task", f"must be one of {TASKS}, got {task!r}")
-        if reward not in REWARDS:
-            raise InputError("reward", f"must be one of {REWARDS}, got {reward!r}")
-        self.reward = REWARDS.index(reward)
+        from steerlab.gym.observations import OBSERVATIONS
+        from steerlab.gym.rewards import PRESETS, reward_weights
+
+        if isinstance(reward, str) and reward not in REWARDS and reward not in PRESETS:
+            raise InputError("reward", f"must be one of {REWARDS + tuple(PRESETS)} or a mapping {{term: weight}}, "
+                                       f"got {reward!r}")
+        # a compiled reward (the step writes it), or weighted terms (steerlab.gym.rewards) after the step
+        self.reward = REWARDS.index(reward) if isinstance(reward, str) and reward in REWARDS else 0
+        self.reward_weights = None if isinstance(reward, str) and reward in REWARDS else reward_weights(reward)
+        if observation not in OBSERVATIONS:
+            raise InputError("observation", f"must be one of {OBSERVATIONS}, got {observation!r}")
+        self.observation = observation
+        if threads is not None and (isinstance(threads, bool) or not isinstance(threads, (int, np.integer))
+                                    or threads < 1):
+            raise InputError("threads", f"must be None (numba's threads) or an int >= 1, got {threads!r}")
         require_finite_range("dt", dt, 0.0, 10.0, lo_open=True)
         require_finite_range("control_dt", control_dt, 0.0, 60.0, lo_open=True)
         require_finite_range("episode_s", episode_s, 0.0, 1e5, lo_open=True)
@@ -146,9 +162,10 @@ class Episodes:
         self.w_index = np.arange(n, dtype=np.int64)
         self._work = np.empty((5, nx))
         self.vectorised = bool(vectorised)
-        # the vectorised step of at least threads_from lanes runs on `threads` threads (None: numba's
-        # number, numba.get_num_threads(), read at each step); the numbers do not depend on either
-        self.threads_from, self.threads = THREADS_FROM, None
+        # the vectorised step of at least threads_from lanes runs on `threads` threads (default 1;
+        # None: numba's number, numba.get_num_threads(), read at each step, where threads pay);
+        # the numbers do not depend on either
+        self.threads_from, self.threads = THREADS_FROM, threads
         from steerlab.jit.drivers import entry
 
         kernels = env_kernels(s0.ship.rhs, self.guide, nx)      # compiled once ever (disk cache)
@@ -161,6 +178,13 @@ class Episodes:
             self._step = entry(kernels, "step_serial")
         self._reset = entry(kernels, "reset")
         self._x0, self._ps0, self._ref0 = s0.x0, s0.ps, initial_reference()
+        from steerlab.gym.observations import N_NORMALISED
+        from steerlab.gym.rewards import RewardTerms
+
+        # weighted reward terms (None: the compiled reward) and the normalised observation (None: raw)
+        self.terms = None if self.reward_weights is None else RewardTerms(self.reward_weights, n, lam,
+                                                                          self.control_dt)
+        self.features = np.zeros((n, N_NORMALISED)) if observation == "normalised" else None
         # per lane: its key (the reset seed), its next episode number (steerlab.gym.lane_seas)
         self.KEY = np.zeros((n, 2), dtype=np.uint64)
         self.EP = np.zeros(n, dtype=np.uint64)
@@ -255,6 +279,9 @@ class Episodes:
             launch(par, at, range_cuts(m, 1, threads), lanes, *args, sea_seeds)
         else:
             self._reset(lanes, *args, sea_seeds)
+        if self.terms is not None:
+            self.terms.restart(lanes, self.obs[lanes, OBS_DELTA])
+        self._observe()
         infos = [{"episode": int(self.EP[i]) - 1, "initial_heading": float(self.X[i, IPSI])} for i in lanes.tolist()]
         if not self._fast_seas:
             for q, i in enumerate(lanes.tolist()):
@@ -286,8 +313,28 @@ class Episodes:
         self._step(self.X, self.K, self.J, self.cmd, self.W, self.PS, self.PG, self.dt, self.nc, self.gd,
                    self.GZ, self.REF, self.rpm_slot, self.lam, self.reward, act, self.obs, self.rew, self.bad,
                    self._work, *self._sea_args())
+        self._shape(act)
         truncated = self.J >= self.n_env_steps
-        return self.obs, self.rew, self.bad.copy(), truncated & ~self.bad
+        return self.observed, self.rew, self.bad.copy(), truncated & ~self.bad
+
+    @property
+    def observed(self) -> np.ndarray:
+        """The observations handed out: ``obs`` (raw) or ``features`` (normalised), (N, n_obs)."""
+        return self.obs if self.features is None else self.features
+
+    def _observe(self) -> None:
+        if self.features is not None:
+            from steerlab.gym.observations import normalised_lanes
+
+            normalised_lanes(self.X, self.REF, self.bad, self.delta_max, self.features)
+
+    def _shape(self, stepped: np.ndarray) -> None:
+        """After a step of the ``stepped`` lanes (bool mask): the weighted reward terms and the
+        normalised observation, where chosen."""
+        if self.terms is not None:
+            self.terms.step(stepped, self.obs[:, OBS_E], self.obs[:, OBS_DELTA], self.K * self.dt,
+                            self.REF[:, REF_XTE], self.bad, self.rew)
+        self._observe()
 
     def step_autoreset(self, actions: ArrayLike, redo: np.ndarray, term: np.ndarray, trunc: np.ndarray) -> None:
         """The vector environment's step (``step`` of :func:`steerlab.gym.plant_batch.env_kernels`): the
@@ -300,6 +347,7 @@ class Episodes:
         :mod:`steerlab.jit.threading_layer`). A lane's numbers do not depend on the split."""
         a = np.ascontiguousarray(actions, dtype=np.float64).reshape(self.n)
         again = None if self.lazy else redo.copy()
+        before = redo.copy() if self.terms is not None else None
         args = (a, redo, self.X, self.K, self.J, self.cmd, self.W, self.w_index, self.PS, self.PG, self.dt,
                 self.nc, self.gd, self.GZ, self.REF, self.rpm_slot, self.lam, self.reward, self.obs, self.rew,
                 self.bad, term, trunc, self.n_env_steps, self.delta_max, *self._sea_args(), self.KEY, self.EP,
@@ -317,5 +365,8 @@ class Episodes:
             i = launch(par, at, cuts, *args)
         if i >= 0:
             raise self._refused(a[i])
+        if before is not None and before.any():            # reset in the compiled step: a new episode
+            self.terms.restart(np.flatnonzero(before), self.obs[before, OBS_DELTA])
         if again is not None and again.any():              # seas realised lane by lane: reset here
             self.reset_lanes(np.flatnonzero(again))
+        self._shape(~before if before is not None else np.ones(self.n, dtype=np.bool_))
