@@ -154,6 +154,7 @@ def _unshare() -> bool:
         return False
 
 
+@pytest.mark.slow
 @pytest.mark.skipif(sys.platform != "linux" or not shutil.which("unshare"), reason="needs Linux namespaces")
 def test_a_read_only_folder_and_a_tiny_real_tmpfs(reference, tmp_path):
     """Real file systems in a private mount namespace: a read-only folder holding a corrupt
@@ -174,6 +175,7 @@ def test_a_read_only_folder_and_a_tiny_real_tmpfs(reference, tmp_path):
     assert run["numbers"] == reference[1]["numbers"] and run["save_warnings"] == 1 and run["faults"] == 0
 
 
+@pytest.mark.slow
 def test_two_processes_repairing_the_same_corrupt_entry_at_once(reference, tmp_path):
     cache = _copy(reference, tmp_path / "cache")
     _flip(_entry(cache, ".nbc"), 5000)
@@ -217,7 +219,9 @@ def test_cache_verify_lists_each_entry_and_fails_on_a_corrupt_one(reference, tmp
 
     cache = _copy(reference, tmp_path / "cache")
     monkeypatch.setenv("STEERLAB_CACHE_DIR", str(cache))
-    monkeypatch.setattr(cache_check, "folders_to_verify", lambda: [drivers.drivers_dir()])
+    from steerlab.jit import cache_verify
+
+    monkeypatch.setattr(cache_verify, "folders_to_verify", lambda: [drivers.drivers_dir()])
     assert main(["cache", "verify", "--all"]) == 0
     out = capsys.readouterr().out
     assert "2 cached files: 2 ok, 0 corrupt, 0 stale" in out and out.count("\nok ") + out.startswith("ok ") == 2

@@ -26,7 +26,10 @@ if len(sys.argv) > 1 and sys.argv[1] == "enospc":
     caching.IndexDataCacheFile._open_for_write = _full     # the disk is full for numba's writes
 
 warnings.simplefilter("always")
-from steerlab.jit import cache_check  # noqa: E402
+try:
+    from steerlab.jit.cache_check import STATS  # noqa: E402
+except ImportError:          # a steerlab before the check (benchmarks/bench_cache_check.py --before)
+    STATS = {}
 from steerlab.jit.drivers import driver  # noqa: E402
 from steerlab.ships.nomoto1 import nomoto1_rhs, pack  # noqa: E402
 from steerlab.steering_gear import SteeringGear  # noqa: E402
@@ -38,4 +41,4 @@ ps, pg, work = pack(5.0), SteeringGear().pack(), np.empty((5, 7))
 for k in range(200):
     mod.rk4_step(0.5 * k, x, 0.3 if k < 100 else -0.2, w, ps, pg, 0.5, work)
 print(" ".join(float(v).hex() for v in x))
-print(json.dumps({"cached": bool(mod._steerlab_cached), **cache_check.STATS}))
+print(json.dumps({"cached": bool(mod._steerlab_cached), **STATS}))

@@ -102,9 +102,9 @@ def run(args) -> int:
 
 def _verify(args) -> int:
     """``steerlab cache verify``: exit 1 if a corrupt entry was found, else 0."""
-    from steerlab.jit import cache_check
+    from steerlab.jit import cache_verify
 
-    found = cache_check.verify_tree(cache_check.folders_to_verify(), repair=args.repair)
+    found = cache_verify.verify_tree(cache_verify.folders_to_verify(), repair=args.repair)
     counts = {state: sum(s == state for s, _, _ in found) for state in ("ok", "corrupt", "stale")}
     if args.json:
         from steerlab.cli import dump_json

@@ -31,8 +31,8 @@ tests cover (:mod:`steerlab.jit.numba_gate`) together with the locator; where it
 installed the drivers are compiled in memory instead of read from an unchecked disk cache
 (:func:`steerlab.jit.drivers._make`).
 
-:func:`verify_tree` is ``steerlab cache verify``: every entry of this steerlab's cache with its
-state (``ok``, ``corrupt``, ``stale``).
+:func:`state_of` is the check alone, for ``steerlab cache verify``
+(:mod:`steerlab.jit.cache_verify`).
 """
 
 from __future__ import annotations
@@ -48,7 +48,6 @@ import time
 import warnings
 from functools import lru_cache
 from pathlib import Path
-from typing import Iterable
 
 SUFFIX = ".check"
 """The check record of ``f`` is ``f + SUFFIX``."""
@@ -320,11 +319,8 @@ def install() -> bool:
 # ---------------------------------------------------------------- steerlab cache verify
 
 def state_of(path: Path) -> tuple[str, str]:
-    """``(state, reason)`` of a cached numba file or memo entry: ``ok``, ``corrupt``, ``stale``."""
-    if path.suffix == ".json":
-        from steerlab.jit.disk_memo import check_entry
-
-        return check_entry(path)
+    """``(state, reason)`` of a cached numba file: ``ok``, ``corrupt`` or ``stale`` (its bytes
+    against its record; an index also parsed)."""
     try:
         data = _check(str(path))
     except FileNotFoundError:
@@ -342,41 +338,3 @@ def state_of(path: Path) -> tuple[str, str]:
     except Exception as err:  # noqa: BLE001 - checked bytes that do not parse
         return "corrupt", f"does not parse ({type(err).__name__}: {err})"
     return "ok", ""
-
-
-def entries(folders: Iterable[Path]) -> list[Path]:
-    """The cached files under ``folders``: numba's ``*.nbi``/``*.nbc`` and memo ``*.json``."""
-    out: list[Path] = []
-    for folder in folders:
-        if not folder.is_dir():
-            continue
-        for pattern in ("*.nbi", "*.nbc"):
-            out += folder.rglob(pattern)
-        out += (p for p in folder.rglob("*.json") if p.parent.parent.name == "memo")
-    return sorted(set(out))
-
-
-def verify_tree(folders: Iterable[Path], repair: bool = False) -> list[tuple[str, str, str]]:
-    """``[(state, path, reason), ...]`` of every entry under ``folders``; with ``repair`` the
-    corrupt and stale ones are deleted (the next use compiles or computes them again)."""
-    out = []
-    for path in entries(folders):
-        state, reason = state_of(path)
-        if repair and state != "ok":
-            for f in (path, Path(str(path) + SUFFIX)):
-                try:
-                    f.unlink()
-                except OSError:
-                    pass
-        out.append((state, str(path), reason))
-    return out
-
-
-def folders_to_verify() -> list[Path]:
-    """This steerlab's cache: its drivers' folder, its memo folder and the package's own
-    ``__pycache__`` folders (numba's files of the ``cache=True`` kernels)."""
-    from steerlab.jit.drivers import cache_root, drivers_dir
-    from steerlab.jit.numba_cache import PACKAGE_ROOT, _fingerprint
-
-    return [drivers_dir(), cache_root() / "memo" / _fingerprint()[:20], PACKAGE_ROOT]
-
