@@ -124,3 +124,21 @@ def test_the_values_digest_follows_wrapped_kernels_and_ignores_steerlab_modules(
 
     wrapped = bound_kernel(template, "wrapped_for_digest", _inner=user.k)
     assert module_values_digest([wrapped]) == module_values_digest([user.k])
+
+
+def test_an_edited_plugin_file_is_found_by_its_path_for_clear_stale(tmp_path, monkeypatch):
+    """``steerlab cache clear --stale`` finds a plug-in loaded by path (``STEERLAB_PLUGINS``) from
+    its module name in a driver's text, although that name is no importable module."""
+    import hashlib
+
+    from steerlab.jit.kernel_sources import LINE, outdated
+    from steerlab.plugins import plugin_module_name
+
+    plugin = tmp_path / "ship.py"
+    plugin.write_text(PLUGIN.format(rate=1.0), encoding="utf-8")
+    monkeypatch.setenv("STEERLAB_PLUGINS", str(plugin))
+    digest = hashlib.sha256(plugin.read_bytes()).hexdigest()[:16]
+    text = LINE.format(module=plugin_module_name(plugin.resolve()), digest=digest)
+    assert not outdated(text)
+    plugin.write_text(PLUGIN.format(rate=2.0), encoding="utf-8")
+    assert outdated(text)
