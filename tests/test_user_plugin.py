@@ -66,24 +66,27 @@ def test_cli_with_plugins_by_module_path(tmp_path):
     assert r.returncode == 2 and "STEERLAB_PLUGINS" in r.stderr and len(r.stderr.strip().splitlines()) == 1
 
 
-def test_a_plugin_file_never_replaces_another_librarys_module(tmp_path):
-    """A plug-in file named like a module already imported (``json.py``) is refused with one line
-    naming both; the imported module stays (tests/test_layering.py: no replaced modules)."""
+def test_a_plugin_file_never_replaces_another_module(tmp_path):
+    """A plug-in file is keyed by its resolved path, never its stem: one named like a module
+    already imported (``json.py``) is a module of its own and ``json`` stays (tests/test_layering.py:
+    no replaced modules); two files of the same name are two modules (tests/test_plugin_identity.py)."""
     import json
     import sys
 
-    from steerlab.errors import InputError
     from steerlab.plugins import load_module
 
     f = tmp_path / "json.py"
     f.write_text("X = 1\n", encoding="utf-8")
-    with pytest.raises(InputError, match="would replace the module 'json'"):
-        load_module(str(f))
+    mine = load_module(str(f))
+    assert mine.X == 1 and mine is not json
     assert sys.modules["json"] is json and hasattr(json, "dumps")
     other = tmp_path / "sub"
     other.mkdir()
     (tmp_path / "my_plug.py").write_text("X = 1\n", encoding="utf-8")
     (other / "my_plug.py").write_text("X = 2\n", encoding="utf-8")
-    assert load_module(str(tmp_path / "my_plug.py")).X == 1
-    assert load_module(str(other / "my_plug.py")).X == 2          # a plug-in may replace a plug-in
-    sys.modules.pop("my_plug", None)
+    first = load_module(str(tmp_path / "my_plug.py"))
+    second = load_module(str(other / "my_plug.py"))
+    assert first.X == 1 and second.X == 2 and first is not second
+    assert load_module(str(tmp_path / "my_plug.py")) is first and first.X == 1   # not replaced
+    for m in (mine, first, second):
+        sys.modules.pop(m.__name__, None)

@@ -356,17 +356,19 @@ def _say_compiling(msg: str) -> None:
 
 
 def _warnings_as_lines():
-    """Show steerlab's :class:`~steerlab.errors.InertSettingWarning` as one line
-    (:func:`print_warning`) instead of Python's two-line form with a source line; other
+    """Show steerlab's :class:`~steerlab.errors.InertSettingWarning` and
+    :class:`~steerlab.jit.cache_check.CacheWarning` as one line (:func:`print_warning`) instead of Python's two-line form with a source line; other
     warnings as Python shows them. Returns the previous ``warnings.showwarning`` (restored
     when the command ends)."""
     import warnings
+
+    from steerlab.jit.cache_check import CacheWarning
 
     previous = warnings.showwarning
     SHOWN_WARNINGS.clear()
 
     def show(message, category, filename, lineno, file=None, line=None):
-        if not issubclass(category, InertSettingWarning):
+        if not issubclass(category, (InertSettingWarning, CacheWarning)):
             return previous(message, category, filename, lineno, file, line)
         print_warning(str(message))
 

@@ -53,27 +53,38 @@ from steerlab.errors import InputError
 PLUGINS_ENV = "STEERLAB_PLUGINS"
 
 
+def plugin_module_name(path: Path) -> str:
+    """The ``sys.modules`` name of a plug-in file: its stem and a digest of its resolved path
+    (``ship_3f2a9c01d4``). Keyed by the path, never by the stem alone: two plug-ins
+    ``a/ship.py`` and ``b/ship.py`` loaded together are two modules, and each one's kernels are
+    named (and their compiled drivers cached) apart; the same file gives the same name in every
+    process, so specs and kernels still pickle by name to workers that load the same plug-ins."""
+    import hashlib
+    import re
+
+    stem = re.sub(r"\W", "_", path.stem) or "plugin"
+    return f"{stem}_{hashlib.sha256(str(path).encode()).hexdigest()[:10]}"
+
+
 def load_module(ref: str) -> ModuleType:
     """Import a module by dotted name, or a ``.py`` file by path (registered in ``sys.modules``
-    under its stem, so that pickling the specs it defines works in the same process)."""
+    under :func:`plugin_module_name`, so that pickling the specs it defines works in the same
+    process; a file already imported under its own stem, from the same path, is that module)."""
     ref = str(ref).strip()
     if ref.endswith(".py") or os.sep in ref or "/" in ref:
         path = Path(ref).expanduser().resolve()
         if not path.is_file():
             raise InputError(PLUGINS_ENV, f"no such plug-in file {str(path)!r}")
-        name = path.stem
-        existing = sys.modules.get(name)
-        if existing is not None and Path(getattr(existing, "__file__", "") or "").resolve() == path:
-            return existing
-        if existing is not None and not getattr(existing, "__steerlab_plugin__", False):
-            raise InputError(PLUGINS_ENV, f"plug-in file {str(path)!r} would replace the module {name!r} "
-                             f"already imported from {getattr(existing, '__file__', None) or 'built-in'}; "
-                             f"rename the file")
+        for name in (plugin_module_name(path), path.stem):
+            existing = sys.modules.get(name)
+            if existing is not None and Path(getattr(existing, "__file__", "") or "").resolve() == path:
+                return existing
+        name = plugin_module_name(path)
         spec = importlib.util.spec_from_file_location(name, path)
         if spec is None or spec.loader is None:
             raise InputError(PLUGINS_ENV, f"cannot load {str(path)!r} as a Python module")
         module = importlib.util.module_from_spec(spec)
-        setattr(module, "__steerlab_plugin__", True)   # another plug-in file of the same name may replace it
+        setattr(module, "__steerlab_plugin__", True)
         sys.modules[name] = module
         try:
             spec.loader.exec_module(module)

@@ -1,11 +1,15 @@
-"""``steerlab cache info|clear|warm``: the on-disk cache of compiled drivers.
+"""``steerlab cache info|clear|warm|verify``: the on-disk cache of compiled drivers.
 
 Each (ship, controller, guidance) combination's closed loop is compiled once and kept in
 the cache (:mod:`steerlab.jit.drivers`), so later processes load it in milliseconds.
 ``warm`` compiles the common catalogue combinations ahead of time (e.g. once per CI run,
 or after installing steerlab), and on request the ships' plant steps and trial loops, the
 combinations of scenario files and the Gymnasium environments; ``clear`` deletes the cache (``--stale`` only the entries of
-other steerlab versions, and the drivers compiled from plug-in code that has been edited since).
+other steerlab versions, and the drivers compiled from plug-in code that has been edited since),
+safely beside running commands; ``verify`` checks every cached file against the digest written
+beside it and lists each one's state (ok, corrupt, stale): exit status 1 if any is corrupt
+(``--repair`` deletes the corrupt and stale ones; a corrupt file is never used in any case: it is
+compiled again with one warning).
 """
 
 from __future__ import annotations
@@ -21,6 +25,8 @@ EXAMPLES = """examples:
   steerlab cache warm --ships all --controllers pid --plants --trials   # + plant steps, trials
   steerlab cache warm --scenario examples/scenarios/los-route.toml --batch   # what a file uses
   steerlab cache clear --stale        # drop the entries of other steerlab versions and of edited plug-ins
+  steerlab cache verify               # every cached file: ok / corrupt / stale (exit 1 if any corrupt)
+  steerlab cache verify --repair      # ... and delete the corrupt and stale ones
   STEERLAB_CACHE_DIR=/tmp/slc steerlab cache info"""
 
 COMMON_SHIPS = ("esso", "nomoto1", "de-keizer", "kosoko")
@@ -28,10 +34,10 @@ COMMON_CONTROLLERS = ("pid", "adrc")
 
 
 def register(sub, formatter_class):
-    p = sub.add_parser("cache", help="the cache of compiled loops: info, clear, warm",
+    p = sub.add_parser("cache", help="the cache of compiled loops: info, clear, warm, verify",
                        description=__doc__.split("\n\n", 1)[1], epilog=EXAMPLES,
                        formatter_class=formatter_class)
-    p.add_argument("action", choices=("info", "clear", "warm"))
+    p.add_argument("action", choices=("info", "clear", "warm", "verify"))
     p.add_argument("--stale", action="store_true",
                    help="clear: only what will not load again: other steerlab versions' entries, "
                         "and drivers compiled from plug-in code edited since")
@@ -52,7 +58,9 @@ def register(sub, formatter_class):
     p.add_argument("--trials", action="store_true", help="warm: also each ship's manoeuvring-trial loop")
     p.add_argument("--scenario", nargs="+", default=[], metavar="FILE",
                    help="warm: also the combinations these scenario files use (with --batch: batch too)")
-    p.add_argument("--json", action="store_true", help="info: print JSON")
+    p.add_argument("--repair", action="store_true", help="verify: delete the corrupt and stale entries")
+    p.add_argument("--all", action="store_true", help="verify: list the entries that are ok too")
+    p.add_argument("--json", action="store_true", help="info, verify: print JSON")
     p.add_argument("--quiet", action="store_true")
     p.set_defaults(func=run)
 
@@ -87,7 +95,30 @@ def run(args) -> int:
         freed = drivers.cache_clear(stale_only=args.stale)
         print(f"freed {_mb(freed)}")
         return 0
+    if args.action == "verify":
+        return _verify(args)
     return _warm(args)
+
+
+def _verify(args) -> int:
+    """``steerlab cache verify``: exit 1 if a corrupt entry was found, else 0."""
+    from steerlab.jit import cache_verify
+
+    found = cache_verify.verify_tree(cache_verify.folders_to_verify(), repair=args.repair)
+    counts = {state: sum(s == state for s, _, _ in found) for state in ("ok", "corrupt", "stale")}
+    if args.json:
+        from steerlab.cli import dump_json
+
+        print(dump_json({"counts": counts, "repaired": bool(args.repair),
+                         "entries": [{"state": s, "path": p, "reason": r} for s, p, r in found]}))
+    else:
+        for state, path, reason in found:
+            if state != "ok" or args.all:
+                print(f"{state:8s} {path}" + (f"  ({reason})" if reason else ""))
+        done = " (deleted: compiled again at next use)" if args.repair and (counts["corrupt"] or counts["stale"]) else ""
+        print(f"{len(found)} cached files: {counts['ok']} ok, {counts['corrupt']} corrupt, "
+              f"{counts['stale']} stale{done}")
+    return 1 if counts["corrupt"] else 0
 
 
 def _lanes(args):

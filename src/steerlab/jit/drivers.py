@@ -28,9 +28,17 @@ Cache layout and guarantees
   the project modules it imports: :mod:`steerlab.jit.kernel_sources`): an edit to any of them
   gives another module, never the old machine code; ``steerlab cache clear --stale`` drops
   the modules of code edited since.
-* **Corrupt entries are rebuilt.** Before the first use in a process, the driver's module
-  text and numba's index and data files are read back; a truncated or unreadable file is
-  deleted and the driver recompiled, never a crash.
+* **A cache that cannot lie.** The module's text is compared with the expected text before
+  it is imported (and rewritten if it differs); numba's index and data files are checked
+  against the digest written beside them before their bytes reach ``pickle`` or LLVM
+  (:mod:`steerlab.jit.cache_check`): a corrupt or stale file is compiled again in memory with
+  one warning and repaired, a save that fails warns once and the process runs uncached.
+  Where that check is not installed (numba outside the tested versions, or
+  ``STEERLAB_NUMBA_CACHE_STAMP=0``) the drivers are compiled in memory, never loaded unchecked.
+* **Module-level values are part of the key.** The values of the module globals a user's
+  kernel reads (numbers, strings, arrays: numba freezes them into the machine code) are
+  digested into the module's text (:mod:`steerlab.jit.kernel_values`), so a value read from a
+  data file or an environment variable that changes gives another driver.
 
 Kernels that cannot be named by :mod:`steerlab.jit.kernel_refs` (defined in ``__main__``, a
 notebook, a closure) get the same driver built in memory and compiled in the process, as
@@ -46,7 +54,6 @@ import glob
 import hashlib
 import importlib.util
 import os
-import pickle
 import shutil
 import sys
 import threading
@@ -58,6 +65,7 @@ from typing import Callable, Optional
 from steerlab.jit.kernel_refs import describe, kernel_ref
 from steerlab.jit.kernel_sources import LINE as SOURCE_LINE
 from steerlab.jit.kernel_sources import outdated, source_digests
+from steerlab.jit.kernel_values import VALUES_LINE, module_values_digest
 from steerlab.jit.numba_cache import _fingerprint
 from steerlab.jit.vector_reports import MODULE_PREFIX
 
@@ -122,15 +130,17 @@ def driver(ship_rhs, ctrl_update=None, guide=None, nx: int = 0, lanes: int = 16,
         return mod
 
 
-def _bindings(refs: dict, nx: int, lanes: int, cache: bool, sources=()) -> str:
+def _bindings(refs: dict, nx: int, lanes: int, cache: bool, sources=(), values: str = "") -> str:
     """The bindings block of a generated driver: its kernels by reference, its sizes, and the
     digests of the user source files its kernels are compiled from (``sources``,
     :func:`steerlab.jit.kernel_sources.source_digests`: an edit to one of them gives another
-    text, hence another module and machine code)."""
+    text, hence another module and machine code) and of the module-level values they read
+    (``values``, :func:`steerlab.jit.kernel_values.module_values_digest`)."""
     lines = [BEGIN, "from steerlab.jit.kernel_refs import resolve as _resolve"]
     for name in ("SHIP_RHS", "CTRL_UPDATE", "GUIDE"):
         lines.append(f"{name} = _resolve({refs[name]!r})")
     lines += [SOURCE_LINE.format(module=module, digest=digest) for module, digest in sources]
+    lines += [VALUES_LINE.format(digest=values)] if values else []
     lines += [f"NX = {int(nx)}", f"LANES = {int(lanes)}", f"CACHE = {bool(cache)}", END]
     return "\n".join(lines)
 
@@ -159,15 +169,25 @@ def _make(key: _Key) -> types.ModuleType:
             "GUIDE": kernel_ref(key.guide)}
     nameable = all(refs[n] is not None or k is None
                    for n, k in (("SHIP_RHS", key.ship), ("CTRL_UPDATE", key.ctrl), ("GUIDE", key.guide)))
-    sources = source_digests(refs.values()) if enabled() and nameable else None
+    sources = source_digests(refs.values()) if enabled() and nameable and _checked() else None
+    values = module_values_digest((key.ship, key.ctrl, key.guide)) if sources is not None else None
     if sources is not None:
         try:
-            return _from_disk(key, _source(_bindings(refs, key.nx, key.lanes, True, sources), key.template))
-        except (OSError, ImportError, AttributeError):
-            # read-only or full disk, or a plug-in kernel whose module cannot be imported back
-            # by name: the same driver, compiled in memory
+            return _from_disk(key, _source(_bindings(refs, key.nx, key.lanes, True, sources, values),
+                                           key.template))
+        except (OSError, ImportError, AttributeError, RuntimeError):
+            # read-only or full disk, a plug-in kernel whose module cannot be imported back by
+            # name, or no folder numba can cache in: the same driver, compiled in memory
             pass
     return _in_memory(key)
+
+
+def _checked() -> bool:
+    """Whether numba's cache files of the drivers are checked before use in this process
+    (:mod:`steerlab.jit.cache_check`): only then are drivers loaded from the disk cache."""
+    from steerlab.jit import cache_check, numba_cache
+
+    return numba_cache.INSTALLED and cache_check.INSTALLED
 
 
 _TWINS: dict = {}
@@ -214,19 +234,27 @@ def _write_once(path: Path, text: str) -> None:
         pass
     path.parent.mkdir(parents=True, exist_ok=True)
     tmp = path.with_name(f".{path.name}.{os.getpid()}.{threading.get_ident()}.tmp")
-    tmp.write_bytes(data)
     try:
+        tmp.write_bytes(data)
         os.replace(tmp, path)   # same text from every writer: the last rename wins, harmlessly
     finally:
-        if tmp.exists():
+        try:
             tmp.unlink()
+        except OSError:
+            pass
 
 
 def _from_disk(key: _Key, text: str) -> types.ModuleType:
     digest = hashlib.sha1(text.encode("utf-8")).hexdigest()[:20]
     name = f"{MODULE_PREFIX}{digest}"
     path = drivers_dir() / f"d_{digest}.py"
-    _write_once(path, text)
+    try:
+        _write_once(path, text)
+    except OSError as err:                # full disk, read-only folder: compiled in memory instead
+        from steerlab.jit.cache_check import report_save_failure
+
+        report_save_failure(err, str(path.parent))
+        raise
     mod = sys.modules.get(name)
     if mod is None:
         spec = importlib.util.spec_from_file_location(name, path)
@@ -237,8 +265,6 @@ def _from_disk(key: _Key, text: str) -> types.ModuleType:
         except BaseException:
             sys.modules.pop(name, None)
             raise
-    for entry in mod.ENTRY_POINTS:
-        _check_cache_files(getattr(mod, entry))
     from steerlab.jit import vector_reports
 
     vector_reports.install()      # a vectorised entry compiled here leaves its report beside the module
@@ -269,30 +295,6 @@ def cached_signatures(dispatcher) -> list:
         return []
 
 
-def _check_cache_files(dispatcher) -> bool:
-    """Read back the dispatcher's cache files; delete them all if one is unreadable.
-
-    Returns whether they were fine (or absent)."""
-    index, data = _cache_files(dispatcher)
-    if index is None or not os.path.exists(index):
-        return True
-    try:
-        with open(index, "rb") as f:
-            pickle.load(f)
-            pickle.loads(f.read())
-        for path in data:
-            with open(path, "rb") as f:
-                pickle.loads(f.read())
-        return True
-    except Exception:  # noqa: BLE001 - any unreadable entry: rebuild it
-        for path in [index, *data]:
-            try:
-                os.unlink(path)
-            except OSError:
-                pass
-        return False
-
-
 def is_compiled_on_disk(mod: types.ModuleType, entry: str) -> bool:
     """Whether ``mod.entry`` has machine code in the disk cache (or in this process)."""
     disp = getattr(mod, entry)
@@ -319,7 +321,7 @@ def cache_info() -> dict:
     """What the cache holds: root, this steerlab's directory, drivers, files and bytes."""
     root = cache_root()
     here = drivers_dir()
-    dirs = sorted(p for p in (root / "drivers").glob("*") if p.is_dir()) if (root / "drivers").exists() else []
+    dirs = sorted(p for p in (root / "drivers").glob("[!.]*") if p.is_dir()) if (root / "drivers").exists() else []
 
     def size(p: Path) -> int:
         return sum(f.stat().st_size for f in p.rglob("*") if f.is_file())
@@ -345,14 +347,43 @@ def cache_clear(stale_only: bool = False) -> int:
         return 0
     here = drivers_dir()
     freed = 0
-    for p in root.iterdir():
+    for p in list(root.iterdir()):
         if stale_only and p == here:
             freed += _clear_outdated(here)
             continue
-        freed += sum(f.stat().st_size for f in p.rglob("*") if f.is_file())
-        shutil.rmtree(p, ignore_errors=True)
+        freed += _move_aside_and_delete(p)
     with _LOCK:
         _LOADED.clear()
+    return freed
+
+
+def _size(p: Path) -> int:
+    total = 0
+    for f in p.rglob("*"):
+        try:
+            total += f.stat().st_size if f.is_file() else 0
+        except OSError:
+            pass
+    return total
+
+
+def _move_aside_and_delete(p: Path) -> int:
+    """Delete a cache folder safely beside running commands: it is first renamed (atomically)
+    out of every path a process looks up, then deleted. A command that was using it finds no
+    folder: a cache miss; it compiles, makes a new folder and saves (a save that fails then only
+    warns, :mod:`steerlab.jit.cache_check`). Returns bytes freed."""
+    if p.name.startswith(".cleared-"):
+        target = p
+    else:
+        target = p.with_name(f".cleared-{os.getpid()}-{threading.get_ident()}-{p.name}")
+        try:
+            os.rename(p, target)
+        except FileNotFoundError:
+            return 0                         # cleared by another process meanwhile
+        except OSError:
+            target = p                       # cannot rename (e.g. a mount point): delete in place
+    freed = _size(target)
+    shutil.rmtree(target, ignore_errors=True)
     return freed
 
 

@@ -174,6 +174,19 @@ def source_digests(refs) -> Optional[list[tuple[str, str]]]:
     return sorted((m, d) for m, d in seen.items() if d)
 
 
+def _plugin_file(module: str) -> Optional[Path]:
+    """The file of a plug-in loaded by path (``STEERLAB_PLUGINS``) whose module name is
+    ``module`` (:func:`steerlab.plugins.plugin_module_name`), or None."""
+    from steerlab.plugins import env_plugins, plugin_module_name
+
+    for ref in env_plugins():
+        if ref.strip().endswith(".py"):
+            path = Path(ref.strip()).expanduser().resolve()
+            if plugin_module_name(path) == module and path.is_file():
+                return path
+    return None
+
+
 #: how a driver's text records one of them (:func:`steerlab.jit.drivers._bindings` writes it)
 LINE = "# compiled from {module} (sha256 {digest})"
 _LINE = re.compile(r"^# compiled from (\S+) \(sha256 ([0-9a-f]{16})\)$", re.M)
@@ -185,7 +198,7 @@ def outdated(driver_text: str) -> bool:
     found from this process (another project, a plug-in not on ``sys.path``) does not count:
     its driver is kept."""
     for module, digest in _LINE.findall(driver_text):
-        path = _project_file(module, frozenset({module.partition(".")[0]}))
+        path = _project_file(module, frozenset({module.partition(".")[0]})) or _plugin_file(module)
         if path is None:
             continue
         try:

@@ -122,7 +122,10 @@ def _make_locator(base):
             self._driver = driver
 
         def ensure_cache_path(self):
-            self._inner.ensure_cache_path()
+            try:
+                self._inner.ensure_cache_path()
+            except OSError:
+                pass          # unwritable: the save fails, and says so once (cache_check)
 
         def get_cache_path(self):
             return self._inner.get_cache_path()
@@ -140,11 +143,24 @@ def _make_locator(base):
             driver = _is_driver(py_file)
             if not driver and not _inside(py_file):
                 return None                    # not steerlab's: numba's own locators decide
+            p = Path(py_file)
+            name = str(p.relative_to(p.parent.parent)) if driver else ""
             for locator_class in _INNER:
                 inner = locator_class.from_function(py_func, py_file)
                 if inner is not None:
-                    p = Path(py_file)
-                    return cls(inner, str(p.relative_to(p.parent.parent)) if driver else "")
+                    return cls(inner, name)
+            if driver and p.exists():
+                # no writable folder anywhere (a read-only cache, no user cache): the driver's
+                # own folder still serves its checked machine code; a save there warns once
+                from numba.core import config
+
+                for locator_class in _INNER:
+                    if "UserProvided" in locator_class.__name__ and not config.CACHE_DIR:
+                        continue                       # numba's NUMBA_CACHE_DIR locator, unset
+                    try:
+                        return cls(locator_class(py_func, py_file), name)
+                    except Exception:  # noqa: BLE001 - a locator of another shape: try the next
+                        continue
             return None
 
     _PackageStampLocator.__name__ = _PackageStampLocator.__qualname__ = "PackageStampLocator"
@@ -181,6 +197,9 @@ def install() -> bool:
             return False        # a class numba cannot find either: numba says so at first use
         _INNER[:] = inner
         config.CACHE_LOCATOR_CLASSES = f"{CONFIG_NAME},{user}"
+    from steerlab.jit import cache_check
+
+    cache_check.install()          # the files the locator claims are checked before use
     INSTALLED = True
     return True
 
