@@ -23,9 +23,9 @@ import re
 import warnings
 from typing import Optional
 
-TESTED = ((0, 62), (0, 69))
+TESTED = ((0, 67), (0, 69))
 """numba versions the tests cover: from ``TESTED[0]`` (inclusive) to ``TESTED[1]`` (exclusive),
-as ``numba>=0.62,<0.69`` in ``pyproject.toml``."""
+as ``numba>=0.67,<0.69`` in ``pyproject.toml``."""
 
 ENV = "STEERLAB_NUMBA_INTERNALS"
 
