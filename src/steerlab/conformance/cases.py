@@ -112,6 +112,16 @@ def run_length(t_s: float) -> tuple[float, float]:
     return T_CHANGE + after, hold
 
 
+def controller_type(law: str, sea: str) -> str:
+    """The controller type a case runs: the law itself in calm water; in a sea, the law behind
+    the wave filter (``law + "+wf"``, its filter designed for the sample time:
+    :func:`steerlab.control.wave_filtered.design_filter`), as ``steerlab run`` advises
+    (:func:`steerlab.sim.sanity.unfiltered_in_waves`); ``asa`` has its own filter."""
+    from steerlab.control.wave_filtered import NOT_WRAPPED, SUFFIX
+
+    return law if sea == CALM or law in NOT_WRAPPED or law.endswith(SUFFIX) else law + SUFFIX
+
+
 def scenario_dict(case: Case, duration: float) -> dict:
     """The scenario of ``case`` as a plain dict (the TOML shape; degrees and knots)."""
     ship = {"model": case.ship, "speed_kn": case.point.speed_kn}
@@ -119,7 +129,7 @@ def scenario_dict(case: Case, duration: float) -> dict:
         ship["options"] = {"rpm": case.point.rpm}
     d = {"name": f"conformance-{case.ship}-{case.controller}-{case.point.label}-{case.sea}",
          "seed": SEA_SEED, "dt": DT, "duration": duration, "ship": ship, "gear": dict(GEAR),
-         "controller": {"type": case.controller},
+         "controller": {"type": controller_type(case.controller, case.sea)},
          "guidance": {"psi0_deg": 0.0, "changes": [{"t": T_CHANGE, "psi_deg": CHANGE_DEG}]}}
     if case.sea == SEA5:
         d["environment"] = {"wave": dict(SEA)}
