@@ -6,9 +6,9 @@ what would count as a change of model rather than of rounding:
 * KVLCC2 35 deg turn, 15.5 kn, 2.32 deg/s gear: advance 3.08 L, tactical diameter 3.11 L
   (starboard), 3.09 / 3.09 L (port). Tolerance 1 %: the trial interpolates the 90/180 deg
   crossings on a 0.1 s grid (about 0.1 % of L); a 1 % move means the forces changed.
-* Against an independent open-source MMG code (shipmmg 0.0.11, same data, run once by steerlab,
-  see experiments/kvlcc2_validation.py) the starboard advance and tactical diameter agree
-  within 2 %: the two codes share YY2015's hull and rudder model and differ in the wake law.
+* The L7 model at the free-running test's conditions (U0 1.179 m/s, 15.68 deg/s, self-propulsion
+  11.85 rev/s): 3.08 / 3.12 L starboard, 3.09 / 3.10 L port; YY2015 Table 4's test is 3.25 /
+  3.34 and 3.11 / 3.08; a lower propeller rate widens the turn.
 * 10/10 zig-zag: overshoots 5.0 / 14.0 deg, 20/20: 10.6 / 15.9 deg (0.3 deg tolerance: the
   overshoot is read at the heading's turning point on the 0.1 s grid).
 * Froude scaling: the 7 m model (fresh water) and the 320 m ship give the same advance/L and
@@ -131,12 +131,61 @@ def test_kvlcc2_turning_and_zigzag_numbers(kv_trials):
     assert nd["zz20_second"] == pytest.approx(15.9, abs=0.3)
 
 
-def test_kvlcc2_agrees_with_the_open_source_mmg_code_to_starboard(kv_trials):
-    from steerlab.experiments.kvlcc2_validation import OPEN_SOURCE
+@pytest.fixture(scope="module")
+def kv_tank():
+    """kvlcc2-l7 at the free-running test's conditions, two rates of the sensitivity table."""
+    from steerlab.experiments import kvlcc2_validation as kv
 
-    nd = kv_trials[1]["nd"]
-    for key in ("advance_starboard", "tactical_starboard"):
-        assert nd[key] == pytest.approx(OPEN_SOURCE[key], rel=0.02)
+    saved = kv.SENSITIVITY_RPS
+    kv.SENSITIVITY_RPS = (11.0, 12.5)
+    try:
+        return kv.tank_trials()
+    finally:
+        kv.SENSITIVITY_RPS = saved
+
+
+def test_kvlcc2_l7_at_the_test_conditions(kv_tank):
+    """U0 1.179 m/s, 15.68 deg/s, self-propulsion 11.85 rev/s: 3.08/3.12 L starboard,
+    3.09/3.10 L port (issue 32's measurement); YY2015 Table 4's test: 3.25/3.34, 3.11/3.08."""
+    assert kv_tank["n_sp"] == pytest.approx(11.85, abs=0.01)
+    nd = kv_tank["nd"]
+    assert nd["advance_starboard"] == pytest.approx(3.08, rel=0.01)
+    assert nd["tactical_starboard"] == pytest.approx(3.12, rel=0.01)
+    assert nd["advance_port"] == pytest.approx(3.09, rel=0.01)
+    assert nd["tactical_port"] == pytest.approx(3.10, rel=0.01)
+
+
+def test_a_lower_propeller_rate_widens_the_turn(kv_tank):
+    """Less thrust, slower rudder inflow: 1.5 rev/s less widens advance by 0.1-0.2 L."""
+    (n1, lo), (n2, hi) = kv_tank["sensitivity"]
+    assert n1 < n2
+    for key in ("advance_starboard", "tactical_starboard", "advance_port", "tactical_port"):
+        assert lo[key] > hi[key]
+    assert 0.1 < lo["advance_starboard"] - hi["advance_starboard"] < 0.2
+
+
+def test_published_rows_and_reasons(kv_trials, kv_tank, monkeypatch):
+    """Table 4 and 6 values with their source; every turn more than 5 % off carries its measured
+    cause; without a reason the experiment stops; no typed-in values of another code remain."""
+    from steerlab.experiments import kvlcc2_validation as kv
+
+    full, model = kv_trials
+    rows = kv.comparison_rows(full, model, kv_tank)
+    pub = {r["quantity"]: r for r in rows if r["quantity"].startswith(("free-running", "their"))}
+    assert len(pub) == 12
+    assert pub["free-running test (YY2015 Table 4): 35 deg turn to starboard: advance / L"]["paper"] == 3.25
+    assert pub["their full-scale simulation (YY2015 Table 6): 35 deg turn to port: tactical diameter / L"]["paper"] == 3.59
+    for r in pub.values():
+        gap = abs(r["steerlab"] - r["paper"]) / r["paper"]
+        assert "Table" in r["note"] and "DyadShip" in r["note"]
+        assert ("not reproduced within 5 %" in r["note"]) == (gap > 0.05)
+    starboard_test = pub["free-running test (YY2015 Table 4): 35 deg turn to starboard: advance / L"]["note"]
+    assert "propeller rate" in starboard_test and "asymmetry" in starboard_test
+    assert not any("open-source" in r["quantity"] for r in rows)
+    assert sum(r["quantity"].startswith("propeller-rate sensitivity") for r in rows) == 8
+    monkeypatch.setattr(kv, "WHY_NOT", {})
+    with pytest.raises(ValueError, match="WHY_NOT"):
+        kv.comparison_rows(full, model, kv_tank)
 
 
 def test_froude_scaling_model_and_ship_agree(kv_trials):
@@ -145,34 +194,11 @@ def test_froude_scaling_model_and_ship_agree(kv_trials):
         assert model[key] == pytest.approx(full[key], rel=0.005)
 
 
-def test_experiment_rows(tmp_path, kv_trials):
+def test_experiment_is_registered():
     from steerlab.experiments import EXPERIMENTS
     from steerlab.experiments import kvlcc2_validation as kv
 
     assert EXPERIMENTS["kvlcc2-validation"] is kv
-    rows = kv.comparison_rows(*kv_trials)
-    assert all(set(r) == {"quantity", "paper", "steerlab", "unit", "note"} for r in rows)
-    unpublished = [r for r in rows if r["paper"] is None and "asymmetry" not in r["quantity"]]
-    assert len(unpublished) == len(kv.QUANTITIES) - len(kv.PUBLISHED)     # nothing typed from memory
-    assert all("not retrieved" in r["note"] for r in unpublished)
-    assert sum("open-source MMG" in r["quantity"] for r in rows) == 4
-
-
-def test_published_rows_show_the_gap_and_a_reason_beyond_5_percent(monkeypatch, kv_trials):
-    """The mechanics of PUBLISHED / WHY_NOT with stand-in values (not published numbers): a
-    turning quantity more than 5 % off needs a reason in the note, else the experiment stops."""
-    from steerlab.experiments import kvlcc2_validation as kv
-
-    full, model = kv_trials
-    s = full["nd"]["advance_starboard"]
-    monkeypatch.setattr(kv, "PUBLISHED", {"advance_starboard": (s / 1.02, "stand-in source A")})
-    row = kv.comparison_rows(full, model)[0]
-    assert row["paper"] == pytest.approx(s / 1.02) and "stand-in source A; gap +2.0 %" in row["note"]
-    monkeypatch.setattr(kv, "PUBLISHED", {"advance_starboard": (s / 1.10, "stand-in source B")})
-    with pytest.raises(ValueError, match="WHY_NOT"):
-        kv.comparison_rows(full, model)
-    monkeypatch.setattr(kv, "WHY_NOT", {"advance_starboard": "stand-in reason"})
-    assert kv.comparison_rows(full, model)[0]["note"].endswith("not reproduced within 5 %: stand-in reason")
 
 
 # ------------------------------------------------------------------ bad input

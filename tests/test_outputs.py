@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 import os
+import re
 import subprocess
 import sys
 
@@ -149,25 +150,74 @@ def test_every_writing_command_checks_out_first(tmp_path, capsys, argv):
     assert code == 2 and "--out" in err and "not a directory" in err, err
 
 
-def test_existing_foreign_folder_is_kept_and_refused(tmp_path, capsys):
+def _snapshot(d):
+    """Every entry under ``d`` with its bytes: what "nothing changed" compares."""
+    return sorted((str(p.relative_to(d)), p.read_bytes() if p.is_file() else b"<dir>") for p in d.rglob("*"))
+
+
+@pytest.mark.parametrize("names", [
+    ["thesis.tex"],
+    ["result.json", "measurements.csv", "notes.html"],              # the issue's case: looks like an output
+    ["metrics.json", "timeseries.csv", "report.html", "fig_heading.png"],
+    ["comparison.json", "fig_2.png", "table.csv"],                  # an output of a version before the marker
+])
+def test_a_folder_steerlab_did_not_mark_is_refused_and_unchanged(tmp_path, capsys, names):
     out = tmp_path / "o"
     out.mkdir()
-    (out / "thesis.tex").write_text("precious")
+    for name in names:
+        (out / name).write_text(f"the user's {name}")
+    (out / "sub").mkdir()
+    (out / "sub" / "keep.txt").write_text("nested")
+    before = _snapshot(out)
     assert main(["run", "--out", str(out), "--quiet"]) == 2
-    assert "did not write" in capsys.readouterr().err
-    assert _files(out) == ["thesis.tex"]
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "--out" in err[0] and str(out) in err[0], err
+    assert "remove it or choose another folder" in err[0]
+    assert _snapshot(out) == before                          # listed before and after: nothing changed
+    assert _files(tmp_path) == ["o"]                          # no stage either
 
 
-def test_an_output_of_an_earlier_version_without_marker_is_replaced(tmp_path):
-    out = tmp_path / "zw"
-    out.mkdir()
-    for name in ("comparison.json", "fig_2.png", "table.csv"):
-        (out / name).write_text("old")
-    check_out(out)                                          # accepted: it is steerlab's
-    (out / "notes.txt").write_text("mine")
-    with pytest.raises(InputError, match="did not write"):  # a file of another kind: refused
+def test_the_marker_names_the_command_and_the_listing(tmp_path):
+    import json
+
+    from steerlab.outputs import listing_digest
+
+    out = tmp_path / "o"
+    with staged_output(out) as stage:
+        (stage / "a.txt").write_text("12345")
+        (stage / "figs").mkdir()
+        (stage / "figs" / "f.png").write_text("xy")
+    doc = json.loads((out / MARKER).read_text())
+    assert doc["listing"] == {"a.txt": 5, "figs": -1, "figs/f.png": 2}
+    assert doc["listing_sha256"] == listing_digest(doc["listing"])
+    assert doc["command"].startswith("steerlab")
+
+
+@pytest.mark.parametrize("tamper, words", [
+    (lambda o: (o / "notes.html").write_text("mine"), "changed since ('notes.html')"),        # a file added
+    (lambda o: (o / "a.txt").write_text("edited by hand"), "changed since ('a.txt')"),        # a file edited
+    (lambda o: (o / MARKER).write_text("written by steerlab\n"), "without steerlab's listing"),  # old marker
+    (lambda o: (o / MARKER).write_text((o / MARKER).read_text().replace('"a.txt": 1', '"a.txt": 2')),
+     "does not match its digest"),
+])
+def test_a_marked_folder_changed_since_is_refused(tmp_path, tamper, words):
+    out = tmp_path / "o"
+    with staged_output(out) as stage:
+        (stage / "a.txt").write_text("1")
+    tamper(out)
+    before = _snapshot(out)
+    with pytest.raises(InputError, match=re.escape(words)) as exc:
         check_out(out)
-    (out / "notes.txt").unlink()
-    (out / "comparison.json").unlink()
-    with pytest.raises(InputError, match="did not write"):  # no command's JSON: refused
-        check_out(out)
+    assert exc.value.field == "--out" and "remove it or choose another folder" in str(exc.value)
+    assert _snapshot(out) == before
+
+
+def test_a_marked_folder_with_files_removed_is_still_replaced(tmp_path):
+    out = tmp_path / "o"
+    with staged_output(out) as stage:
+        (stage / "a.txt").write_text("1")
+        (stage / "b.txt").write_text("2")
+    (out / "b.txt").unlink()                                  # nothing of the user's to lose
+    with staged_output(out) as stage:
+        (stage / "c.txt").write_text("3")
+    assert _files(out) == [MARKER, "c.txt"]

@@ -59,7 +59,7 @@ def test_one_keep_alive_client_gets_100_answers_from_each_endpoint():
                     resp = conn.getresponse()
                     body = resp.read()
                     assert resp.status == 200, (path, i)
-                    assert resp.getheader("Connection") == "close", path
+                    assert resp.getheader("Connection") == "keep-alive", path
                     assert int(resp.getheader("Content-Length")) == len(body) > 0, path
                     if path.endswith(".json") or "/signalk" in path:
                         json.loads(body)

@@ -111,14 +111,22 @@ def _cpu_timed(obj, name, worst: list, clock: _GcClock):
     setattr(obj, name, timed)
 
 
-async def _hostile(url, rng, stop_at, stats, reply_each=False, max_size=65536):
-    """Send fuzz messages of at most ``max_size`` bytes until ``stop_at`` (reconnecting if closed)."""
-    while time.monotonic() < stop_at:
+MIN_SENT = 250               # fuzz messages each hostile client sends at least, however slow the machine
+
+
+async def _hostile(url, rng, stop_at, stats, reply_each=False, max_size=65536, min_sent=MIN_SENT):
+    """Send fuzz messages of at most ``max_size`` bytes until ``stop_at`` and at least ``min_sent``
+    of them (reconnecting if closed): the amount of fuzz is set by count, not by how fast a busy
+    machine sends in the wall-clock window."""
+    def more() -> bool:
+        return time.monotonic() < stop_at or stats["sent"] < min_sent
+
+    while more():
         try:
             async with connect(url, max_size=2**20, open_timeout=5, close_timeout=1) as ws:
                 if reply_each:
                     await ws.recv()
-                while time.monotonic() < stop_at:
+                while more():
                     msg = _fuzz_message(rng)
                     if len(msg) > max_size // 3:     # (a larger message is closed by the WebSocket layer)
                         continue

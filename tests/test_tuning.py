@@ -347,3 +347,46 @@ def test_a_scipy_outside_the_tested_versions_tunes_publicly_and_refuses_only_the
         run_optimiser(PopulationEvaluator(lq_conditions, pm, [parse_cost("ise")]), "de", 2, 6, 0,
                       checkpoint=tmp_path / "de.ckpt")
     assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("method, cost", [("ga", "itae"), ("de", "ise"), ("nsga2", "itae|travel")])
+def test_a_finished_checkpoint_is_reported_without_another_generation(lq_conditions, tmp_path, method, cost):
+    """Re-running a finished tune with its checkpoint: the same best, bit for bit, no more
+    generations or simulations, the file unchanged; --fresh starts over (the same seed: the same
+    result again); --resume without a file and a checkpoint past --generations are refused."""
+    pm = build_param_map(lq_conditions, ["kp", "kd"], np.array([[0.1, 5.0], [1.0, 100.0]]))
+
+    def ev():
+        return PopulationEvaluator(lq_conditions, pm, [parse_cost(c) for c in cost.split("|")])
+
+    ck = tmp_path / f"{method}.ckpt"
+    said = []
+    first = run_optimiser(ev(), method, 2, 6, 1, checkpoint=ck)
+    written = ck.read_bytes()
+    again = run_optimiser(ev(), method, 2, 6, 1, checkpoint=ck, progress=said.append)
+    assert any("is finished (2 of 2 generations)" in m for m in said), said
+    assert again.n_generations == 2 and again.n_sims == first.n_sims
+    assert np.array_equal(again.x, first.x) and np.array_equal(again.f, first.f)
+    assert again.history == first.history and ck.read_bytes() == written
+    if method == "nsga2":
+        assert np.array_equal(again.front_f, first.front_f)
+    said.clear()
+    fresh = run_optimiser(ev(), method, 2, 6, 1, checkpoint=ck, progress=said.append, checkpoint_mode="fresh")
+    assert any("starting fresh" in m for m in said) and fresh.resumed_from is None
+    assert np.array_equal(fresh.x, first.x) and fresh.n_sims == first.n_sims
+    with pytest.raises(InputError, match=r"already holds 2 generations, more than the 1 asked") as e:
+        run_optimiser(ev(), method, 1, 6, 1, checkpoint=ck)
+    assert e.value.field == "--generations"
+    with pytest.raises(InputError, match="no checkpoint at") as e:
+        run_optimiser(ev(), method, 2, 6, 1, checkpoint=tmp_path / "none.ckpt", checkpoint_mode="resume")
+    assert e.value.field == "--resume"
+
+
+@pytest.mark.parametrize("flag", ["--resume", "--fresh"])
+def test_resume_or_fresh_without_a_checkpoint_is_one_line(tmp_path, capsys, flag):
+    from steerlab.cli import main
+
+    code = main(["tune", str(tmp_path / "x.toml"), "--params", "kp", "--bounds", "0:1", flag,
+                 "--out", str(tmp_path / "o")])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and err == [f"steerlab: error: {flag}: needs --checkpoint FILE"]

@@ -118,7 +118,8 @@ def cmd_experiment(args) -> int:
         rows = run(stage, progress=say, quick=args.quick)
     from steerlab.text_table import render_table
 
-    print(render_table(("quantity", "paper", "steerlab", "unit"),
+    # an experiment whose 'paper' column is not a published measurement names its columns (COLUMNS)
+    print(render_table(getattr(EXPERIMENTS[args.name], "COLUMNS", ("quantity", "paper", "steerlab", "unit")),
                        ((r["quantity"], r["paper"], r["steerlab"], r["unit"]) for r in rows), align="lrrl"))
     say(f"wrote {args.out}/comparison.json and the figures")
     return 0
@@ -279,6 +280,7 @@ def main(argv=None) -> int:
     shown_by = _warnings_as_lines()
     try:
         if getattr(args, "out", None):        # every command that writes: --out checked before any work
+            _name_command(args)
             restore = _prepare_out(args.out)
         elif args.command in RUNS_UNTIL_STOPPED:
             restore = _unwind_on_sigterm()
@@ -370,6 +372,19 @@ def _prepare_out(out: str):
 
     prepare_out(out)
     return _unwind_on_sigterm()
+
+
+def _name_command(args) -> None:
+    """Name the running command in the marker of the folders it writes (its subcommand too)."""
+    from steerlab.outputs import set_command
+
+    words = [str(getattr(args, "command", "") or "")]
+    for attr in ("name", "kind", "trial"):
+        value = getattr(args, attr, None)
+        if isinstance(value, str) and len(value) <= 40:
+            words.append(value)
+            break
+    set_command(" ".join(w for w in words if w))
 
 
 def _unwind_on_sigterm():

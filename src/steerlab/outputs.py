@@ -13,15 +13,21 @@ renames (microseconds) ``NAME`` is missing. The next command writing to ``NAME``
 leftover of a run whose process is gone (:func:`repair_leftovers`): a stage without an old
 folder is an unfinished run (deleted); a stage *with* an old folder means the kill fell between
 the two renames, so the stage is complete and the swap is finished (roll forward); an old folder
-alone is a kill during the final delete (deleted). A folder that exists, is not empty and was
-not written by steerlab (no :data:`MARKER` file, and not an output of an earlier version: only
-.json/.csv/.parquet/.png/.html files, one of them a command's JSON such as ``metrics.json``) is
-never replaced: the command refuses it before doing any work (:func:`check_out`).
+alone is a kill during the final delete (deleted).
+
+Outputs never take what is not theirs: a folder that exists and is not empty is replaced only
+if it holds a :data:`MARKER` that steerlab wrote last in it, naming the command and a digest of
+the listing it wrote (relative paths and sizes, :func:`listing_digest`), and the folder holds
+nothing that listing lacks and no file of another size (files removed since are fine: nothing
+of the user's is lost). Anything else non-empty — a user's folder whatever its files look like,
+an output whose files were edited or added to, an output of a steerlab version before the
+marker — is refused before any work in one line naming the folder (:func:`check_out`).
 """
 
 from __future__ import annotations
 
 import contextlib
+import hashlib
 import json
 import math
 import os
@@ -33,31 +39,91 @@ from steerlab.errors import InputError
 MARKER = ".steerlab-out"
 """File in every output folder: the folder was written by steerlab and may be replaced whole."""
 
-MARKER_TEXT = "written by steerlab: the next run with --out here replaces this folder whole\n"
+MARKER_NOTE = "written by steerlab: the next run with --out here replaces this folder whole"
+
+MAX_LISTING = 100_000
+"""Entries of an output folder listed for its digest at most (a bigger folder is not steerlab's)."""
+
+_command = "steerlab"
+
+
+def set_command(name: str) -> None:
+    """Name the command whose outputs :func:`staged_output` marks (set by the CLI per command)."""
+    global _command
+    _command = f"steerlab {name}" if name else "steerlab"
 
 PARTIAL = ".partial-"   #: infix of a stage folder: ``.NAME.partial-PID``
 OLD = ".old-"           #: infix of a replaced folder awaiting deletion: ``.NAME.old-PID``
 
 
-SIGNATURES = frozenset({"metrics.json", "comparison.json", "montecarlo.json", "robustness.json", "result.json",
-                        "tuning.json", "sea.json", "imo.json", "fit.json", "turning.json", "zigzag.json",
-                        "spiral.json", "pullout.json"})
-"""The JSON file each command writes: one of them marks a folder of an earlier steerlab version."""
-OUTPUT_SUFFIXES = frozenset({".json", ".csv", ".parquet", ".png", ".html"})
-
-
-def _earlier_steerlab_output(folder: Path) -> bool:
-    """A folder written by a steerlab version before :data:`MARKER`: only files, each with an
-    output suffix, one of them a command's JSON (:data:`SIGNATURES`)."""
+def _listing(folder: Path) -> dict[str, int] | None:
+    """``{relative path: size}`` of every entry under ``folder`` but the marker (folders size -1,
+    symbolic links -2); None if it cannot be listed or holds more than :data:`MAX_LISTING`."""
+    found: dict[str, int] = {}
     try:
-        entries = list(folder.iterdir())
+        for root, dirs, files in os.walk(folder, onerror=_raise):
+            rel = os.path.relpath(root, folder)
+            for name in dirs + files:
+                path = os.path.join(root, name)
+                key = name if rel == "." else f"{rel}/{name}"
+                if key == MARKER:
+                    continue
+                if os.path.islink(path):
+                    found[key] = -2
+                elif name in dirs:
+                    found[key] = -1
+                else:
+                    found[key] = os.stat(path).st_size
+                if len(found) > MAX_LISTING:
+                    return None
     except OSError:
-        return False
-    if not entries or len(entries) > 10_000:
-        return False
-    if any(not p.is_file() or p.is_symlink() or p.suffix not in OUTPUT_SUFFIXES for p in entries):
-        return False
-    return any(p.name in SIGNATURES for p in entries)
+        return None
+    return found
+
+
+def _raise(err):
+    raise err
+
+
+def listing_digest(listing: dict[str, int]) -> str:
+    """SHA-256 of a folder listing (sorted ``path<TAB>size`` lines): what the marker records."""
+    h = hashlib.sha256()
+    for key in sorted(listing):
+        h.update(f"{key}\t{listing[key]}\n".encode("utf-8", "surrogateescape"))
+    return h.hexdigest()
+
+
+def write_marker(stage: Path, command: str | None = None) -> None:
+    """Write :data:`MARKER` into the finished ``stage``: the command, the listing and its digest."""
+    listing = _listing(stage) or {}
+    doc = {"note": MARKER_NOTE, "command": command or _command, "listing": listing,
+           "listing_sha256": listing_digest(listing)}
+    (stage / MARKER).write_text(json.dumps(doc, indent=1, sort_keys=True) + "\n", encoding="utf-8")
+
+
+def _foreign(folder: Path) -> str | None:
+    """Why the non-empty ``folder`` is not steerlab's to replace (None: it is, untouched since)."""
+    remedy = "remove it or choose another folder"
+    try:
+        doc = json.loads((folder / MARKER).read_text(encoding="utf-8"))
+        recorded = {str(k): int(v) for k, v in doc["listing"].items()}
+        sound = listing_digest(recorded) == doc["listing_sha256"]
+    except FileNotFoundError:
+        return f"holds files steerlab did not write (no {MARKER} marker); {remedy}"
+    except (OSError, ValueError, KeyError, TypeError, AttributeError):
+        return (f"has a {MARKER} without steerlab's listing (an output of an earlier version, or "
+                f"not steerlab's); {remedy}")
+    if not sound:
+        return f"has a {MARKER} whose listing does not match its digest; {remedy}"
+    now = _listing(folder)
+    if now is None:
+        return f"cannot be listed whole (over {MAX_LISTING} entries or unreadable); {remedy}"
+    changed = sorted(k for k, v in now.items() if recorded.get(k) != v)
+    if changed:
+        shown = ", ".join(repr(k) for k in changed[:3]) + (f" and {len(changed) - 3} more" if len(changed) > 3 else "")
+        return (f"holds files {doc.get('command', 'steerlab')!s:.40} did not write or that changed since "
+                f"({shown}); {remedy}")
+    return None
 
 
 def _pid_alive(pid: int) -> bool:
@@ -82,8 +148,8 @@ def check_out(out_dir) -> Path:
     """Refuse an unusable ``--out`` before any work; returns the absolute folder.
 
     Raises :class:`InputError` (field ``--out``) if it is a file, the root, the current
-    folder or one of its parents, a non-empty folder steerlab did not write (no
-    :data:`MARKER`), or if its nearest existing parent is not a writable folder.
+    folder or one of its parents, a non-empty folder that is not an untouched steerlab output
+    (:func:`_foreign`), or if its nearest existing parent is not a writable folder.
     """
     shown = str(out_dir)
     target = _target(out_dir)
@@ -95,14 +161,14 @@ def check_out(out_dir) -> Path:
     if target == cwd or target in cwd.parents:
         raise InputError("--out", f"{shown!r} is the current folder or one of its parents; the whole "
                                   "folder is replaced on success, so give a folder of its own")
-    if target.is_dir() and not (target / MARKER).exists() and not _earlier_steerlab_output(target):
+    if target.is_dir():
         try:
             empty = next(target.iterdir(), None) is None
         except OSError as err:
             raise InputError("--out", f"cannot list {shown!r}: {err.strerror}") from None
-        if not empty:
-            raise InputError("--out", f"{shown!r} holds files steerlab did not write (no {MARKER}); the whole "
-                                      "folder is replaced on success: choose a new or empty folder")
+        why = None if empty else _foreign(target)
+        if why:
+            raise InputError("--out", f"{shown!r} {why} (the whole folder is replaced on success)")
     parent = target.parent
     while not parent.exists():
         parent = parent.parent
@@ -196,8 +262,8 @@ def staged_output(out_dir: Path):
     shutil.rmtree(stage, ignore_errors=True)
     stage.mkdir()
     try:
-        (stage / MARKER).write_text(MARKER_TEXT, encoding="utf-8")
         yield stage
+        write_marker(stage)                 # last: the listing of everything the command wrote
     except BaseException:
         shutil.rmtree(stage, ignore_errors=True)
         raise

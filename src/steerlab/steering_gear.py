@@ -61,6 +61,33 @@ class SteeringGear(NamedTuple):
                          dead_zone=g.dead_zone)
 
 
+def froude_scaled(gear: SteeringGear, scale: float) -> SteeringGear:
+    r"""The steering gear of a ``1 : scale`` model of a ship with ``gear`` (Froude scaling).
+
+    Froude similarity (equal ``Fn = U / sqrt(g L)``) keeps angles and scales times as
+    ``sqrt(L)``: with ``lambda = L_full / L_model``, ``t_model = t_full / sqrt(lambda)``. Hence
+
+    .. math::
+
+        \delta_{max,m} = \delta_{max},\quad \dot\delta_{max,m} = \sqrt{\lambda}\,\dot\delta_{max},
+        \quad T_{SG,m} = T_{SG} / \sqrt{\lambda},\quad \text{dead zone unchanged}.
+
+    Source: the Froude law as used for free-running model tests (ITTC Recommended Procedure
+    7.5-02-06-01, "Free running model tests", 2021); SIMMAN 2008/2020 KVLCC2 case 1.2 gives
+    2.32 deg/s at full scale and 15.68 deg/s for the 1:45.714 model, i.e. ``2.32 sqrt(45.714)``.
+
+    Parameters
+    ----------
+    gear : SteeringGear
+        The full-scale gear (SI).
+    scale : float
+        ``lambda = L_full / L_model`` [-], >= 1.
+    """
+    require_finite_range("model_scale", scale, 1.0, 1e4)
+    k = scale ** 0.5
+    return SteeringGear(gear.delta_max, gear.rate_max * k, gear.T_sg / k, gear.dead_zone)
+
+
 @numba.njit(cache=True)
 def gear_rate(delta, delta_cmd, g):
     """Rudder rate [rad/s] of eq (15) for angle ``delta`` and order ``delta_cmd`` [rad]."""

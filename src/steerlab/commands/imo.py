@@ -28,6 +28,7 @@ def cmd_imo(args) -> int:
     from steerlab.cli import _progress, dump_json, staged_output
     from steerlab.trials.api import write_figures
     from steerlab.trials.imo_report import write_imo_html
+    from steerlab.trials.imo_criteria import model_scale_note, verdict_text
     from steerlab.trials.imo_standard import run_imo
     from steerlab.trials.tables import format_table
 
@@ -44,11 +45,14 @@ def cmd_imo(args) -> int:
         print(dump_json(report))
     else:
         rows = [(f"{c['trial']}: {c['criterion']}", f"{c['value']:.4g} <= {c['limit']:.4g} {c['unit']}",
-                 {True: "PASS", False: "FAIL", None: "n/a"}[c["pass"]]) for c in report["criteria"]]
+                 verdict_text(c)) for c in report["criteria"]]
         cs = report["course_stability"]
         rows.append(("course stability (spiral / pull-out)", f"{cs['spiral_verdict']} / {cs['pullout_verdict']}",
                      f"loop width {cs['loop_width_deg']:.3g} deg"))
         verdict = {True: "PASS", False: "FAIL", None: "incomplete"}[report["overall_pass"]]
+        scale = report["conditions"].get("model_scale")
+        if scale is not None and report["overall_pass"] is not None:
+            verdict += f" ({model_scale_note(scale)})"
         print(format_table(rows, f"IMO trials on {cond.ship} at {cond.speed_kn:g} kn: {verdict}"))
     say(f"wrote {args.out}/report.html and {args.out}/imo.json")
     return 0

@@ -16,7 +16,8 @@ EXAMPLES = """examples:
   steerlab trial turning --ship esso --rudder 35 --side both --out out/turning
   steerlab trial spiral --ship esso --max-rudder 10 --step 2 --out out/spiral
   steerlab trial pullout --ship nomoto1 --ship-option K=0.1 --ship-option T=80 --no-gear
-  steerlab trial zigzag --ship nomoto1 --speed-kn 12 --rudder 10 --heading 10 --port-first"""
+  steerlab trial zigzag --ship nomoto1 --speed-kn 12 --rudder 10 --heading 10 --port-first
+  steerlab trial turning --ship kvlcc2-l7 --speed-m-s 1.179 --propeller-rps 11 --rudder-rate 15.68 --servo-lag 0.1"""
 
 HELP = {
     "turning": "turning circle: advance, transfer, tactical and steady diameter, steady speed and rate",
@@ -81,8 +82,9 @@ def _table(kind, metrics) -> str:
             rows += imo_rows(m["imo"])
         blocks.append(format_table(rows))
     c = parts[0]["conditions"]
-    head = (f"{kind} trial on {c['ship']} at {c['speed_kn']:g} kn, {c['gear']} "
-            f"(L = {c['L_m']:.4g} m, L/U = {c['L_over_U_s']:.3g} s)")
+    prop = "" if c.get("propeller_rps") is None else f", propeller {c['propeller_rps']:.4g} rev/s"
+    head = (f"{kind} trial on {c['ship']} at {c['speed_kn']:.4g} kn ({c['speed_m_s']:.4g} m/s){prop}, "
+            f"{c.get('gear_description', c['gear'])} (L = {c['L_m']:.4g} m, L/U = {c['L_over_U_s']:.3g} s)")
     return head + "\n" + "\n\n".join(blocks)
 
 

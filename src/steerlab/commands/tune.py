@@ -47,7 +47,13 @@ def register(sub, formatter_class) -> None:
     add_condition_args(p)
     add_executor_args(p)
     p.add_argument("--checkpoint", default=None, metavar="FILE",
-                   help="write a checkpoint after every generation; resume from it if it exists")
+                   help="write a checkpoint after every generation; resume from it if it exists (a finished "
+                        "one is reported without another generation)")
+    again = p.add_mutually_exclusive_group()
+    again.add_argument("--resume", dest="checkpoint_mode", action="store_const", const="resume", default="auto",
+                       help="continue the --checkpoint FILE, which must exist")
+    again.add_argument("--fresh", dest="checkpoint_mode", action="store_const", const="fresh",
+                       help="ignore an existing --checkpoint FILE: start over and overwrite it")
     p.add_argument("--out", required=True, help="output directory")
     p.add_argument("--quiet", action="store_true", help="no progress messages")
     p.set_defaults(func=cmd_tune)
@@ -64,6 +70,8 @@ def cmd_tune(args) -> int:
     from steerlab.tuning.session import TuneSpec, tune, write_tuning_outputs
 
     say = _progress(args.quiet)
+    if args.checkpoint_mode != "auto" and not args.checkpoint:
+        raise InputError(f"--{args.checkpoint_mode}", "needs --checkpoint FILE")
     scenario = load_scenario(args.scenario)
     from steerlab.commands._guard import design_checked
     from steerlab.tuning.session import with_controller
@@ -79,7 +87,7 @@ def cmd_tune(args) -> int:
         raise InputError("--seed", f"must be >= 0, got {args.seed}")
     spec = TuneSpec(scenario, names, bounds, costs, args.controller, method, args.generations,
                     args.pop_size, args.seed, aggregate=args.aggregate, lam=args.lam,
-                    checkpoint=args.checkpoint, **condition_kwargs(args))
+                    checkpoint=args.checkpoint, checkpoint_mode=args.checkpoint_mode, **condition_kwargs(args))
     _check_tune_memory(spec, args.max_memory)
     executor = executor_from_args(args)
     try:

@@ -32,6 +32,8 @@ from pathlib import Path
 from typing import Callable, Optional
 
 NAME = "esso-models"
+#: printed column headers: the JSON's "paper" holds the 2021 paper's simplified model (a model, not a measurement)
+COLUMNS = ("quantity", "esso (2021 simplified model)", "mss-tanker (original)", "unit")
 DESCRIPTION = ("Esso Osaka tanker: the 2021 paper's simplified model (esso) vs the original Van Berlekom & "
                "Goddard model of MSS tanker.m (mss-tanker) in the standard trials at 16 kn, 80 rpm")
 

@@ -35,7 +35,8 @@ Anything else is counted as ``rejected`` and otherwise ignored; nothing a client
 the stream or raises. A request whose ``Host`` does not name this server (DNS rebinding) or a
 WebSocket from a browser page of another origin is refused (403,
 :class:`steerlab.runtime.access.AccessPolicy`), more
-than ``max_clients`` connections are refused (503), and a client that does not read (its write
+than ``max_clients`` connections take the slot of the client quiet longest, or are refused (503)
+when every client spoke within the last second (:class:`~steerlab.runtime.client_slots.ClientSlots`), and a client that does not read (its write
 buffer above ``max_buffer`` bytes) misses updates rather than growing the sender's memory.
 """
 
@@ -50,7 +51,8 @@ from websockets.asyncio.server import broadcast, serve
 
 from steerlab.errors import InputError
 from steerlab.runtime.access import AccessPolicy, parse_json
-from steerlab.runtime.http_conn import CLOSE_TIMEOUT, HttpConnection
+from steerlab.runtime.client_slots import ClientSlots
+from steerlab.runtime.http_conn import CLOSE_TIMEOUT, close_plain_connections, http_connection, is_upgrade
 from steerlab.runtime.path_glob import PathPattern
 from steerlab.runtime.rate_limit import RateLimiter
 from steerlab.runtime.signalk import MAX_DELTA_BYTES, SELF_ID, delta, is_self_context, iso_time
@@ -157,8 +159,10 @@ class SignalKStreamServer:
         self.cache: dict = {}
         self.cache_time: dict = {}       # path -> wall time of its last value [s]
         self.clients: dict = {}          # connection -> Subscriptions
+        self.slots = ClientSlots(max_clients)
         self.counts = {"clients": 0, "sent": 0, "skipped_slow": 0, "subscriptions": 0, "put_ok": 0,
-                       "put_refused": 0, "rejected": 0, "rate_limited": 0, "put_rate_limited": 0, "refused_http": 0}
+                       "put_refused": 0, "rejected": 0, "rate_limited": 0, "put_rate_limited": 0, "refused_http": 0,
+                       "refused_full": 0}
         self.server = None
 
     # ------------------------------------------------------------ HTTP side
@@ -185,8 +189,13 @@ class SignalKStreamServer:
         if opts.get("subscribe", "self") not in SUBSCRIBE_MODES or \
                 opts.get("sendCachedValues", "true") not in ("true", "false"):
             return _response(HTTPStatus.NOT_IMPLEMENTED, b"subscribe must be self, all or none\n", "text/plain")
-        if len(self.clients) >= self.max_clients:
+        if not is_upgrade(request):
+            return _response(HTTPStatus.UPGRADE_REQUIRED, b"the Signal K stream is a WebSocket: send Upgrade: websocket\n",
+                             "text/plain")
+        if not self.slots.make_room():          # full, and every client spoke within the last second
+            self.counts["refused_full"] += 1
             return _response(HTTPStatus.SERVICE_UNAVAILABLE, b"too many Signal K clients\n", "text/plain")
+        self.slots.add(connection)
         return None
 
     # ------------------------------------------------------------ a connection
@@ -201,6 +210,7 @@ class SignalKStreamServer:
             if opts.get("sendCachedValues", "true") == "true":
                 self._send(ws, subs, self.cache)
             async for msg in ws:
+                self.slots.touch(ws)
                 reply = self.handle_message(ws, subs, msg)
                 if reply is not None:
                     await ws.send(json.dumps(reply))
@@ -208,6 +218,7 @@ class SignalKStreamServer:
             pass
         finally:
             self.clients.pop(ws, None)
+            self.slots.remove(ws)
 
     def handle_message(self, source, subs: Subscriptions, msg):
         """Apply one client message; the reply to send (or None). Never raises."""
@@ -279,7 +290,8 @@ class SignalKStreamServer:
         try:
             self.server = await serve(self._handler, self.host, self.port, process_request=self._process_request,
                                       max_size=MAX_DELTA_BYTES, compression=None, server_header=None,
-                                      create_connection=HttpConnection, close_timeout=CLOSE_TIMEOUT)
+                                      open_timeout=None, create_connection=http_connection(self._process_request),
+                                      close_timeout=CLOSE_TIMEOUT)
         except OSError as err:
             raise InputError(self.field, f"cannot bind {self.host}:{self.port}: {err.strerror}") from None
         return self
@@ -287,6 +299,7 @@ class SignalKStreamServer:
     async def close(self) -> None:
         if self.server is not None:
             self.server.close()
+            close_plain_connections(self.server)
             await self.server.wait_closed()
 
 

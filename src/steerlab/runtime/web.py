@@ -32,7 +32,8 @@ from websockets.http11 import Response
 
 from steerlab.errors import InputError
 from steerlab.runtime.access import AccessPolicy, parse_json
-from steerlab.runtime.http_conn import CLOSE_TIMEOUT, HttpConnection
+from steerlab.runtime.client_slots import ClientSlots
+from steerlab.runtime.http_conn import CLOSE_TIMEOUT, close_plain_connections, http_connection, is_upgrade
 from steerlab.runtime.rate_limit import RateLimiter
 
 STATIC = {"/": ("bridge.html", "text/html; charset=utf-8"),
@@ -110,7 +111,8 @@ class BridgeServer:
 
     ``allow_origins``: browser origins allowed besides loopback pages; ``action_rate``: actions
     applied per second per connection (bursts of twice that; no shared limit, so a flooding page
-    cannot lock the operator out; ``max_clients`` pages at most).
+    cannot lock the operator out); ``max_clients`` pages at most, a new page taking the slot of
+    the one quiet longest when full (:class:`~steerlab.runtime.client_slots.ClientSlots`).
     """
 
     def __init__(self, autopilot, host: str = "127.0.0.1", port: int = 8080, period: float = 0.2,
@@ -119,12 +121,22 @@ class BridgeServer:
         self.host, self.port = host, port
         self.period = period
         self.server = None
-        self.clients = 0
         self.max_clients = max_clients
+        self.slots = ClientSlots(max_clients)
         self.access = AccessPolicy(host, allow_origins)
         self.action_rate = action_rate
         self.limiter = RateLimiter(action_rate, 2 * action_rate, max_sources=4 * max_clients)
-        self.counts = {"refused_http": 0, "rate_limited": 0}
+        self.counts = {"refused_http": 0, "rate_limited": 0, "refused_full": 0}
+
+    @property
+    def clients(self) -> int:
+        """Bridge pages connected now."""
+        return len(self.slots)
+
+    @property
+    def evicted(self) -> int:
+        """Quiet pages closed to make room for a new one (docs/reliability.md)."""
+        return self.slots.evicted
 
     def _process_request(self, connection, request):
         path = request.path.split("?", 1)[0]
@@ -133,8 +145,12 @@ class BridgeServer:
             self.counts["refused_http"] += 1
             return _response(HTTPStatus.FORBIDDEN, why.encode() + b"\n", "text/plain")
         if path == "/ws":
-            if self.clients >= self.max_clients:
+            if not is_upgrade(request):
+                return _response(HTTPStatus.UPGRADE_REQUIRED, b"a WebSocket: send Upgrade: websocket\n", "text/plain")
+            if not self.slots.make_room():      # full and every page spoke within the last second
+                self.counts["refused_full"] += 1
                 return _response(HTTPStatus.SERVICE_UNAVAILABLE, b"too many bridge pages\n", "text/plain")
+            self.slots.add(connection)
             return None
         if path == "/status.json":
             body = json.dumps(_json_safe(self.ap.status())).encode()
@@ -145,8 +161,6 @@ class BridgeServer:
         return _response(HTTPStatus.NOT_FOUND, b"not found\n", "text/plain")
 
     async def _handler(self, ws):
-        self.clients += 1
-
         async def push():
             while True:
                 await ws.send(json.dumps(_json_safe({"type": "status", **self.ap.status()})))
@@ -155,12 +169,13 @@ class BridgeServer:
         pusher = asyncio.create_task(push())
         try:
             async for msg in ws:
+                self.slots.touch(ws)
                 await ws.send(json.dumps(self.action(ws, msg)))
         except Exception:
             pass
         finally:
             pusher.cancel()
-            self.clients -= 1
+            self.slots.remove(ws)
 
     def action(self, source, msg) -> dict:
         """The reply to one message of connection ``source``: applied unless over the rate limit."""
@@ -179,7 +194,9 @@ class BridgeServer:
         try:
             self.server = await serve(self._handler, self.host, self.port,
                                       process_request=self._process_request, max_size=4096,
-                                      compression=None, server_header=None, create_connection=HttpConnection, close_timeout=CLOSE_TIMEOUT)
+                                      compression=None, server_header=None, open_timeout=None,
+                                      create_connection=http_connection(self._process_request),
+                                      close_timeout=CLOSE_TIMEOUT)
         except OSError as err:
             raise InputError("--web", f"cannot bind {self.host}:{self.port}: {err.strerror}") from None
         return self
@@ -187,4 +204,5 @@ class BridgeServer:
     async def close(self) -> None:
         if self.server is not None:
             self.server.close()
+            close_plain_connections(self.server)
             await self.server.wait_closed()

@@ -1,7 +1,8 @@
 r"""The ship catalogue: data files ``ships/data/*.toml`` turned into ships (``SHIP_SPECS``).
 
-Each file describes one vessel (``vessel``, ``length_m``, optional ``beam_m`` and
-``block_coefficient``, ``source``, ``notes``) and one or more ``[[entry]]`` tables, each a
+Each file describes one vessel (``vessel``, ``length_m``, optional ``beam_m``,
+``block_coefficient`` and ``model_scale`` (``L_full / L_model`` of a scale model: its default
+steering gear is Froude-scaled), ``source``, ``notes``) and one or more ``[[entry]]`` tables, each a
 model of that vessel as published::
 
     [[entry]]
@@ -157,6 +158,10 @@ class CatalogueEntry:
         self.block_coefficient = vessel.get("block_coefficient")
         self.source = vessel["source"]
         self.vessel_notes = vessel.get("notes", "")
+        self.model_scale = vessel.get("model_scale")
+        if self.model_scale is not None and not (isinstance(self.model_scale, (int, float))
+                                                 and 1.0 <= self.model_scale <= 1e4):
+            raise ValueError(f"{where}: model_scale must be a number in [1, 1e4]")
         scale = KNOT if (self.index == "speed" and units[0] == "kn") else 1.0
         self.index_si = rows[:, 0] * scale          # m/s (speed) or rev/min (rpm)
 
@@ -212,6 +217,8 @@ class CatalogueEntry:
             d["beam_m"] = self.beam
         if self.block_coefficient is not None:
             d["block_coefficient"] = self.block_coefficient
+        if self.model_scale is not None:
+            d["model_scale"] = self.model_scale
         return d
 
 
@@ -287,6 +294,7 @@ def _make_spec(entry: CatalogueEntry):
         b2_exact=b2_exact, dims=dims, source=f"{entry.source}; {entry.table}",
         options_model=opts_model, nomoto_KT=nomoto_KT, speed_range=speed_range,
         equilibrium_rudder=eq_rudder, symmetric=symmetric, catalogue=entry.describe(),
+        model_scale=None if entry.model_scale is None else float(entry.model_scale),
         estimate_unavailable=unavailable)
 
 

@@ -54,7 +54,7 @@ import math
 import tomllib
 from functools import lru_cache
 from importlib import resources
-from typing import Literal
+from typing import Literal, Optional
 
 import numba
 import numpy as np
@@ -128,6 +128,9 @@ class MMGShipData(FrozenConfig):
     description: str
     source: str
     speed_range_m_s: tuple[float, float] = (0.0, float("inf"))
+    #: ``lambda = L_full / L_model`` of a scale model (``ShipSpec.model_scale``: its default
+    #: steering gear is Froude-scaled); None for a full-size ship
+    model_scale: Optional[float] = Field(None, ge=1.0, le=1e4, allow_inf_nan=False)
     hull: HullData
     rudder: RudderData
     propeller: PropellerData
@@ -523,7 +526,8 @@ def _spec_for(data: MMGShipData):
         state_names=PLANAR_NAMES, state_units=PLANAR_UNITS, pack=spec_pack, b2_exact=b2_exact,
         dims=(data.hull.C_b, data.hull.L, data.hull.B), source=data.source, linearise=linearise,
         options_model=MMGOptions, nomoto_KT=nomoto_KT, speed_range=tuple(data.speed_range_m_s),
-        service_speed=float(data.design.speed_m_s), kernel_for_options=kernel_for_options)
+        service_speed=float(data.design.speed_m_s), kernel_for_options=kernel_for_options,
+        model_scale=data.model_scale)
 
 
 def get_mmg_data(name: str) -> MMGShipData:

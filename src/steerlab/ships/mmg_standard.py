@@ -134,6 +134,9 @@ class MMGStdShipData(FrozenConfig):
     speed_range_m_s: tuple[float, float]
     #: the speed the source states [m/s] (``ShipSpec.service_speed``; None: none stated)
     service_speed_m_s: Optional[float] = Field(None, gt=0.0)
+    #: ``lambda = L_full / L_model`` of a scale model (``ShipSpec.model_scale``: its default
+    #: steering gear is Froude-scaled); None for a full-size ship
+    model_scale: Optional[float] = Field(None, ge=1.0, le=1e4, allow_inf_nan=False)
     hull: MMGStdHull
     propeller: MMGStdPropeller
     rudder: MMGStdRudder
@@ -260,6 +263,17 @@ def propeller_rate_for_speed(speed: float, data: MMGStdShipData) -> float:
     b = rho * k1 * up * D**3
     c = rho * k2 * up * up * D**2 - resistance(speed, data) / (1.0 - pr.t_P)
     return (-b + math.sqrt(b * b - 4.0 * a * c)) / (2.0 * a)
+
+
+def propeller_rate_range(data: MMGStdShipData) -> tuple[float, float]:
+    """Propeller rates [rev/s] a ship accepts: the self-propulsion rates
+    (:func:`propeller_rate_for_speed`) at the ends of its validity range ``speed_range_m_s``.
+
+    The hull and propeller data hold only near self-propulsion; a rate outside these is
+    refused (``ship.rpm``) rather than extrapolated.
+    """
+    lo, hi = data.speed_range_m_s
+    return propeller_rate_for_speed(lo, data), propeller_rate_for_speed(hi, data)
 
 
 def pack(data: MMGStdShipData, n_rps: float) -> np.ndarray:
@@ -407,8 +421,11 @@ def _spec_for(data: MMGStdShipData):
 
     def spec_pack(speed, rpm, options=None):
         if rpm is not None:
-            if not (math.isfinite(rpm) and 0.0 < rpm <= 2000.0):
-                raise InputError("ship.rpm", f"must be in (0, 2000] rpm, got {rpm}")
+            n_lo, n_hi = propeller_rate_range(data)
+            if not (math.isfinite(rpm) and n_lo <= rpm / 60.0 <= n_hi):
+                raise InputError("ship.rpm", f"ship {data.id!r} accepts {n_lo:.4g}-{n_hi:.4g} rev/s "
+                                             f"({60 * n_lo:.4g}-{60 * n_hi:.4g} rpm), the self-propulsion rates "
+                                             f"over its speed range {lo:g}-{hi:g} m/s; got {rpm / 60.0:.4g} rev/s")
             return pack(data, rpm / 60.0)
         return pack(data, propeller_rate_for_speed(speed, data))
 
@@ -427,7 +444,8 @@ def _spec_for(data: MMGStdShipData):
         state_names=PLANAR_NAMES, state_units=PLANAR_UNITS, pack=spec_pack, b2_exact=b2_exact,
         dims=(data.hull.volume / (data.hull.L * data.hull.B * data.hull.d), data.hull.L, data.hull.B),
         source=data.source, linearise=linearise, nomoto_KT=nomoto_KT, speed_range=(lo, hi),
-        service_speed=data.service_speed_m_s, equilibrium_rudder=lambda speed, options=None: 0.0,
+        service_speed=data.service_speed_m_s, model_scale=data.model_scale,
+        equilibrium_rudder=lambda speed, options=None: 0.0,
         symmetric=lambda speed, options=None: data.rudder.gamma_R_plus == data.rudder.gamma_R_minus
         and data.propeller.C_2_plus == data.propeller.C_2_minus)
 

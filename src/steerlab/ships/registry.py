@@ -46,6 +46,9 @@ class ShipSpec(PicklesByName):
     * ``service_speed`` [m/s]: the speed its source states (a service or design speed, the
       speed of the captive tests); :attr:`design_speed` is the speed a scenario without
       ``speed_kn`` and a design without a speed use.
+    * ``model_scale``: ``lambda = L_full / L_model`` of a scale model (None: a full-size ship);
+      its :meth:`default_gear` is the Froude-scaled one, which a scenario without those
+      ``[gear]`` keys gets (``docs/ships.md``, "Model-scale ships").
     """
 
     name: str
@@ -71,6 +74,8 @@ class ShipSpec(PicklesByName):
     #: ``options -> kernel``: a kernel suited to these validated options (None: always ``rhs``);
     #: it must give the same derivatives as ``rhs`` for every record ``pack`` makes with them
     kernel_for_options: Callable | None = None
+    #: ``lambda = L_full / L_model`` of a scale model, None for a full-size ship
+    model_scale: float | None = None
     #: ``(function, args)`` that made this spec from another one (:meth:`for_options`): it
     #: pickles as that (:class:`steerlab.plugins.PicklesByName`)
     recipe: tuple | None = field(default=None, compare=False, repr=False)
@@ -103,6 +108,19 @@ class ShipSpec(PicklesByName):
         if math.isfinite(hi) and hi > 0.0:
             return 0.5 * (lo + hi)
         return knots_to_ms(DEFAULT_SPEED_KN)
+
+    def default_gear(self):
+        """The steering gear a scenario gets when its ``[gear]`` table leaves a key out.
+
+        A full-size ship: Zwierzewicz et al. (2021) eq (15), 35 deg, 2.33 deg/s, servo lag 1 s
+        (:class:`steerlab.steering_gear.SteeringGear`). A scale model (:attr:`model_scale`):
+        that gear Froude-scaled (:func:`steerlab.steering_gear.froude_scaled`: rate times
+        ``sqrt(lambda)``, lag divided by it, angle kept).
+        """
+        from steerlab.steering_gear import SteeringGear, froude_scaled
+
+        g = SteeringGear()
+        return g if self.model_scale is None else froude_scaled(g, self.model_scale)
 
     def b2(self, speed: float, method: str, options: Optional[FrozenConfig] = None) -> float:
         """Rudder efficiency [1/s^2], steerlab sign: ``exact`` (linearisation) or ``estimate`` (eq 29).

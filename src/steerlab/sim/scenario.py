@@ -35,7 +35,7 @@ import os
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, Any, Literal, Mapping, Optional
 
-from pydantic import BaseModel, Field, PlainValidator, ValidationError
+from pydantic import BaseModel, Field, PlainValidator, ValidationError, model_validator
 from pydantic_core import PydanticCustomError
 
 from steerlab.config_base import FrozenConfig
@@ -77,10 +77,49 @@ class ShipConfig(_Frozen):
 
 
 class GearConfig(_Frozen):
+    """``[gear]``: eq (15) defaults (35 deg, 2.33 deg/s, 1 s) for a full-size ship; a key left
+    out takes the ship's :meth:`~steerlab.ships.registry.ShipSpec.default_gear` value (a scale
+    model's gear is Froude-scaled: :func:`ship_gear_defaults`)."""
+
     delta_max_deg: float = Field(35.0, gt=0.0, le=90.0)
     rate_max_deg_s: float = Field(2.33, gt=0.0, le=100.0)
     T_sg: float = Field(1.0, ge=0.001, le=100.0, description="servo time constant [s], 0.001-100 s")
     dead_zone_deg: float = Field(0.0, ge=0.0, le=10.0)
+
+
+def ship_gear_defaults(model: Any) -> dict:
+    """``[gear]`` values (degrees at the edge) of ship ``model``'s default steering gear when it
+    differs from :class:`GearConfig`'s (a scale model: Froude-scaled rate and lag), else ``{}``.
+    An unknown ship gives ``{}`` (``[ship] model`` is reported by its own check)."""
+    from steerlab.ships.registry import get_ship
+
+    try:
+        spec = get_ship(model if isinstance(model, str) else ShipConfig().model)
+    except Exception:  # noqa: BLE001 - the ship's own validation reports an unknown model
+        return {}
+    if getattr(spec, "model_scale", None) is None:
+        return {}
+    g = spec.default_gear()
+    return {"rate_max_deg_s": math.degrees(g.rate_max), "T_sg": g.T_sg}
+
+
+def _fill_ship_gear(data: Any) -> Any:
+    """Scenario data with the ``[gear]`` keys it leaves out taken from the ship's default gear."""
+    if not isinstance(data, dict):
+        return data
+    ship = data.get("ship", {})
+    model = ship.get("model") if isinstance(ship, dict) else getattr(ship, "model", None)
+    defaults = ship_gear_defaults(model)
+    if not defaults:
+        return data
+    gear = data.get("gear", {})
+    if isinstance(gear, BaseModel):
+        given = {k: getattr(gear, k) for k in gear.model_fields_set}
+    elif isinstance(gear, dict):
+        given = dict(gear)
+    else:
+        return data           # not a table: reported by the [gear] validation
+    return {**data, "gear": {**defaults, **given}}
 
 
 def _expected_tags() -> str:
@@ -194,9 +233,17 @@ class EnvironmentConfig(_Frozen):
     wind_rudder: Optional[WindRudderConfig] = None
 
 
+MAX_NAME = 200
+"""Longest scenario ``name`` [characters]: it titles every figure, report and table (a name of
+100 000 characters took 76 s of figure layout, millions hung; now refused in one line)."""
+MAX_DESCRIPTION = 10_000
+"""Longest scenario ``description`` [characters]."""
+
+
 class Scenario(_Frozen):
-    name: str = "scenario"
-    description: str = ""
+    name: str = Field("scenario", max_length=MAX_NAME,
+                      description=f"titles the figures and the report; at most {MAX_NAME} characters")
+    description: str = Field("", max_length=MAX_DESCRIPTION)
     seed: int = Field(0, ge=0, le=2**63 - 1)
     dt: float = Field(0.1, ge=1e-4, le=10.0, description="integration step [s], 1e-4-10 s")
     duration: float = Field(3000.0, gt=0.0, le=1e6, description="[s]")
@@ -206,6 +253,8 @@ class Scenario(_Frozen):
     guidance: GuidanceConfig = GuidanceConfig()
     environment: EnvironmentConfig = EnvironmentConfig()
     sensors: Optional[SensorsConfig] = None   # steerlab.sensors: off by default
+
+    _ship_gear = model_validator(mode="before")(classmethod(lambda cls, data: _fill_ship_gear(data)))
 
     @property
     def n_steps(self) -> int:

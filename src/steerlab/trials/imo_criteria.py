@@ -64,6 +64,30 @@ def second_overshoot_10_limit_deg(L_over_V: float) -> float:
     return 40.0
 
 
+def model_scale_note(scale: float) -> str:
+    """What a verdict on a ``1 : scale`` model means (the criteria are for full-size ships)."""
+    return (f"model scale 1:{scale:g}: Froude-scaled, indicative only, not a full-scale verdict "
+            f"(MSC.137(76) applies to ships; model tests carry scale effects)")
+
+
+def mark_model_scale(rows: list[dict], cond) -> list[dict]:
+    """Add ``model_scale`` and ``scale_note`` to each criterion of a trial on a scale model."""
+    from steerlab.ships.registry import get_ship
+
+    scale = get_ship(cond.ship).model_scale
+    if scale is None:
+        return rows
+    return [{**r, "model_scale": scale, "scale_note": model_scale_note(scale)} for r in rows]
+
+
+def verdict_text(c: dict, overall: bool | None = None) -> str:
+    """``PASS``, ``FAIL`` or ``n/a`` of a criterion row, with ``(model scale 1:N, indicative)``
+    when the trial ran on a scale model (never a bare PASS/FAIL for a model)."""
+    v = {True: "PASS", False: "FAIL", None: "n/a"}[c["pass"] if overall is None else overall]
+    scale = c.get("model_scale")
+    return v if scale is None or v == "n/a" else f"{v} (model scale 1:{scale:g}, indicative)"
+
+
 def criterion(name: str, value: float, limit: float, unit: str, source: str) -> dict:
     """One pass/fail row; ``pass`` is None when the value could not be measured."""
     ok = None if (value is None or not math.isfinite(value)) else bool(value <= limit)

@@ -6,6 +6,7 @@ import base64
 import html
 from pathlib import Path
 
+from steerlab.trials.imo_criteria import model_scale_note
 from steerlab.trials.tables import ROWS, _v, imo_rows
 
 _CSS = """body{font-family:sans-serif;max-width:60em;margin:1em auto;padding:0 1em;color:#222}
@@ -43,7 +44,9 @@ def write_imo_html(path: Path, report: dict, figures: dict) -> Path:
     parts = [f"<!DOCTYPE html><html><head><meta charset='utf-8'><title>IMO trials: {_e(report['ship'])}</title>"
              f"<style>{_CSS}</style></head><body>",
              f"<h1>IMO manoeuvring trials: {_e(report['ship'])}</h1>",
-             f"<p>Overall: {_verdict(report['overall_pass'])} (every applicable criterion).</p>",
+             f"<p>Overall: {_verdict(report['overall_pass'])} (every applicable criterion)"
+             + (f"; {_e(model_scale_note(c['model_scale']))}" if c.get("model_scale") is not None else "")
+             + ".</p>",
              _table([(k, _v(v), "") for k, v in c.items()], ("condition", "value", "")),
              "<h2>Criteria</h2>"]
     rows = "".join(f"<tr><td>{_e(x['trial'])}</td><td>{_e(x['criterion'])}</td><td>{x['value']:.4g}</td>"

@@ -10,7 +10,10 @@ process.
 "Open loop or with the gear"
 ----------------------------
 * ``gear=True`` (default): the scenario's steering gear (Zwierzewicz et al. 2021 eq 15:
-  35 deg, 2.33 deg/s, servo lag 1 s; IMO trials assume a gear of at least that rate).
+  35 deg, 2.33 deg/s, servo lag 1 s; IMO trials assume a gear of at least that rate). A scale
+  model (``ShipSpec.model_scale``, e.g. ``kvlcc2-l7``, ``kosoko``) gets that gear
+  Froude-scaled (:func:`steerlab.steering_gear.froude_scaled`: ``kvlcc2-l7`` 15.75 deg/s and
+  0.148 s), unless ``gear_config`` says otherwise.
 * ``gear=False`` (``--no-gear``, "open loop"): an ideal rudder that follows the order: the
   same gear kernel with no rate limit and a servo lag ``T = dt/1.6`` (the lag RK4 damps
   fastest: the rudder reaches 73 % of a step in one integration step, 98 % in three, i.e.
@@ -46,9 +49,13 @@ class TrialConditions:
     """What a trial is run on.
 
     ship : registry name; speed_kn : approach speed [kn] (None: :func:`default_speed_kn`);
-    options : raw ``[ship.options]`` (validated by the ship); gear : scenario steering gear
+    options : raw ``[ship.options]`` (validated by the ship; a water depth is the ship's
+    ``depth_m`` option where its model has shallow-water terms); gear : scenario steering gear
     (True) or the ideal rudder (False); gear_config : overrides of the ``[gear]`` table
-    (``delta_max_deg``, ``rate_max_deg_s``, ``T_sg``); dt : integration step [s].
+    (``delta_max_deg``, ``rate_max_deg_s``, ``T_sg``; keys left out: the ship's default gear);
+    dt : integration step [s]; rpm : propeller rate [rev/min] held through the trial (the
+    scenario's ``[ship] rpm``; None: the ship's own, e.g. the self-propulsion rate of the
+    approach speed).
     """
 
     ship: str
@@ -57,6 +64,7 @@ class TrialConditions:
     gear: bool = True
     gear_config: dict = field(default_factory=dict)
     dt: float = 0.1
+    rpm: float | None = None
 
     def resolved(self) -> "TrialConditions":
         """A copy with the ship checked and the default speed filled in."""
@@ -77,10 +85,14 @@ class TrialConditions:
 
 
 def default_speed_kn(ship) -> float:
-    """16 kn, or the middle of the ship's validity range when 16 kn lies outside it."""
+    """16 kn; when 16 kn lies outside the ship's validity range, the speed its source states
+    (``service_speed``: ``kvlcc2-l7``'s 1.179 m/s of the free-running tests, Kosoko's 0.5 m/s),
+    else the middle of that range."""
     lo, hi = ship.speed_range
     if lo <= knots_to_ms(DEFAULT_SPEED_KN) <= hi:
         return DEFAULT_SPEED_KN
+    if ship.service_speed is not None and lo <= ship.service_speed <= hi:
+        return float(ship.service_speed) / KNOT
     top = hi if math.isfinite(hi) else 2.0 * lo
     return round(0.5 * (lo + top) / KNOT, 2)
 
@@ -88,7 +100,8 @@ def default_speed_kn(ship) -> float:
 def _scenario(cond: TrialConditions, duration: float):
     return scenario_from_dict({
         "name": f"trial-{cond.ship}", "seed": 0, "dt": cond.dt, "duration": duration,
-        "ship": {"model": cond.ship, "speed_kn": cond.speed_kn, "options": dict(cond.options)},
+        "ship": {"model": cond.ship, "speed_kn": cond.speed_kn, "options": dict(cond.options),
+                 **({} if cond.rpm is None else {"rpm": cond.rpm})},
         "gear": dict(cond.gear_config),
         "controller": {"type": "pid", "gains": "paper"},        # placeholder, replaced by the manoeuvre program
         "guidance": {"psi0_deg": 0.0, "changes": []},
@@ -210,12 +223,46 @@ def heading_change(res, psi0: float = 0.0) -> np.ndarray:
     return np.unwrap(res.psi) - psi0
 
 
+def gear_of(cond: TrialConditions):
+    """The scenario's ``[gear]`` table (validated, degrees) the trial runs with (the ship's
+    default gear for the keys ``gear_config`` leaves out)."""
+    return _scenario(cond.resolved(), 1.0).gear
+
+
+def gear_description(cond: TrialConditions) -> str:
+    """One line: the gear the trial runs with and where its rate and lag come from."""
+    if not cond.gear:
+        return "ideal rudder (--no-gear)"
+    g = gear_of(cond)
+    ship = get_ship(cond.ship)
+    text = f"gear {g.delta_max_deg:g} deg, {g.rate_max_deg_s:.4g} deg/s, servo lag {g.T_sg:.3g} s"
+    if ship.model_scale is not None:
+        given = [k for k in ("rate_max_deg_s", "T_sg") if k in cond.gear_config]
+        how = ("given" if len(given) == 2 else
+               f"Froude-scaled for the 1:{ship.model_scale:g} model from 2.33 deg/s, 1 s"
+               + (" (lag given)" if given == ["T_sg"] else " (rate given)" if given else ""))
+        text += f" ({how})"
+    return text
+
+
 def conditions_dict(cond: TrialConditions) -> dict:
-    """The trial conditions for a JSON report (edge units)."""
+    """The trial conditions for a JSON report (edge units): the ship, the approach speed, the
+    propeller rate, the gear (limit, rate, servo lag), the water depth and the model scale."""
     ts = time_scale(cond)
+    ship = get_ship(cond.ship)
+    g = gear_of(cond)
+    opts = ship.options(cond.options)
+    depth = getattr(opts, "depth_m", None) if opts is not None else None
     return {"ship": cond.ship, "speed_kn": cond.speed_kn, "speed_m_s": cond.speed,
             "ship_options": dict(cond.options), "gear": "scenario steering gear" if cond.gear else
-            "ideal rudder (--no-gear)", "rudder_limit_deg": gear_limit_deg(cond), "dt_s": cond.dt,
+            "ideal rudder (--no-gear)", "gear_description": gear_description(cond),
+            "rudder_limit_deg": gear_limit_deg(cond),
+            "rudder_rate_deg_s": g.rate_max_deg_s if cond.gear else None,
+            "servo_lag_s": g.T_sg if cond.gear else cond.dt / IDEAL_GEAR_LAG_STEPS,
+            "propeller_rps": None if cond.rpm is None else cond.rpm / 60.0,
+            "propeller": ("held at the given rate" if cond.rpm is not None else
+                          "the ship's own (MMG ships: the self-propulsion rate of the approach speed, held)"),
+            "water_depth_m": depth, "model_scale": ship.model_scale, "dt_s": cond.dt,
             "L_m": ts["L"], "L_over_U_s": ts["L_over_U"], "nomoto_K_1_s": ts["K"], "nomoto_T_s": ts["T"]}
 
 

@@ -69,9 +69,11 @@ def pullout_rows(m: dict) -> list[tuple[str, str, str]]:
 
 
 def imo_rows(criteria: list[dict]) -> list[tuple[str, str, str]]:
+    from steerlab.trials.imo_criteria import verdict_text
+
     out = []
     for c in criteria:
-        verdict = {True: "PASS", False: "FAIL", None: "n/a"}[c["pass"]]
+        verdict = verdict_text(c)
         out.append((c["criterion"], f"{_v(c['value'])} <= {_v(c['limit'])} {c['unit']}: {verdict}", c["source"]))
     return out
 

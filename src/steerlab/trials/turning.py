@@ -27,7 +27,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from steerlab.trials.imo_criteria import turning_criteria
+from steerlab.trials.imo_criteria import mark_model_scale, turning_criteria
 from steerlab.trials.program import TrialProgramConfig
 from steerlab.trials.runner import (TrialConditions, conditions_dict, heading_change, rudder_limit_check,
                                     run_until, speed_of, time_scale)
@@ -136,6 +136,7 @@ def run_turning(cond: TrialConditions, rudder_deg: float = 35.0, port: bool = Fa
 
     res, _ = run_until(program, cond, duration, done, label="turning-circle")
     m = turning_metrics(res, t0, sign, ts["L"], cond.speed, rudder_deg)
-    m["imo"] = turning_criteria(m["advance_m"], m["tactical_diameter_m"], ts["L"], rudder_deg, cond)
+    m["imo"] = mark_model_scale(turning_criteria(m["advance_m"], m["tactical_diameter_m"], ts["L"], rudder_deg,
+                                                 cond), cond)
     m["conditions"] = conditions_dict(cond)
     return TurningTrial(res, m, t0, sign)

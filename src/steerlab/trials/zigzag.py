@@ -24,7 +24,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from steerlab.trials.imo_criteria import zigzag_criteria
+from steerlab.trials.imo_criteria import mark_model_scale, zigzag_criteria
 from steerlab.trials.program import TrialProgramConfig
 from steerlab.trials.runner import (TrialConditions, conditions_dict, heading_change, rudder_limit_check,
                                     run_until, speed_of, time_scale)
@@ -110,7 +110,7 @@ def run_zigzag(cond: TrialConditions, rudder_deg: float = 10.0, heading_deg: flo
     L_over_V = ts["L_over_U"]
     m = zigzag_metrics(res, t0, sign, rudder_deg, heading_deg, ts["L"], cond.speed)
     m["L_over_V_s"] = L_over_V
-    m["imo"] = zigzag_criteria(rudder_deg, heading_deg, m["overshoot_angles_deg"], L_over_V,
-                               m["initial_turning_distance_L"])
+    m["imo"] = mark_model_scale(zigzag_criteria(rudder_deg, heading_deg, m["overshoot_angles_deg"], L_over_V,
+                                                m["initial_turning_distance_L"]), cond)
     m["conditions"] = conditions_dict(cond)
     return ZigzagTrial(res, m, t0, sign, heading_deg)

@@ -159,9 +159,43 @@ class _Progress:
         self.say(bar_message(gen, self.n_gen, f"gen {gen}/{self.n_gen}  sims {n_sims}  best {best}  ({params})"))
 
 
+CHECKPOINT_MODES = ("auto", "resume", "fresh")
+"""What an existing checkpoint does (``steerlab tune --resume`` / ``--fresh``; neither: auto):
+auto and resume continue from it (resume also refuses a missing file), fresh starts over and
+overwrites it. A checkpoint that already holds ``generations`` generations is finished: its
+result is reported as it is, without another generation (:func:`checkpoint_plan`)."""
+
+
+def checkpoint_plan(ck: dict | None, generations: int, path, mode: str = "auto") -> str:
+    """One line saying what the run does with its checkpoint ``ck`` (None: none read).
+
+    Raises :class:`InputError` on ``--resume`` without a checkpoint file and on a checkpoint
+    already past ``generations`` (its result is not that of ``generations`` generations).
+    """
+    if mode not in CHECKPOINT_MODES:
+        raise InputError("--resume", f"checkpoint mode must be one of {CHECKPOINT_MODES}, got {mode!r}")
+    shown = str(path)
+    if mode == "fresh":
+        return f"starting fresh: {shown!r} is overwritten after the first generation (--fresh)"
+    if ck is None:
+        if mode == "resume":
+            raise InputError("--resume", f"no checkpoint at {shown!r} to resume; run without --resume to start one")
+        return f"no checkpoint at {shown!r} yet: starting, one written after every generation"
+    done = int(ck["generation"])
+    if done > generations:
+        raise InputError("--generations", f"the checkpoint {shown!r} already holds {done} generations, more "
+                                          f"than the {generations} asked; ask for {done} or more, or use --fresh")
+    if done == generations:
+        return (f"the checkpoint {shown!r} is finished ({done} of {generations} generations): reporting its "
+                "result without another generation (--fresh starts over)")
+    return f"resuming from generation {done} of {generations} in {shown!r}"
+
+
 def run_optimiser(evaluator, method: str, generations: int, pop_size: int, seed: int,
-                  checkpoint=None, problem_key: dict | None = None, progress=None) -> TuningResult:
-    """Run ``method`` on ``evaluator`` (see the module docstring)."""
+                  checkpoint=None, problem_key: dict | None = None, progress=None,
+                  checkpoint_mode: str = "auto") -> TuningResult:
+    """Run ``method`` on ``evaluator`` (see the module docstring); ``checkpoint_mode`` is one of
+    :data:`CHECKPOINT_MODES`."""
     if method not in METHODS:
         raise InputError("--method", f"must be one of {METHODS}, got {method!r}")
     if not (1 <= generations <= 100_000):
@@ -174,9 +208,13 @@ def run_optimiser(evaluator, method: str, generations: int, pop_size: int, seed:
     if method != "nsga2" and n_obj != 1:
         raise InputError("--cost", f"method {method!r} takes exactly one cost expression, got {n_obj}")
     key = dict(problem_key or {}, method=method, seed=seed, pop_size=pop_size)
+    ck = None
     if checkpoint:
         _checkpoint_folder(checkpoint)
-    ck = load_checkpoint(checkpoint, key) if checkpoint else None
+        ck = load_checkpoint(checkpoint, key) if checkpoint_mode != "fresh" else None
+        (progress or (lambda msg: None))(checkpoint_plan(ck, generations, checkpoint, checkpoint_mode))
+    elif checkpoint_mode == "resume":
+        raise InputError("--resume", "needs --checkpoint FILE (the checkpoint to resume)")
     prog = _Progress(progress, generations, evaluator.param_map.names)
     if method == "de":
         return _run_de(evaluator, generations, pop_size, seed, checkpoint, key, ck, prog)
@@ -341,7 +379,9 @@ def _run_pymoo(ev, method, generations, pop_size, seed, checkpoint, key, ck, pro
         algorithm.setup(problem, termination=("n_gen", generations), seed=seed, verbose=False)
         history = []
     gen = resumed or 0
-    while algorithm.has_next():
+    # a finished checkpoint (as many generations as asked) is reported as it is: pymoo's
+    # has_next() would otherwise grant the restored algorithm one more generation
+    while gen < generations and algorithm.has_next():
         pop = algorithm.ask()
         F = ev(pop.get("X"))
         Evaluator().eval(StaticProblem(problem, F=F), pop)

@@ -48,6 +48,7 @@ class TuneSpec:
     aggregate: str = "mean"
     lam: float = 0.1
     checkpoint: str | None = None
+    checkpoint_mode: str = "auto"          # auto, resume or fresh (optimisers.CHECKPOINT_MODES)
 
 
 @dataclass
@@ -93,7 +94,8 @@ def tune(spec: TuneSpec, executor=None, progress=None) -> TuneOutcome:
         f"executor {ev.executor.name}; first generation compiles the loop (a few seconds)")
     t0 = time.perf_counter()
     result = run_optimiser(ev, spec.method, spec.generations, spec.pop_size, spec.seed,
-                           spec.checkpoint, problem_key(spec, conditions), say)
+                           spec.checkpoint, problem_key(spec, conditions), say,
+                           checkpoint_mode=spec.checkpoint_mode)
     wall = time.perf_counter() - t0
     summary = _summary(spec, conditions, ev, result, wall)
     return TuneOutcome(spec, result, ev, summary, wall)
