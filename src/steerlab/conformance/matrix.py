@@ -88,12 +88,20 @@ def builtin_ships() -> list[str]:
     return sorted(n for n, s in SHIPS.items() if getattr(s.rhs, "__module__", "").startswith("steerlab."))
 
 
+NOT_DESIGNED = ("policy",)
+"""Built-in controller types the matrix leaves out: ``policy`` runs a network trained for one
+ship (the shipped one: the Esso tanker) and designs nothing for another; it is judged beside the
+classical laws in its own experiment (``learning-vs-classical``, docs/learning.md)."""
+
+
 def builtin_controllers() -> list[str]:
-    """The types of steerlab's own control laws, without the ``+wf`` variants, sorted."""
+    """The types of steerlab's own control laws, without the ``+wf`` variants and
+    :data:`NOT_DESIGNED`, sorted."""
     from steerlab.control.registry import CONTROLLERS
 
     return sorted(n for n, s in CONTROLLERS.items()
-                  if "+" not in n and getattr(s.update, "__module__", "").startswith("steerlab."))
+                  if "+" not in n and n not in NOT_DESIGNED
+                  and getattr(s.update, "__module__", "").startswith("steerlab."))
 
 
 def cases(ships: Iterable[str] | None = None, controllers: Iterable[str] | None = None,
