@@ -3,7 +3,8 @@ r"""One cell of the conformance matrix and the scenario it runs.
 A :class:`Case` is (ship, controller, operating point, sea). Its scenario is the one a new
 user would write: the ship at that point, the controller with its **default settings**
 (``[controller] type = ...`` and nothing else), the scenario's default steering gear
-(:data:`GEAR`: 35 deg, 2.33 deg/s, servo 1 s), ``dt`` = :data:`DT`, and a course change of
+(:data:`GEAR`: 35 deg, 2.33 deg/s, servo 1 s; a scale model's Froude-scaled:
+:func:`ship_gear`), ``dt`` = :data:`DT`, and a course change of
 :data:`~steerlab.conformance.judge.CHANGE_DEG` to starboard at :data:`T_CHANGE`. The sea is
 calm, or a JONSWAP spectrum of WMO sea state 5 (Hs 3.25 m, Tp 9.7 s) from 45 deg off the bow,
 seed :data:`SEA_SEED` (:data:`SEA`).
@@ -68,6 +69,16 @@ GEAR = _default_gear()
 """``[gear]``: the scenario's default steering gear (degrees at the edge)."""
 
 
+def ship_gear(spec) -> dict:
+    """``[gear]`` of a case on ship ``spec``: :data:`GEAR` with the ship's own defaults where it
+    has them (a scale model's Froude-scaled rate and lag:
+    :meth:`~steerlab.ships.registry.ShipSpec.default_gear`), as a scenario that gives no
+    ``[gear]`` gets."""
+    from steerlab.sim.scenario import ship_gear_defaults
+
+    return {**GEAR, **ship_gear_defaults(spec.name)}
+
+
 @dataclass(frozen=True)
 class Case:
     """One cell: ship id, controller type, operating point and sea (``"calm"`` or ``"sea5"``)."""
@@ -94,7 +105,7 @@ def point_nomoto(spec, point: OperatingPoint) -> tuple[float, float]:
 
 def time_scale(spec, point: OperatingPoint, gear: dict | None = None) -> float:
     """``t_s = 2 pi / omega_g`` [s] of the ship at the point with the gear (module docstring)."""
-    g = GEAR if gear is None else gear
+    g = ship_gear(spec) if gear is None else gear
     K, T = point_nomoto(spec, point)
     b = abs(K / T) if (math.isfinite(K) and math.isfinite(T) and T != 0.0) else math.nan
     if not (math.isfinite(b) and b > 0.0):
@@ -112,14 +123,26 @@ def run_length(t_s: float) -> tuple[float, float]:
     return T_CHANGE + after, hold
 
 
+def controller_type(law: str, sea: str) -> str:
+    """The controller type a case runs: the law itself in calm water; in a sea, the law behind
+    the wave filter (``law + "+wf"``, its filter designed for the sample time:
+    :func:`steerlab.control.wave_filtered.design_filter`), as ``steerlab run`` advises
+    (:func:`steerlab.sim.sanity.unfiltered_in_waves`); ``asa`` has its own filter."""
+    from steerlab.control.wave_filtered import NOT_WRAPPED, SUFFIX
+
+    return law if sea == CALM or law in NOT_WRAPPED or law.endswith(SUFFIX) else law + SUFFIX
+
+
 def scenario_dict(case: Case, duration: float) -> dict:
     """The scenario of ``case`` as a plain dict (the TOML shape; degrees and knots)."""
+    from steerlab.ships.registry import get_ship
+
     ship = {"model": case.ship, "speed_kn": case.point.speed_kn}
     if case.point.rpm is not None:
         ship["options"] = {"rpm": case.point.rpm}
     d = {"name": f"conformance-{case.ship}-{case.controller}-{case.point.label}-{case.sea}",
-         "seed": SEA_SEED, "dt": DT, "duration": duration, "ship": ship, "gear": dict(GEAR),
-         "controller": {"type": case.controller},
+         "seed": SEA_SEED, "dt": DT, "duration": duration, "ship": ship, "gear": ship_gear(get_ship(case.ship)),
+         "controller": {"type": controller_type(case.controller, case.sea)},
          "guidance": {"psi0_deg": 0.0, "changes": [{"t": T_CHANGE, "psi_deg": CHANGE_DEG}]}}
     if case.sea == SEA5:
         d["environment"] = {"wave": dict(SEA)}

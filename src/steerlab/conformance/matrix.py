@@ -35,7 +35,8 @@ import warnings
 from dataclasses import asdict, dataclass, field
 from typing import Callable, Iterable, Optional
 
-from steerlab.conformance.cases import CALM, SEA5, T_CHANGE, Case, run_length, scenario_dict, time_scale
+from steerlab.conformance.cases import (CALM, SEA5, T_CHANGE, Case, controller_type, run_length, scenario_dict,
+                                        time_scale)
 from steerlab.conformance.judge import CHANGE_DEG, FAILS, REFUSED, STEERS, VERDICTS, judge
 from steerlab.conformance.points import operating_points
 
@@ -87,12 +88,20 @@ def builtin_ships() -> list[str]:
     return sorted(n for n, s in SHIPS.items() if getattr(s.rhs, "__module__", "").startswith("steerlab."))
 
 
+NOT_DESIGNED = ("policy",)
+"""Built-in controller types the matrix leaves out: ``policy`` runs a network trained for one
+ship (the shipped one: the Esso tanker) and designs nothing for another; it is judged beside the
+classical laws in its own experiment (``learning-vs-classical``, docs/learning.md)."""
+
+
 def builtin_controllers() -> list[str]:
-    """The types of steerlab's own control laws, without the ``+wf`` variants, sorted."""
+    """The types of steerlab's own control laws, without the ``+wf`` variants and
+    :data:`NOT_DESIGNED`, sorted."""
     from steerlab.control.registry import CONTROLLERS
 
     return sorted(n for n, s in CONTROLLERS.items()
-                  if "+" not in n and getattr(s.update, "__module__", "").startswith("steerlab."))
+                  if "+" not in n and n not in NOT_DESIGNED
+                  and getattr(s.update, "__module__", "").startswith("steerlab."))
 
 
 def cases(ships: Iterable[str] | None = None, controllers: Iterable[str] | None = None,
@@ -148,7 +157,8 @@ def build_case(case: Case, duration: float):
         setup = build(scenario)
         _SEAS[key] = setup.w
         return setup
-    calm = build(scenario_from_dict(scenario_dict(replace(case, sea=CALM), duration)))
+    # the same scenario without its sea (the controller type is the sea case's: "+wf" in waves)
+    calm = build(scenario_from_dict({k: v for k, v in scenario_dict(case, duration).items() if k != "environment"}))
     return replace(calm, w=w, name=scenario.name)
 
 
@@ -196,7 +206,7 @@ def _kernel_key(case: Case) -> tuple:
     from steerlab.control.registry import get_controller
     from steerlab.ships.registry import get_ship
 
-    rhs, update = get_ship(case.ship).rhs, get_controller(case.controller).update
+    rhs, update = get_ship(case.ship).rhs, get_controller(controller_type(case.controller, case.sea)).update
     return (getattr(rhs, "__module__", ""), getattr(rhs, "__name__", repr(rhs)),
             getattr(update, "__module__", ""), getattr(update, "__name__", repr(update)))
 

@@ -27,7 +27,10 @@ driver, :mod:`steerlab.jit.drivers`).
 
 The filter's K, T come from ``ctx.nomoto()`` (the ship's first-order Nomoto model at the
 design speed) unless ``filter_K``, ``filter_T`` are given; ASA itself uses the same filter
-kernel with its on-line identified K*, tau* instead.
+kernel with its on-line identified K*, tau* instead. Its settings (``wave_filter = {...}``)
+are designed for the controller's sample time where not given
+(:func:`steerlab.control.wave_filter.design_filter`: the default scenario's tuning with the
+noise floor scaled as ``h^4``); with ``gains = "paper"`` the thesis' per-sample defaults.
 
 Registration: the controller registry (:mod:`steerlab.control.registry`) wraps every
 controller it knows, plug-ins included (except ``asa``, which has its own filter), as
@@ -52,8 +55,8 @@ from pydantic import create_model
 from steerlab.control.registry import ControllerSpec
 from steerlab.control.wave_filter import PARAMS as WF_PARAMS
 from steerlab.control.wave_filter import STATE as WF_STATE
-from steerlab.control.wave_filter import (F_PSI, F_R, WaveFilterConfig, WaveFilterParams, wave_filter_init,
-                                          wave_filter_step)
+from steerlab.control.wave_filter import (F_PSI, F_R, WaveFilterParams, WaveFilterSettings, filter_params,
+                                          wave_filter_init, wave_filter_step)
 from steerlab.errors import InputError
 from steerlab.jit.kernel_refs import bound_kernel
 from steerlab.records import Field as RecordField
@@ -172,7 +175,7 @@ def wave_filtered(spec: ControllerSpec) -> ControllerSpec:
     cfg_cls = create_model(
         spec.config.__name__ + "WaveFiltered", __base__=(spec.config, _PickledByControllerName),
         type=(Literal[name], ...),
-        wave_filter=(WaveFilterConfig, WaveFilterConfig()),
+        wave_filter=(Optional[WaveFilterSettings], None),
         **{n: (Optional[float], f) for n, (_, f) in PARAMS.config_fields(["filter_K", "filter_T"]).items()})
 
     def build(cfg, ctx):
@@ -187,7 +190,8 @@ def wave_filtered(spec: ControllerSpec) -> ControllerSpec:
             K, T = ctx.nomoto()
         K = cfg.filter_K if cfg.filter_K is not None else K
         T = cfg.filter_T if cfg.filter_T is not None else T
-        c = WaveFiltered(inner, float(K), float(T), cfg.wave_filter.params())
+        c = WaveFiltered(inner, float(K), float(T), filter_params(cfg.wave_filter, ctx.sample_time,
+                                                                getattr(cfg, "gains", "design") == "paper"))
         return c, c.pack(inner_p)
 
     return ControllerSpec(

@@ -89,6 +89,7 @@ def _ship():
 
 def _scenario(gain: str, filt: bool, duration: float):
     from steerlab.control.asa_schedule import kd_lq
+    from steerlab.control.wave_filter import WaveFilterParams
     from steerlab.sim.scenario import scenario_from_dict
     from steerlab.sim.setup import build
 
@@ -100,6 +101,8 @@ def _scenario(gain: str, filt: bool, duration: float):
     kp = KP[gain]
     kd = kd_lq(K * L_SHIP / U, T * U / L_SHIP, kp, L_SHIP / U)
     ctrl = {"type": "pid+wf" if filt else "pid", "Kp": kp, "Kd": kd, "Ki": kp / (4.0 * T)}
+    if filt:     # the thesis' filter settings (the per-sample defaults), not the ones designed for a sample time
+        ctrl["wave_filter"] = WaveFilterParams()._asdict()
     return scenario_from_dict({
         "name": f"table5.1-{gain}-{'filter' if filt else 'raw'}", "seed": 7, "dt": 0.5,
         "duration": duration, "ship": ship, "controller": ctrl,

@@ -67,4 +67,23 @@ def scenario_warnings(s) -> list[str]:
         L = ship.dims[1]
         if not has_hull_data(ship.dims) and math.isfinite(L) and L > 0.0:
             out.append(typical_hull_warning(ship.name, L))
+    if wave is not None and wave.model == "spectrum":
+        hint = unfiltered_in_waves(s.controller.type)
+        if hint:
+            out.append(hint)
     return out
+
+
+def unfiltered_in_waves(controller_type: str) -> str:
+    """The one-line hint for a law that steers on the raw heading in a wave spectrum, or ``""``.
+
+    Without the wave filter a law answers the first-order wave yaw, which no rudder can take
+    out: in JONSWAP sea state 5 every built-in law worked its rudder 12-18 times a minute
+    (issue 30's conformance matrix: 15 of 836 cases within six reversals a minute), for the same
+    mean heading. ``asa`` has the filter built in; the ``+wf`` variants put it in front.
+    """
+    from steerlab.control.wave_filtered import NOT_WRAPPED, SUFFIX
+
+    if controller_type.endswith(SUFFIX) or controller_type in NOT_WRAPPED:
+        return ""
+    return f"controller.type: {controller_type!r} chases the wave yaw; {controller_type + SUFFIX!r} filters it out"
