@@ -72,7 +72,8 @@ PARAMS = Layout("controller", "P_", [
     RecordField("K", "filter_K", "1/s", "Nomoto gain of the filter's model, non-zero, with the sign of filter_T "
                 "(a course-unstable ship's first-order model has K < 0 and T < 0) (default: the ship's at the "
                 "design speed)", -100.0, 100.0),
-    RecordField("T", "filter_T", "s", "Nomoto time constant of the filter's model, non-zero", -1e4, 1e4),
+    RecordField("T", "filter_T", "s", "Nomoto time constant of the filter's model, non-zero (a ship near "
+                "the edge of course stability has |T| of 1e4 s and more: KVLCC2 at 8 kn, -1.5e4 s)", -1e6, 1e6),
 ], size_name="OFF_P")
 PARAMS.export(globals())         # P_WF_TLF = 0, ..., P_K = 4, P_T = 5, OFF_P = 6 (the inner record from here)
 STATE = Layout("controller state", "Z_", [
