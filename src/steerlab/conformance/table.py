@@ -92,10 +92,13 @@ def markdown(m: Matrix) -> str:
            "`limit cycle`, `steady offset`, `not settled`, `rudder reversals`, or `crashed` (an exception "
            "other than `InputError`: a defect).",
            "",
-           "The runs: the scenario's default gear "
+           "The runs: the ship's default gear "
            f"({C.GEAR['delta_max_deg']:g} deg, {C.GEAR['rate_max_deg_s']:g} deg/s, servo "
-           f"{C.GEAR['T_sg']:g} s), dt = {C.DT:g} s, the change at t = {C.T_CHANGE:g} s; the sea is "
-           f"JONSWAP sea state 5 from {C.SEA['wave_angle_deg']:g} deg off the bow, seed {C.SEA_SEED}. "
+           f"{C.GEAR['T_sg']:g} s; a scale model's Froude-scaled), dt = {C.DT:g} s, the change at "
+           f"t = {C.T_CHANGE:g} s; the sea is "
+           f"JONSWAP sea state 5 from {C.SEA['wave_angle_deg']:g} deg off the bow, seed {C.SEA_SEED}, and "
+           "in it each law runs behind the wave filter designed for the step (`law+wf`; `asa` has its own; "
+           "docs/environment.md). "
            "A run lasts "
            f"{C.RUN_SCALES:g} time scales after the change ({C.MIN_AFTER:g}-{C.MAX_AFTER:g} s), the hold "
            f"window is the last {C.HOLD_SCALES:g} ({C.MIN_HOLD:g} s at least); the time scale is "
