@@ -61,7 +61,7 @@ COMMANDS = {
 }
 
 
-VOLATILE = frozenset({"result.json"})   #: differs between identical runs (tune's wall time)
+VOLATILE = frozenset({"result.json", ".steerlab-out"})   #: differ between identical runs (tune's wall time; the marker lists its size)
 
 
 def _env():
@@ -140,11 +140,16 @@ class Case:
             subprocess.run(argv(self.command, self.scen[1], self.template), env=_env(), check=True,
                            capture_output=True, timeout=600)
         else:
+            from steerlab.outputs import MARKER, write_marker
+
             self.template.mkdir()
             for p in self.reference.iterdir():
+                if p.name == MARKER:
+                    continue
                 text = '{"old": true}\n' if p.suffix == ".json" else f"old {p.name}\n"
                 (self.template / p.name).write_text(text)
             (self.template / "stale.parquet").write_text("an earlier run's file\n")
+            write_marker(self.template, f"steerlab {self.command}")   # an earlier steerlab output, marked
         self.volatile = VOLATILE
         if find_volatile:
             again = self.work / "again"

@@ -26,7 +26,7 @@ def _package_imports(pkg: str) -> set:
 LAYERS = [
     ("base", ["steerlab", "errors", "units", "angles", "records", "config_base", "sincos", "vecmath",
               "textfile", "toml_input", "fast_csv", "arrow_table", "text_table", "progress", "messages",
-              "outputs", "plugins", "registry_index", "jit"]),
+              "outputs", "plugin_names", "plugins", "registry_index", "jit"]),
     ("models", ["environment", "ships", "steering_gear", "metrics_online"]),
     ("laws", ["guidance", "control", "sensors"]),
     ("indices", ["metrics", "metrics_waves"]),

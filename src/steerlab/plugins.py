@@ -50,20 +50,7 @@ S = TypeVar("S", bound=_Named)     #: the spec type of a registry (ShipSpec, Con
 
 from steerlab.errors import InputError
 
-PLUGINS_ENV = "STEERLAB_PLUGINS"
-
-
-def plugin_module_name(path: Path) -> str:
-    """The ``sys.modules`` name of a plug-in file: its stem and a digest of its resolved path
-    (``ship_3f2a9c01d4``). Keyed by the path, never by the stem alone: two plug-ins
-    ``a/ship.py`` and ``b/ship.py`` loaded together are two modules, and each one's kernels are
-    named (and their compiled drivers cached) apart; the same file gives the same name in every
-    process, so specs and kernels still pickle by name to workers that load the same plug-ins."""
-    import hashlib
-    import re
-
-    stem = re.sub(r"\W", "_", path.stem) or "plugin"
-    return f"{stem}_{hashlib.sha256(str(path).encode()).hexdigest()[:10]}"
+from steerlab.plugin_names import PLUGINS_ENV, env_plugins, plugin_module_name  # noqa: F401 (re-exported)
 
 
 def load_module(ref: str) -> ModuleType:
@@ -111,11 +98,6 @@ def package_modules(package: str, skip: Iterable[str] = (), recursive: bool = Fa
         if base in skip or base.startswith("_"):
             continue
         yield importlib.import_module(mod.name if recursive else f"{package}.{mod.name}")
-
-
-def env_plugins() -> list[str]:
-    """The module names or files listed in ``STEERLAB_PLUGINS``."""
-    return [p for p in os.environ.get(PLUGINS_ENV, "").split(os.pathsep) if p.strip()]
 
 
 class PicklesByName:

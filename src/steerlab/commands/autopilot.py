@@ -12,11 +12,11 @@ EXAMPLES = """examples:
   steerlab autopilot --connect 127.0.0.1:47110 --controller pid --heading 0 --web 127.0.0.1:8080
   steerlab autopilot --connect 127.0.0.1:47110 --controller pid --nmea-listen 127.0.0.1:10111   # follow OpenCPN APB/RMB
   steerlab autopilot --connect 127.0.0.1:47110 --controller pid --signalk-ws 127.0.0.1:3000      # Signal K WebSocket
-  steerlab autopilot --connect 127.0.0.1:47110 --heading 90 --nmea-serial /dev/ttyUSB0:4800 --variation -3.5  # HDG compass
-  steerlab autopilot --connect 127.0.0.1:47110 --heading 90 --nmea-tcp 192.168.1.5:10110 --actuator serial:/dev/ttyUSB1:38400
 
 The controller is designed for the scenario's ship (--scenario, default: the bundled one); use
-the same scenario as serve-ship. Every sample is logged to --log (CSV). docs/runtime.md"""
+the same scenario as serve-ship. Every sample is logged to --log (CSV). A compass on a serial
+port or NMEA over TCP (--nmea-serial /dev/ttyUSB0:4800 --variation -3.5, --nmea-tcp HOST:10110)
+and a rudder drive (--actuator serial:/dev/ttyUSB1:38400): docs/runtime.md"""
 
 
 def register(sub, formatter_class) -> None:

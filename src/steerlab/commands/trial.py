@@ -83,8 +83,8 @@ def _table(kind, metrics) -> str:
         blocks.append(format_table(rows))
     c = parts[0]["conditions"]
     prop = "" if c.get("propeller_rps") is None else f", propeller {c['propeller_rps']:.4g} rev/s"
-    head = (f"{kind} trial on {c['ship']} at {c['speed_kn']:.4g} kn ({c['speed_m_s']:.4g} m/s){prop}, "
-            f"{c.get('gear_description', c['gear'])} (L = {c['L_m']:.4g} m, L/U = {c['L_over_U_s']:.3g} s)")
+    head = (f"{kind} trial on {c['ship']} at {c['speed_kn']:.4g} kn ({c['speed_m_s']:.4g} m/s){prop} "
+            f"(L = {c['L_m']:.4g} m, L/U = {c['L_over_U_s']:.3g} s)\n{c.get('gear_description', c['gear'])}")
     return head + "\n" + "\n\n".join(blocks)
 
 

@@ -365,7 +365,7 @@ class Episodes:
             i = launch(par, at, cuts, *args)
         if i >= 0:
             raise self._refused(a[i])
-        if before is not None and before.any():            # reset in the compiled step: a new episode
+        if before is not None and before.any() and self.terms is not None:   # reset in the compiled step
             self.terms.restart(np.flatnonzero(before), self.obs[before, OBS_DELTA])
         if again is not None and again.any():              # seas realised lane by lane: reset here
             self.reset_lanes(np.flatnonzero(again))

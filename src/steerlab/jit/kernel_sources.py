@@ -176,8 +176,8 @@ def source_digests(refs) -> Optional[list[tuple[str, str]]]:
 
 def _plugin_file(module: str) -> Optional[Path]:
     """The file of a plug-in loaded by path (``STEERLAB_PLUGINS``) whose module name is
-    ``module`` (:func:`steerlab.plugins.plugin_module_name`), or None."""
-    from steerlab.plugins import env_plugins, plugin_module_name
+    ``module`` (:func:`steerlab.plugin_names.plugin_module_name`), or None."""
+    from steerlab.plugin_names import env_plugins, plugin_module_name
 
     for ref in env_plugins():
         if ref.strip().endswith(".py"):

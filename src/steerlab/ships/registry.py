@@ -26,6 +26,7 @@ DEFAULT_SPEED_KN = 16.0
 
 if TYPE_CHECKING:
     from steerlab.config_base import FrozenConfig
+    from steerlab.steering_gear import SteeringGear
 
 
 @dataclass(frozen=True)
@@ -109,7 +110,7 @@ class ShipSpec(PicklesByName):
             return 0.5 * (lo + hi)
         return knots_to_ms(DEFAULT_SPEED_KN)
 
-    def default_gear(self):
+    def default_gear(self) -> "SteeringGear":
         """The steering gear a scenario gets when its ``[gear]`` table leaves a key out.
 
         A full-size ship: Zwierzewicz et al. (2021) eq (15), 35 deg, 2.33 deg/s, servo lag 1 s

@@ -254,7 +254,11 @@ class Scenario(_Frozen):
     environment: EnvironmentConfig = EnvironmentConfig()
     sensors: Optional[SensorsConfig] = None   # steerlab.sensors: off by default
 
-    _ship_gear = model_validator(mode="before")(classmethod(lambda cls, data: _fill_ship_gear(data)))
+    @model_validator(mode="before")
+    @classmethod
+    def _ship_gear(cls, data: Any) -> Any:
+        """The ``[gear]`` keys the scenario leaves out, from the ship's default gear."""
+        return _fill_ship_gear(data)
 
     @property
     def n_steps(self) -> int:
