@@ -77,7 +77,7 @@ def test_model_scale_turning_defaults_and_the_propeller_rate(capsys):
     out = capsys.readouterr().out
     assert "1.179 m/s" in out and "15.75 deg/s" in out and "Froude-scaled for the 1:45.714 model" in out
     # advance and tactical diameter (the verdict may wrap in the table's column)
-    assert out.count("PASS (model") == 2 and out.count("1:45.714, indicative)") == 2
+    assert out.count("PASS (model") == 2 and out.count("indicative)") == 2
     assert "PASS " + " " * 10 not in out and not out.rstrip().endswith("PASS")
     assert main(["trial", "turning", "--ship", "kvlcc2-l7", "--speed-m-s", "1.179", "--propeller-rps", "11",
                  "--rudder-rate", "15.68", "--servo-lag", str(0.2 / math.sqrt(45.714)),

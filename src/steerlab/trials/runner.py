@@ -239,7 +239,7 @@ def gear_description(cond: TrialConditions) -> str:
     if ship.model_scale is not None:
         given = [k for k in ("rate_max_deg_s", "T_sg") if k in cond.gear_config]
         how = ("given" if len(given) == 2 else
-               f"Froude-scaled for the 1:{ship.model_scale:g} model from 2.33 deg/s, 1 s"
+               f"Froude-scaled for the 1:{ship.model_scale:g} model"
                + (" (lag given)" if given == ["T_sg"] else " (rate given)" if given else ""))
         text += f" ({how})"
     return text
