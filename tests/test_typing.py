@@ -99,9 +99,12 @@ def test_the_annotation_check_finds_a_missing_annotation(tmp_path):
     assert [m.split(" ", 1)[1] for m in _unannotated(bad)] == ["f: return", "C.m: z"]
 
 
-def test_mypy_is_clean_on_the_public_api_and_a_typed_user_script():
+def test_mypy_is_clean_on_the_public_api_and_a_typed_user_script(tmp_path):
     pytest.importorskip("mypy")
-    proc = subprocess.run([sys.executable, "-m", "mypy", "--no-error-summary"], cwd=ROOT,
+    # each mypy run its own cache: two runs sharing ROOT/.mypy_cache on two pytest-xdist workers
+    # once ended in "INTERNAL ERROR" on a clean clone
+    proc = subprocess.run([sys.executable, "-m", "mypy", "--no-error-summary", "--cache-dir",
+                           str(tmp_path / "mypy-cache")], cwd=ROOT,
                           capture_output=True, text=True, timeout=900)
     assert proc.returncode == 0, proc.stdout[-5000:] + proc.stderr[-2000:]
 
@@ -112,8 +115,9 @@ def test_mypy_catches_a_wrong_return_type(tmp_path):
     probe = tmp_path / "probe.py"
     probe.write_text("from typing import assert_type\nimport steerlab as sl\nfrom steerlab.sim.batch import BatchResult\n"
                      "assert_type(sl.simulate(sl.default_scenario()), BatchResult)\n", encoding="utf-8")
-    proc = subprocess.run([sys.executable, "-m", "mypy", "--no-error-summary", "--config-file",
-                           str(ROOT / "pyproject.toml"), str(probe)], cwd=ROOT, capture_output=True, text=True,
+    proc = subprocess.run([sys.executable, "-m", "mypy", "--no-error-summary", "--cache-dir", str(tmp_path / "mypy-cache"),
+                           "--config-file", str(ROOT / "pyproject.toml"), str(probe)], cwd=ROOT, capture_output=True,
+                          text=True,
                           timeout=900)
     assert proc.returncode == 1, proc.stdout + proc.stderr
     assert 'Expression is of type "Result", not "BatchResult"' in proc.stdout
