@@ -92,3 +92,25 @@ def test_same_step_reset_lanes_and_thread_policy_of_the_native_env():
     with pytest.raises(InputError, match="autoreset_mode"):
         gym.make_vec("steerlab/CourseKeeping-v0", num_envs=2, vectorization_mode="vector_entry_point",
                      autoreset_mode="later")
+
+
+def test_export_refuses_a_model_the_policy_controller_cannot_run_in_one_line(tmp_path):
+    """Bad input at the export: a model trained on another observation layout (the raw ``[e, r,
+    delta]``), a hidden layer wider than the kernel holds, or not an actor-critic model is one
+    InputError naming the field, and no file is written."""
+    from stable_baselines3 import PPO
+
+    from steerlab.gym.policy_export import export_policy
+    from steerlab.gym.sb3 import make_sb3_vec_env
+
+    raw = make_sb3_vec_env("steerlab/CourseKeeping-v0", 2, episode_s=8.0)           # observation="raw"
+    wide = make_sb3_vec_env("steerlab/CourseKeeping-v0", 2, **KW)
+    cases = [(PPO("MlpPolicy", raw, n_steps=8, batch_size=16, device="cpu"), "model.observation_space"),
+             (PPO("MlpPolicy", wide, n_steps=8, batch_size=16, device="cpu", policy_kwargs={"net_arch": [80]}),
+              "controller.weights.W0"),
+             (object(), "model")]
+    for model, field in cases:
+        with pytest.raises(InputError) as err:
+            export_policy(model, tmp_path / "p.npz")
+        assert err.value.field == field and "\n" not in str(err.value), str(err.value)
+        assert not (tmp_path / "p.npz").exists()

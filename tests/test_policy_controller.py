@@ -110,3 +110,26 @@ def test_save_and_load_round_trip_and_a_small_shipped_file(tmp_path):
     again = load_policy(save_policy(tmp_path / "again.npz", pol.layers, pol.activation))
     for (w1, b1), (w2, b2) in zip(pol.layers, again.layers):
         assert np.array_equal(w1, w2) and np.array_equal(b1, b2)
+
+
+def test_check_controller_passes_for_the_policy_on_its_ship():
+    """steerlab.testing's rules (declared sizes, record size, compiles, no allocation, readable =
+    compiled, and the batch engine vectorises it) hold for the registered ``policy``."""
+    from steerlab.control.registry import get_controller
+    from steerlab.testing import check_controller
+
+    out = check_controller(get_controller("policy"), ship="esso", strict=True)
+    assert out["parity_max_abs_diff"] == 0.0 and out["warnings"] == []
+    assert {"compiles", "no allocation", "parity", "vectorises"} <= set(out["rules"])
+
+
+def test_steerlab_run_with_nan_weights_exits_2_with_one_line_naming_the_field(tmp_path, capsys):
+    from steerlab.cli import main
+
+    path = _write(tmp_path, W1=np.array([[0.1] * 7 + [np.nan]]))
+    sc = tmp_path / "s.toml"
+    sc.write_text(f'dt = 0.5\nduration = 10.0\n[ship]\nmodel = "esso"\n[controller]\ntype = "policy"\n'
+                  f'weights = "{path}"\n')
+    assert main(["run", str(sc), "--out", str(tmp_path / "out"), "--quiet"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("steerlab: error: controller.weights.W1") and "NaN" in err[0], err
