@@ -9,6 +9,7 @@ Usage::
     python benchmarks/bench_env.py --threads 2          # the native env on two threads from 512 ships
     python benchmarks/bench_env.py --sb3 --n 8,64       # as SB3 sees it: steerlab.gym.sb3 vs DummyVecEnv
     python benchmarks/bench_env.py --sb3 --subproc --n 8   # ... and SubprocVecEnv (one process per env)
+    python benchmarks/bench_env.py --sb3 --subproc --start-method fork --n 8,64   # workers forked (less memory)
 
 Workload: ``steerlab/CourseKeeping-v0`` with its defaults (Esso tanker at 16 kn, gear 35 deg /
 2.33 deg/s, eq-39 waves, dt 0.1 s, control_dt 1 s = 10 RK4 steps per env step) but episodes of
@@ -30,7 +31,12 @@ an autoreset round costs).
 calls): steerlab's adapter (:mod:`steerlab.gym.sb3`, same-step autoreset on the native env, the
 normalised observation and the ``"autopilot"`` reward terms) against SB3's ``DummyVecEnv`` over N
 single environments of the same settings (and ``SubprocVecEnv`` with ``--subproc``: one process
-per env), ``--repeats`` alternating timings, medians.
+per env), ``--repeats`` alternating timings, medians. ``--start-method`` is SubprocVecEnv's
+(default: SB3's, ``forkserver`` on Linux, each worker importing steerlab anew; ``fork``: the
+workers share the parent's imports, far less memory at 64 envs); it changes how the workers
+start, not the timed steps (a pipe round trip to every worker per step). A SubprocVecEnv's
+steps run in its workers, so its ``env_steps_per_cpu_s`` (the parent's CPU) is no cost figure:
+read the wall clock.
 
 Threads: the native env runs on one thread unless asked (issue 34: an automatic switch to two
 threads from 512 ships ran at 0.65x one thread with the cores busy); ``--threads k`` asks it to
@@ -101,7 +107,7 @@ def _time_sb3(venv, acts, min_s=0.0):
     return wall / blocks, cpu / blocks
 
 
-def measure_sb3(n, steps=150, repeats=5, control_dt=1.0, min_s=0.2, subproc=False):
+def measure_sb3(n, steps=150, repeats=5, control_dt=1.0, min_s=0.2, subproc=False, start_method=None):
     """One row for ``n`` ships as SB3 sees them (module docstring)."""
     import gymnasium as gym
     from stable_baselines3.common.vec_env import DummyVecEnv, SubprocVecEnv
@@ -114,7 +120,8 @@ def measure_sb3(n, steps=150, repeats=5, control_dt=1.0, min_s=0.2, subproc=Fals
     envs = {"adapter": make_sb3_vec_env("steerlab/CourseKeeping-v0", n, **kw),
             "dummy": DummyVecEnv([lambda: gym.make("steerlab/CourseKeeping-v0", **kw) for _ in range(n)])}
     if subproc:
-        envs["subproc"] = SubprocVecEnv([lambda: gym.make("steerlab/CourseKeeping-v0", **kw) for _ in range(n)])
+        envs["subproc"] = SubprocVecEnv([lambda: gym.make("steerlab/CourseKeeping-v0", **kw) for _ in range(n)],
+                                        start_method=start_method)
     acts = np.random.default_rng(0).uniform(-1, 1, size=(steps, n, 1)).astype(np.float32)
     for env in envs.values():
         _time_sb3(env, acts[:5])
@@ -180,6 +187,8 @@ def main(argv=None) -> int:
                     help="threads of the native env from 512 ships on (default: 1, the env's default)")
     ap.add_argument("--sb3", action="store_true", help="time SB3's VecEnv.step: the adapter against DummyVecEnv")
     ap.add_argument("--subproc", action="store_true", help="with --sb3: SubprocVecEnv too")
+    ap.add_argument("--start-method", choices=("fork", "forkserver", "spawn"), default=None,
+                    help="with --subproc: how SubprocVecEnv starts its workers (default: SB3's)")
     ap.add_argument("--json", action="store_true")
     a = ap.parse_args(argv)
     import numba
@@ -196,7 +205,7 @@ def main(argv=None) -> int:
     rows = []
     if a.sb3:
         for n in (int(v) for v in a.n.split(",")):
-            r = measure_sb3(n, a.steps, a.repeats, a.control_dt, a.min_time, a.subproc)
+            r = measure_sb3(n, a.steps, a.repeats, a.control_dt, a.min_time, a.subproc, a.start_method)
             rows.append(r)
             if not a.json:
                 extra = (f"   SubprocVecEnv {r['subproc_env_steps_per_s']:10.3g}   ratio {r['ratio_vs_subproc']:6.1f}x"
@@ -205,6 +214,7 @@ def main(argv=None) -> int:
                       f"{r['dummy_env_steps_per_s']:10.3g}   ratio {r['ratio_vs_dummy']:6.1f}x{extra}", flush=True)
         if a.json:
             print(json.dumps({"workload": "SB3 VecEnv.step, steerlab/CourseKeeping-v0 normalised/autopilot",
+                              "start_method": a.start_method,
                               "load_average_1min": os.getloadavg()[0], "rows": rows}, indent=2))
         return 0
     load0 = os.getloadavg()

@@ -114,3 +114,21 @@ def test_export_refuses_a_model_the_policy_controller_cannot_run_in_one_line(tmp
             export_policy(model, tmp_path / "p.npz")
         assert err.value.field == field and "\n" not in str(err.value), str(err.value)
         assert not (tmp_path / "p.npz").exists()
+
+
+def test_bench_env_reports_the_adapter_as_sb3_sees_it(capsys):
+    """benchmarks/bench_env.py --sb3 on a tiny workload: env-steps/s of the adapter and of
+    DummyVecEnv, and their ratio (the numbers of a real run: benchmarks/RESULTS.md)."""
+    import importlib.util
+    import json
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parents[1] / "benchmarks" / "bench_env.py"
+    spec = importlib.util.spec_from_file_location("bench_env_sb3", path)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    assert mod.main(["--sb3", "--n", "2", "--steps", "4", "--repeats", "1", "--min-time", "0", "--json"]) == 0
+    (row,) = json.loads(capsys.readouterr().out)["rows"]
+    assert row["n"] == 2 and row["steps"] == 4 and "subproc_env_steps_per_s" not in row
+    assert row["adapter_env_steps_per_s"] > 0 and row["dummy_env_steps_per_s"] > 0
+    assert row["ratio_vs_dummy"] == pytest.approx(row["adapter_env_steps_per_s"] / row["dummy_env_steps_per_s"])
