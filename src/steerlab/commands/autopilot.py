@@ -83,7 +83,11 @@ def register(sub, formatter_class) -> None:
     p.add_argument("--signalk-to", metavar="HOST:PORT", help="send Signal K autopilot deltas here")
     p.add_argument("--signalk-ws", metavar="HOST:PORT",
                    help="serve the Signal K stream here (WebSocket; ship and autopilot paths; PUT target heading/state)")
-    p.add_argument("--web", metavar="HOST:PORT", help="serve the bridge page here (e.g. 127.0.0.1:8080)")
+    p.add_argument("--web", metavar="HOST:PORT", help="serve the bridge page here (e.g. 127.0.0.1:8080); the "
+                                                      "operator's address, with its token (#op=...), is printed at start")
+    p.add_argument("--operator-token-env", metavar="NAME",
+                   help="environment variable holding the operator's token (URL-safe, >= 16 characters; default: "
+                        "a random one per run): a reserved slot on the bridge page and the Signal K stream")
     p.add_argument("--mode", help="steering mode at start: compass, route (needs --route) or plotter (needs "
                                   "--nmea-listen); default: route with --route, else plotter with --nmea-listen, "
                                   "else compass; switchable at run time (docs/runtime.md)")
@@ -137,6 +141,9 @@ def build_autopilot(args):
     if connect is not None and connect[1] == 0:
         raise InputError("--connect", "port must be in [1, 65535]")
     origin = _origin(args.origin) if args.origin is not None else None
+    from steerlab.runtime.operator_session import OperatorSession
+
+    operator = OperatorSession.from_env(args.operator_token_env)
     key = load_key(args.key_file, args.key_env)
     origins = allowed_origins(args)
     check_report_every(args)
@@ -191,7 +198,8 @@ def build_autopilot(args):
                    signalk_to=hp(args.signalk_to, "--signalk-to"), signalk_ws=signalk_ws,
                    allow_origins=origins, nmea_streams=streams, actuator=actuator,
                    signalk_input=hp(args.signalk_input, "--signalk-input"),
-                   mode=args.mode, settings=settings, state_file=args.state_file, origin=origin)
+                   mode=args.mode, settings=settings, state_file=args.state_file, origin=origin,
+                   operator=operator)
     if args.profile is not None:
         try:
             ap.configure(0.0, profile=args.profile)
@@ -273,9 +281,10 @@ def run(args) -> int:
 
     def started(a, bridge):
         if not args.quiet:
-            page = f", bridge page http://{bridge.address[0]}:{bridge.address[1]}/" if bridge else ""
+            page = f", bridge page {a.operator.url(*bridge.address)}" if bridge else ""
             if a.signalk_stream is not None:
-                page += ", Signal K ws://%s:%d/signalk/v1/stream" % tuple(a.signalk_stream.address)
+                page += (", Signal K ws://%s:%d/signalk/v1/stream" % tuple(a.signalk_stream.address)
+                         + f" (operator: ?op={a.operator.token})")
             to = f"{a.connect[0]}:{a.connect[1]}" if a.connect else f"actuator {getattr(a.actuator, 'name', '?')} (sensors only)"
             print(f"autopilot: {a.ctrl.name} -> {to}, sample {a.config.sample_time:g} s, "
                   f"watchdog {a.config.watchdog_timeout:g} s ({a.config.safe_action}), log {args.log}{page}; "

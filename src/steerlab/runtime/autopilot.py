@@ -184,6 +184,11 @@ class Autopilot:
         ``compass``). Switchable at run time (:meth:`set_mode`).
     settings : steerlab.runtime.controller_settings.ControllerSettings or None
         Named profiles and gains changeable at run time (:meth:`configure`).
+    origin : (float, float) or None
+        (lat, lon) [deg] of ``x_n = y_e = 0`` for GNSS positions (default: serve-ship's).
+    operator : steerlab.runtime.operator_session.OperatorSession or None
+        The operator's token (reserved slots on the bridge page and the Signal K stream);
+        None: a random one.
     state_file : path or None
         Where the set course, mode, profile and gains are kept across restarts
         (:mod:`steerlab.runtime.pilot_state`).
@@ -196,7 +201,7 @@ class Autopilot:
                  heading=None, route=None, key=None, log_path=None, engaged=True,
                  nmea_listen=None, signalk_listen=None, signalk_to=None, nmea_to=None, bind=None,
                  signalk_ws=None, allow_origins=(), nmea_streams=(), actuator=None, signalk_input=None,
-                 mode=None, settings=None, state_file=None, plotter_input=None, origin=None):
+                 mode=None, settings=None, state_file=None, plotter_input=None, origin=None, operator=None):
         self.ctrl = controller
         self.connect = connect
         self.config = cfg = config.validate()
@@ -277,6 +282,10 @@ class Autopilot:
         self.signalk_ws = signalk_ws
         self.signalk_stream = None
         self.allow_origins = tuple(allow_origins)
+        from steerlab.runtime.operator_session import OperatorSession
+
+        #: the operator's token: a reserved slot on the bridge page and the Signal K stream
+        self.operator = operator if operator is not None else OperatorSession()
         if settings is None:
             from steerlab.runtime.controller_settings import ControllerSettings
 
@@ -851,7 +860,7 @@ class Autopilot:
 
                 self.signalk_stream = await SignalKStreamServer(
                     *self.signalk_ws, on_put=lambda path, v: autopilot_put(self, path, v, self.clock()),
-                    allow_origins=self.allow_origins).start()
+                    allow_origins=self.allow_origins, operator=self.operator).start()
             # the whole controller registry loaded now, not inside the loop: the first refused
             # setting's message (the scenario schema's) reads it, which blocked the loop ~2 s
             from steerlab.control.registry import CONTROLLERS
