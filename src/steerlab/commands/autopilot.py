@@ -12,12 +12,12 @@ EXAMPLES = """examples:
   steerlab autopilot --connect 127.0.0.1:47110 --controller pid --heading 0 --web 127.0.0.1:8080
   steerlab autopilot --connect 127.0.0.1:47110 --controller pid --nmea-listen 127.0.0.1:10111   # follow OpenCPN APB/RMB
   steerlab autopilot --connect 127.0.0.1:47110 --controller pid --signalk-ws 127.0.0.1:3000      # Signal K WebSocket
-  steerlab autopilot --nmea-serial /dev/ttyUSB0:4800 --actuator serial:/dev/ttyUSB1:38400 --heading 20   # a boat
 
 The controller is designed for the scenario's ship (--scenario, default: the bundled one); use
 the same scenario as serve-ship. Every sample is logged to --log (CSV). A compass on a serial
 port or NMEA over TCP (--nmea-serial /dev/ttyUSB0:4800 --variation -3.5, --nmea-tcp HOST:10110)
-and a rudder drive (--actuator serial:/dev/ttyUSB1:38400): docs/runtime.md"""
+and a rudder drive (--actuator serial:/dev/ttyUSB1:38400); on a boat, without --connect, the sensors
+alone (HDG/HDM, ROT, RMC/GGA/VTG or Signal K) measure: docs/runtime.md"""
 
 
 def register(sub, formatter_class) -> None:
@@ -285,7 +285,8 @@ def run(args) -> int:
             if a.signalk_stream is not None:
                 page += (", Signal K ws://%s:%d/signalk/v1/stream" % tuple(a.signalk_stream.address)
                          + f" (operator: ?op={a.operator.token})")
-            to = f"{a.connect[0]}:{a.connect[1]}" if a.connect else f"actuator {getattr(a.actuator, 'name', '?')} (sensors only)"
+            drive = getattr(a.actuator, "name", "?")
+            to = f"{a.connect[0]}:{a.connect[1]}" if a.connect else f"actuator {drive} (sensors only)"
             print(f"autopilot: {a.ctrl.name} -> {to}, sample {a.config.sample_time:g} s, "
                   f"watchdog {a.config.watchdog_timeout:g} s ({a.config.safe_action}), log {args.log}{page}; "
                   "Ctrl-C stops", file=sys.stderr, flush=True)

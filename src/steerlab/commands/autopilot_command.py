@@ -6,14 +6,13 @@ from __future__ import annotations
 import sys
 
 EXAMPLES = """examples:
-  steerlab autopilot-command --to 127.0.0.1:8376 --key-file link.key --profile rough
-  steerlab autopilot-command --to 127.0.0.1:8376 --key-file link.key --gain Kp=2.5 --gain Kd=10
-  steerlab autopilot-command --to 127.0.0.1:8376 --key-file link.key --profile calm --reply-on 127.0.0.1:8375
+  steerlab autopilot-command --to 127.0.0.1:8376 --key-file examples/data/demo-link.key --profile rough
+  steerlab autopilot-command --to 127.0.0.1:8376 --key-file examples/data/demo-link.key --gain Kp=2.5 --gain Kd=10
 
 --to is the autopilot's --signalk-listen; the key is the link's (--key-file / --key-env, the one
-the autopilot was started with). With --reply-on (the autopilot's --signalk-to, where its signed
-status goes) the command waits for the autopilot's answer: exit 0 applied, 1 refused or no
-answer within --timeout. docs/runtime.md, "Live gains and profiles"."""
+the autopilot was started with). With --reply-on HOST:PORT (the autopilot's --signalk-to, where
+its signed status goes) the command waits for the autopilot's answer: exit 0 applied, 1 refused
+or no answer within --timeout. docs/runtime.md, "Live gains and profiles"."""
 
 
 def register(sub, formatter_class) -> None:

@@ -144,7 +144,7 @@
 
   function connect() {
     // the operator's token, from the address's fragment (#op=...): a reserved slot (issue 35)
-    const op = new URLSearchParams(location.hash.slice(1)).get("op");
+    const op = new URLSearchParams((location.hash || "").slice(1)).get("op");
     ws = new WebSocket((location.protocol === "https:" ? "wss://" : "ws://") + location.host + "/ws"
                        + (op ? "?op=" + encodeURIComponent(op) : ""));
     ws.onmessage = (ev) => {
