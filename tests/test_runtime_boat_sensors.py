@@ -272,3 +272,65 @@ def test_a_sim_actuator_needs_a_ship_server(controller):  # noqa: F811
     with pytest.raises(InputError, match="--connect"):
         Autopilot(controller, None, AutopilotConfig())
     assert BoatSensors(1.0, (0.0, 0.0)).status(0.0)["chosen"] == {}
+
+
+def test_the_cli_on_a_boat_compass_on_a_pty_and_a_drive_on_another(tmp_path):
+    """``steerlab autopilot`` without ``--connect``: a compass (HDG, turning at 1 deg/s) on one
+    pseudo-terminal, the drive emulator (first-order rudder) on another. The autopilot steers
+    by the compass, orders the drive, reads the rudder angle back from it; then the compass
+    stops: link alarm, midships. Real processes throughout."""
+    import csv
+    import subprocess
+    import sys
+
+    from test_runtime_boat_io import _emulator
+
+    d_master, d_slave = os.openpty()
+    drive_path = os.ttyname(d_slave)
+    os.close(d_slave)
+    drive = _emulator(d_master)
+    os.close(d_master)
+    c_master, c_slave = os.openpty()
+    compass_path = os.ttyname(c_slave)
+    os.close(c_slave)
+    log = tmp_path / "ap.csv"
+    proc = subprocess.Popen([sys.executable, "-m", "steerlab", "autopilot", "--nmea-serial", compass_path,
+                             "--actuator", f"serial:{drive_path}:38400", "--heading", "30", "--duration", "12",
+                             "--log", str(log), "--watchdog", "1", "--report-every", "0"],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        t0 = time.monotonic()
+        deadline = t0 + 120.0                                   # hang guard: the start-up imports and loads kernels
+        started = None
+        while proc.poll() is None and time.monotonic() < deadline:
+            if started is None and log.exists() and log.stat().st_size > 200:
+                started = time.monotonic()                      # sampling: the compass speaks for 6 s
+            if started is not None and time.monotonic() - started > 6.0:
+                break
+            psi = math.radians(10.0 + (time.monotonic() - t0))
+            try:
+                os.write(c_master, _hdg_line(psi))
+            except OSError:
+                break
+            time.sleep(0.1)
+        out, err = proc.communicate(timeout=120)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+        drive.kill()
+        drive.communicate(timeout=30)
+        os.close(c_master)
+    assert proc.returncode == 0, err[-2000:]
+    assert "sensors only" in err and "Traceback" not in err
+    with open(log, newline="") as f:
+        rows = list(csv.DictReader(f))
+    steered = [r for r in rows if r["link_ok"] == "1"]
+    assert len(steered) > 10 and all(r["heading_source"] == "nmea" and r["mode"] == "auto" for r in steered)
+    assert all(r["t_sim"] == "nan" for r in rows)
+    # the drive answered: the rudder angle it reports moves with the orders (not stuck at 0)
+    assert max(abs(float(r["delta_deg"])) for r in steered) > 1.0
+    assert all(r["delta_cmd_deg"] != "nan" for r in steered)
+    # the compass stopped before the end: the link alarm and midships
+    tail = rows[-3:]
+    assert all(r["link_ok"] == "0" and r["mode"] == "safe" and float(r["delta_cmd_deg"]) == 0.0
+               and "link" in r["alarms"] for r in tail), tail
