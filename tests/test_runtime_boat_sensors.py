@@ -334,3 +334,16 @@ def test_the_cli_on_a_boat_compass_on_a_pty_and_a_drive_on_another(tmp_path):
     tail = rows[-3:]
     assert all(r["link_ok"] == "0" and r["mode"] == "safe" and float(r["delta_cmd_deg"]) == 0.0
                and "link" in r["alarms"] for r in tail), tail
+
+
+def test_on_a_boat_a_state_datagram_is_refused_and_counted(controller):  # noqa: F811
+    """Without a ship server any STATE datagram is some local process's forgery: never a
+    measurement (it would otherwise outrank the sensors for position, speed and rate)."""
+    ap = _boat_ap(controller)
+    forged = P.Sender(None).pack(P.State(0.0, 5000.0, 0.0, 1.0, 0.3, 9.0, 0.0, 0.0, math.nan, 0.0, 0), time.time())
+    ap.on_state_datagram(forged, ("127.0.0.1", 4000), t=0.0)
+    ap.on_nmea_datagram(_lines(("HDT", ["10.0", "T"])) + _rmc(100.0, 0.0).encode(), t=0.0)
+    ap.sample(0.0)
+    assert ap.latest is None and ap.filter.counts["no_ship_server"] == 1
+    assert ap.measured["sources"]["position"] == "nmea" and ap.measured["x_n"] == pytest.approx(100.0, abs=0.3)
+    assert ap.steered[1] == "nmea"

@@ -320,6 +320,9 @@ class Autopilot:
         return (time.monotonic() - self._t0) * self.config.speedup
 
     def on_state_datagram(self, data: bytes, addr=None, t: float | None = None) -> None:
+        if self.connect is None:          # a boat: no ship server, a state datagram is forged
+            self.filter.counts["no_ship_server"] += 1
+            return
         msg, _ = self.filter.accept(data, time.time(), addr)
         if msg is not None:
             self.latest = msg.body
@@ -577,7 +580,8 @@ class Autopilot:
         cfg = self.config
         st = self.latest
         age = (t if now is None else now) - self.latest_t
-        state_fresh = st is not None and age <= cfg.watchdog_timeout
+        # no ship server (a boat): a state datagram is nobody's, never a measurement
+        state_fresh = self.connect is not None and st is not None and age <= cfg.watchdog_timeout
         if self.connect is not None:
             # the ship server's link (its orders go over it too): its watchdog decides
             link_ok = state_fresh
