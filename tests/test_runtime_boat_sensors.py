@@ -169,8 +169,8 @@ class _Drive:
         return {}
 
 
-def _boat_ap(controller, **kw):  # noqa: F811
-    return Autopilot(controller, None, AutopilotConfig(nmea_timeout=1.0, watchdog_timeout=1.0), heading=0.0,
+def _boat_ap(controller, heading=0.0, **kw):  # noqa: F811
+    return Autopilot(controller, None, AutopilotConfig(nmea_timeout=1.0, watchdog_timeout=1.0), heading=heading,
                      actuator=_Drive(), **kw)
 
 
@@ -347,3 +347,21 @@ def test_on_a_boat_a_state_datagram_is_refused_and_counted(controller):  # noqa:
     assert ap.latest is None and ap.filter.counts["no_ship_server"] == 1
     assert ap.measured["sources"]["position"] == "nmea" and ap.measured["x_n"] == pytest.approx(100.0, abs=0.3)
     assert ap.steered[1] == "nmea"
+
+
+def test_route_mode_without_a_position_holds_its_reference_with_an_alarm(controller, tmp_path):  # noqa: F811
+    f = tmp_path / "route.csv"
+    f.write_text("x_n,y_e\n0,0\n250,0\n250,300\n")
+    plan = route_guidance(scenario_from_dict(SCENARIO), controller.setup.ship, controller.setup.ps, str(f),
+                          lookahead_L=1.0)
+    ap = _boat_ap(controller, heading=None, route=plan)
+    for k in range(4):                                   # a compass, no GNSS
+        ap.on_nmea_datagram(_lines(("HDT", ["20.0", "T"])), t=0.1 * k)
+        ap.sample(0.1 * k)
+    assert ap.alarms.active(POSITION) and ap.mode == "auto"
+    assert math.degrees(ap.psi_set) == pytest.approx(20.0) and ap.ref[1] == 0.0     # held, not turning
+    for k in range(4, 8):                                # the GNSS comes: the route steers, alarm cleared
+        ap.on_nmea_datagram(_lines(("HDT", ["20.0", "T"])) + _rmc(10.0, 30.0).encode(), t=0.1 * k)
+        row = ap.sample(0.1 * k)
+    assert not ap.alarms.active(POSITION) and ap.course_source == "route" and row["leg"] == 0
+    assert abs(row["xte_m"]) == pytest.approx(30.0, abs=0.5)        # 30 m east of the first leg
