@@ -3,26 +3,19 @@ r"""A boat's own sensors as the autopilot's measured state: position, speed, rat
 On a boat there is no ship-state datagram (``serve-ship``); the autopilot measures what its laws
 need from the sensors it is given (:class:`BoatSensors`):
 
-==============  ===============================================================  ==================
-quantity        sources, first fresh one wins (:func:`~steerlab.runtime.           alarm when a seen
-                source_health.select_source`)                                      source goes bad
-==============  ===============================================================  ==================
-heading         ``nmea`` (HDT/THS/HDG/HDM) > ``signalk`` > ``state``; on a signed  ``heading_nmea``...
-                link ``state`` alone while it is fresh (:mod:`~steerlab.runtime.
-                heading_health`)
-rate of turn    ``state`` > ``nmea`` (ROT) > ``signalk`` (``navigation.           ``rate_nmea``,
-                rateOfTurn``) > ``heading``: the filtered derivative of the        ``rate_signalk``
-                heading steered by (below)
-position        ``state`` > ``nmea`` (RMC, GGA) > ``signalk``                      ``position_nmea``...
-                (``navigation.position``), turned into metres north/east of the
-                origin (``--origin``, serve-ship's default)
-speed           ``state`` (surge) > ``nmea`` (RMC, VTG speed over ground) >         ``speed_nmea``...
-                ``signalk`` (``navigation.speedOverGround``) > ``design``: the
-                controller's design speed
-rudder angle    ``nmea`` (RSA) > ``signalk`` (``steering.rudderAngle``) >           ``rudder_nmea``...
-                ``state`` > ``actuator`` (the driver's feedback) > ``order``
-                (the last order, assumed reached)
-==============  ===============================================================  ==================
+* **heading**: ``nmea`` (HDT/THS/HDG/HDM) > ``signalk`` > ``state``; on a signed link ``state``
+  alone while it is fresh (:mod:`~steerlab.runtime.heading_health`); alarms ``heading_nmea``...
+* **rate of turn** (:data:`RATE_PRIORITY`): ``state`` > ``nmea`` (ROT) > ``signalk``
+  (``navigation.rateOfTurn``) > ``heading``, the filtered derivative of the heading steered by
+  (below); alarms ``rate_nmea``, ``rate_signalk``;
+* **position** (:data:`POSITION_PRIORITY`): ``state`` > ``nmea`` (RMC, GGA) > ``signalk``
+  (``navigation.position``), turned into metres north/east of the origin (``--origin``,
+  serve-ship's default); alarms ``position_nmea``...;
+* **speed** (:data:`SPEED_PRIORITY`): ``state`` (surge) > ``nmea`` (RMC, VTG speed over ground) >
+  ``signalk`` (``navigation.speedOverGround``) > ``design``, the controller's design speed;
+* **rudder angle** (:data:`RUDDER_PRIORITY`): ``nmea`` (RSA) > ``signalk``
+  (``steering.rudderAngle``) > ``state`` > ``actuator`` (the driver's feedback) > ``order`` (the
+  last order, assumed reached).
 
 The state datagram, when fresh, comes first for rate, position and speed: it carries them all at
 one instant with the heading, and on a signed link it is the authenticated source; the sensors
