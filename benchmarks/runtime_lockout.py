@@ -4,7 +4,9 @@ A hostile local process opens ``--idle`` TCP connections that send nothing and `
 WebSocket clients that never speak, on the bridge page's port and on the Signal K stream's
 port; then the operator loads the page, opens its WebSocket and engages, and opens the Signal K
 stream and PUTs. Prints what the attacker holds, what was evicted and how long the operator
-took. Then ``--requests`` GETs of ``/status.json``: a new connection each, one kept-alive
+took. Run twice: idle attackers and an operator without a token (the quiet-client eviction is
+what saves it), then chatty attackers (every held slot speaks every 0.3 s; eviction cannot help)
+and the operator with the run's token (its reserved slot, issue 35). Then ``--requests`` GETs of ``/status.json``: a new connection each, one kept-alive
 connection, and all of them pipelined on one socket.
 
     python benchmarks/runtime_lockout.py [--idle 100] [--requests 1000]
@@ -38,10 +40,22 @@ class _Autopilot:
         self.mode = "auto"
 
 
-async def lockout(n_idle: int) -> dict:
-    sk = await SignalKStreamServer(on_put=lambda path, value: (200, None)).start()
-    web = await BridgeServer(_Autopilot(), port=0).start()
-    tcp, wss, refused = [], [], 0
+async def lockout(n_idle: int, chatty: bool = False) -> dict:
+    from steerlab.runtime.operator_session import OperatorSession
+
+    op = OperatorSession()
+    sk = await SignalKStreamServer(on_put=lambda path, value: (200, None), operator=op).start()
+    web = await BridgeServer(_Autopilot(), port=0, operator=op).start()
+    tcp, wss, refused, chatter = [], [], 0, []
+
+    async def chat(ws):
+        try:
+            while True:
+                await ws.send(json.dumps({"action": "nothing"}))
+                await asyncio.sleep(0.3)
+        except Exception:
+            pass
+
     try:
         for addr in (web.address, sk.address):
             for _ in range(n_idle):
@@ -52,14 +66,18 @@ async def lockout(n_idle: int) -> dict:
                     wss.append(await connect(f"ws://{host}:{port}{path}", open_timeout=5))
                 except Exception:
                     refused += 1
+                    continue
+                if chatty:
+                    chatter.append(asyncio.create_task(chat(wss[-1])))
         await asyncio.sleep(1.1)
+        q = f"?op={op.token}" if chatty else ""
         t0 = time.perf_counter()
         host, port = web.address
         conn = http.client.HTTPConnection(host, port, timeout=5)
         await asyncio.to_thread(conn.request, "GET", "/")
         page = (await asyncio.to_thread(conn.getresponse)).status
         t_page = time.perf_counter() - t0
-        async with connect(f"ws://{host}:{port}/ws", open_timeout=5) as ws:
+        async with connect(f"ws://{host}:{port}/ws{q}", open_timeout=5) as ws:
             await ws.recv()
             await ws.send(json.dumps({"action": "engage"}))
             while (m := json.loads(await ws.recv()))["type"] != "reply":
@@ -67,17 +85,20 @@ async def lockout(n_idle: int) -> dict:
         t_action = time.perf_counter() - t0
         host, port = sk.address
         t1 = time.perf_counter()
-        async with connect(f"ws://{host}:{port}/signalk/v1/stream", open_timeout=5) as ws:
+        async with connect(f"ws://{host}:{port}/signalk/v1/stream{q}", open_timeout=5) as ws:
             await ws.recv()
             await ws.send(json.dumps({"requestId": "op", "put": {"path": "steering.autopilot.state", "value": "auto"}}))
             while "requestId" not in (r := json.loads(await ws.recv())):
                 pass
         t_put = time.perf_counter() - t1
-        return {"idle_tcp": len(tcp), "ws_tried": 2 * n_idle, "ws_refused_503": refused,
+        return {"attackers": "chatty (0.3 s), operator with token" if chatty else "idle, operator without token",
+                "idle_tcp": len(tcp), "ws_tried": 2 * n_idle, "ws_refused_503": refused,
                 "evicted": web.evicted + sk.slots.evicted, "page_status": page, "page_ms": 1e3 * t_page,
                 "engage_ok": m["ok"], "page_and_engage_ms": 1e3 * t_action, "put_status": r["statusCode"],
                 "stream_put_ms": 1e3 * t_put}
     finally:
+        for t in chatter:
+            t.cancel()
         for w in tcp:
             w.close()
         for ws in wss:
@@ -117,6 +138,7 @@ def requests(addr, n: int) -> dict:
 
 async def main(n_idle: int, n_req: int) -> None:
     print(json.dumps(await lockout(n_idle), indent=1))
+    print(json.dumps(await lockout(n_idle, chatty=True), indent=1))
     web = await BridgeServer(_Autopilot(), port=0).start()
     try:
         print(json.dumps(await asyncio.to_thread(requests, web.address, n_req), indent=1))

@@ -67,9 +67,11 @@ def test_good_sentences_are_accepted_and_others_ignored():
     lines = [_r("THS", ["359.99", "A"]), _r("HDT", ["360.0", "T"]), _r("APB", APB_T),
              _r("HTC", ["V", "", "", "H", "N", "", "", "", "", "123.4", "", "", "T"]),
              _r("XTE", ["A", "A", "0.1", "L", "N"]), _r("RSA", ["1.0", "A", "", "V"])]
-    got = nmea.steering_inputs("".join(lines + [_r("VTG", ["10.0", "T", "", "M", "5.0", "N", "9.3", "K", "A"])]).encode())
-    # RSA is read (rudder feedback, issue 33); VTG is valid but not used
-    assert got["accepted"] == 6 and got["ignored"] == 1 and got["rejected"] == 0
+    got = nmea.steering_inputs("".join(lines + [_r("VTG", ["10.0", "T", "", "M", "5.0", "N", "9.3", "K", "A"]),
+                                                _r("GSV", ["1", "1", "00"])]).encode())
+    # RSA is read (rudder feedback, issue 33), VTG too (speed over ground); GSV is valid but not used
+    assert got["accepted"] == 7 and got["ignored"] == 1 and got["rejected"] == 0
+    assert got["sog"] == pytest.approx(5.0 * 1852.0 / 3600.0)
     assert got["rudder"] == pytest.approx(math.radians(1.0))
     assert got["heading"] == 0.0                                 # 360 deg = north
     assert got["course"] == pytest.approx(math.radians(50.0)) and got["course_source"] == "APB"
@@ -93,7 +95,7 @@ def _ap(controller, **cfg):  # noqa: F811
 
 def test_rejections_are_counted_per_reason_and_shown_in_status(controller):  # noqa: F811
     ap = _ap(controller, input_rate=0.0)
-    ap.on_nmea_datagram((_r("THS", ["1e300", "A"]) + _r("HDT", ["10.0", "T"]) + _r("RMC", [""] * 12)).encode(), t=0.0)
+    ap.on_nmea_datagram((_r("THS", ["1e300", "A"]) + _r("HDT", ["10.0", "T"]) + _r("GSV", ["1", "1", "00"])).encode(), t=0.0)
     ap.on_signalk_datagram(b'{"updates": [{"values": [{"path": "steering.autopilot.target.headingTrue", '
                            b'"value": 100.0}]}]}', t=0.0)
     ap.on_signalk_datagram(b'{"updates": [{"values": [{"path": "steering.autopilot.state", "value": "x"}]}]}', t=0.0)

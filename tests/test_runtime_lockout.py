@@ -226,3 +226,101 @@ def test_keep_alive_follows_the_request(hdr, keep):
             await web.close()
 
     asyncio.run(go())
+
+
+def test_chatty_clients_on_every_slot_do_not_lock_the_operator_out():
+    """Issue 35: a hostile local process whose clients speak every 0.3 s on every public slot
+    (100 tries per port; the rest idle TCP) refuses everyone else (503), but the operator, with
+    the run's token, gets a reserved slot: the page loads, engages, and the Signal K stream takes
+    a PUT. A wrong token is refused (403) and counted, never given the operator's slot."""
+    from websockets.asyncio.client import connect
+
+    from steerlab.runtime.operator_session import OperatorSession
+
+    async def go():
+        op = OperatorSession()
+        sk = await SignalKStreamServer(on_put=lambda path, value: (200, None), operator=op).start()
+        web = await BridgeServer(_Autopilot(), port=0, operator=op).start()
+        hostile, idle_tcp, chatter = [], [], []
+        stop = asyncio.Event()
+
+        async def chat(ws, msg):
+            try:
+                while not stop.is_set():
+                    await ws.send(msg)
+                    await asyncio.sleep(0.3)
+            except Exception:
+                pass
+
+        try:
+            for (host, port), path, msg in ((web.address, "/ws", json.dumps({"action": "nothing"})),
+                                            (sk.address, "/signalk/v1/stream", json.dumps({"context": "vessels.self"}))):
+                for _ in range(100):
+                    r, w = await asyncio.open_connection(host, port)
+                    idle_tcp.append(w)
+                    try:
+                        ws = await connect(f"ws://{host}:{port}{path}", open_timeout=5)
+                    except Exception:            # 503: every public slot is held by a speaker
+                        continue
+                    hostile.append(ws)
+                    chatter.append(asyncio.create_task(chat(ws, msg)))
+            assert len(hostile) == web.max_clients + sk.max_clients          # every public slot taken
+            await asyncio.sleep(1.2)                                          # the attack stands
+            host, port = web.address
+            with pytest.raises(Exception, match="503"):                       # without the token: locked out
+                await connect(f"ws://{host}:{port}/ws", open_timeout=5)
+            with pytest.raises(Exception, match="403"):                       # a wrong token
+                await connect(f"ws://{host}:{port}/ws?op=guess{op.token[5:]}", open_timeout=5)
+            assert web.counts["operator_refused"] == 1
+
+            t0 = time.monotonic()
+            page = await asyncio.to_thread(_get, host, port, "/")
+            assert page.startswith(b"HTTP/1.1 200 ") and b"<html" in page.lower()
+            async with connect(f"ws://{host}:{port}/ws?op={op.token}", open_timeout=5) as ws:
+                assert json.loads(await asyncio.wait_for(ws.recv(), 5))["type"] == "status"
+                await ws.send(json.dumps({"action": "engage"}))
+                while (m := json.loads(await asyncio.wait_for(ws.recv(), 5)))["type"] != "reply":
+                    pass
+                assert m["ok"] is True and web.ap.mode == "auto"
+            host, port = sk.address
+            async with connect(f"ws://{host}:{port}/signalk/v1/stream",
+                               additional_headers={"Authorization": f"Bearer {op.token}"}, open_timeout=5) as ws:
+                assert "self" in json.loads(await asyncio.wait_for(ws.recv(), 5))
+                await ws.send(json.dumps({"requestId": "op", "put": {"path": "steering.autopilot.state", "value": "auto"}}))
+                while "requestId" not in (m := json.loads(await asyncio.wait_for(ws.recv(), 5))):
+                    pass
+                assert m["statusCode"] == 200
+            assert time.monotonic() - t0 < 60.0       # a hang guard only (the 2 s: benchmarks/runtime_lockout.py)
+            assert web.counts["operator"] == 1 and sk.counts["operator"] == 1
+            assert web.evicted == 0 and sk.slots.evicted == 0                 # no speaker was evicted
+            assert all(ws.close_code is None for ws in hostile)
+        finally:
+            stop.set()
+            for t in chatter:
+                t.cancel()
+            for w in idle_tcp:
+                w.close()
+            for ws in hostile:
+                ws.transport.abort()
+            await sk.close()
+            await web.close()
+
+    asyncio.run(go())
+
+
+def test_the_operator_token_reserves_slots_and_replaces_its_own_oldest():
+    now = [0.0]
+    slots = ClientSlots(1, min_quiet=1.0, clock=lambda: now[0], operator_capacity=2)
+    pub, o1, o2, o3 = object(), object(), object(), object()
+    slots.add(pub)
+    assert not slots.make_room()                    # the public slot is held by a fresh client
+    for o in (o1, o2):
+        assert slots.make_room(operator=True)
+        slots.add(o, operator=True)
+        now[0] += 0.1
+    assert slots.make_room(operator=True) and o1 not in slots.operator and slots.operator_replaced == 1
+    slots.add(o3, operator=True)
+    assert set(slots.operator) == {o2, o3} and pub in slots.last and len(slots) == 3
+    now[0] = 5.0
+    assert slots.make_room() and pub not in slots.last     # a public newcomer evicts the quiet public one only
+    assert set(slots.operator) == {o2, o3}

@@ -66,8 +66,14 @@ def test_registered_sentences_round_trip():
 def test_steering_inputs_heading_and_plotter_course():
     got = nmea.steering_inputs("".join(nmea.state_sentences(STATE, wall=WALL)).encode())
     assert got["heading"] == pytest.approx(math.radians(350.0)) and got["course"] is None
-    # HDT, THS and RSA (rudder feedback) are read; ROT, RMC (no variation), VTG are valid but not used
-    assert got["accepted"] == 3 and got["ignored"] == 3 and got["rejected"] == 0
+    # HDT, THS, RSA (rudder feedback), ROT, RMC and VTG (rate of turn, position, speed) are all read
+    assert got["accepted"] == 6 and got["ignored"] == 0 and got["rejected"] == 0
+    from steerlab.runtime.boat_sensors import local_position
+
+    # the position round trip through RMC (4 decimals of a minute: 0.2 m), speed and rate of turn
+    assert local_position(*got["position"], nmea.DEFAULT_ORIGIN) == pytest.approx((1852.0, -926.0), abs=0.3)
+    assert got["sog"] == pytest.approx(math.hypot(STATE.u, STATE.v), abs=0.005)
+    assert got["rot"] == pytest.approx(STATE.r, abs=1e-5)
     apb = nmea.render("APB", ["A", "A", "0.10", "R", "N", "V", "V", "45.0", "T", "WP1", "44.0", "T", "50.0", "T"])
     assert nmea.steering_inputs(apb.encode())["course"] == pytest.approx(math.radians(50.0))   # heading to steer
     apb = nmea.render("APB", ["A", "A", "0.10", "R", "N", "V", "V", "45.0", "T", "WP1", "44.0", "T", "", ""])

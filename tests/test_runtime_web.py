@@ -129,7 +129,7 @@ const els = {};
 const buttons = [-10, -1, 1, 10].map((d) => { const b = el("adj" + d); b.dataset.adjust = String(d); return b; });
 global.document = { getElementById: (id) => els[id] || (els[id] = el(id)), createElementNS: (ns, t) => el(t),
                     createElement: (t) => el(t), querySelectorAll: () => buttons };
-global.location = { protocol: "http:", host: "127.0.0.1:" + port };
+global.location = { protocol: "http:", host: "127.0.0.1:" + port, hash: process.argv[4] || "" };
 const RealWS = WebSocket;
 let statuses = 0;
 global.WebSocket = function (url) { const s = new RealWS(url); s.addEventListener("message", () => statuses++); return s; };
@@ -194,10 +194,12 @@ def test_bridge_js_runs_against_the_live_page(controller, tmp_path):  # noqa: F8
         try:
             proc = await asyncio.create_subprocess_exec(
                 node, "--experimental-websocket", str(harness), str(bridge.address[1]), str(js),
+                f"#op={bridge.operator.token}",             # the operator's address (issue 35)
                 stdout=asyncio.subprocess.PIPE, stderr=asyncio.subprocess.PIPE)
             stdout, stderr = await asyncio.wait_for(proc.communicate(), 60)
             assert proc.returncode == 0, stderr.decode()
-            out.update(json.loads(stdout), d_set=math.degrees(ap.psi_set - before), mode=ap.mode)
+            out.update(json.loads(stdout), d_set=math.degrees(ap.psi_set - before), mode=ap.mode,
+                       operator=bridge.counts["operator"], public=len(bridge.slots.last))
         finally:
             await bridge.close()
             ap.stop()
@@ -213,3 +215,4 @@ def test_bridge_js_runs_against_the_live_page(controller, tmp_path):  # noqa: F8
     assert standby["mode"] == "standby" and standby["reply"] == "ok: standby"
     assert standby["set_course"] == "10.0\u00b0"
     assert engaged["reply"] == "ok: engage" and out["mode"] == "auto"
+    assert out["operator"] == 1 and out["public"] == 0      # the page presented its token: a reserved slot

@@ -16,7 +16,8 @@ EXAMPLES = """examples:
 The controller is designed for the scenario's ship (--scenario, default: the bundled one); use
 the same scenario as serve-ship. Every sample is logged to --log (CSV). A compass on a serial
 port or NMEA over TCP (--nmea-serial /dev/ttyUSB0:4800 --variation -3.5, --nmea-tcp HOST:10110)
-and a rudder drive (--actuator serial:/dev/ttyUSB1:38400): docs/runtime.md"""
+and a rudder drive (--actuator serial:/dev/ttyUSB1:38400); on a boat, without --connect, the sensors
+alone (HDG/HDM, ROT, RMC/GGA/VTG or Signal K) measure: docs/runtime.md"""
 
 
 def register(sub, formatter_class) -> None:
@@ -27,7 +28,12 @@ def register(sub, formatter_class) -> None:
                                    "controller and send rudder orders; watchdog (alarm + safe action), "
                                    "off-course alarm, CSV log, optional NMEA 0183 / Signal K / bridge page.",
                        epilog=EXAMPLES, formatter_class=formatter_class)
-    p.add_argument("--connect", required=True, metavar="HOST:PORT", help="the ship server")
+    p.add_argument("--connect", metavar="HOST:PORT",
+                   help="the ship server (serve-ship); leave it out on a boat: the sensors alone measure "
+                        "(--nmea-serial/--nmea-tcp/--signalk-input) and --actuator drives the rudder")
+    p.add_argument("--origin", default=None, metavar="LAT,LON",
+                   help="where x_n = y_e = 0 is, for GNSS positions (RMC/GGA, Signal K) and --route in metres "
+                        "(default 54.5,18.9, serve-ship's)")
     p.add_argument("--controller", help="controller name (default: the scenario's)")
     g = p.add_mutually_exclusive_group()
     g.add_argument("--heading", type=float, help="set course [deg] (default: heading at engagement)")
@@ -77,7 +83,11 @@ def register(sub, formatter_class) -> None:
     p.add_argument("--signalk-to", metavar="HOST:PORT", help="send Signal K autopilot deltas here")
     p.add_argument("--signalk-ws", metavar="HOST:PORT",
                    help="serve the Signal K stream here (WebSocket; ship and autopilot paths; PUT target heading/state)")
-    p.add_argument("--web", metavar="HOST:PORT", help="serve the bridge page here (e.g. 127.0.0.1:8080)")
+    p.add_argument("--web", metavar="HOST:PORT", help="serve the bridge page here (e.g. 127.0.0.1:8080); the "
+                                                      "operator's address, with its token (#op=...), is printed at start")
+    p.add_argument("--operator-token-env", metavar="NAME",
+                   help="environment variable holding the operator's token (URL-safe, >= 16 characters; default: "
+                        "a random one per run): a reserved slot on the bridge page and the Signal K stream")
     p.add_argument("--mode", help="steering mode at start: compass, route (needs --route) or plotter (needs "
                                   "--nmea-listen); default: route with --route, else plotter with --nmea-listen, "
                                   "else compass; switchable at run time (docs/runtime.md)")
@@ -125,9 +135,15 @@ def build_autopilot(args):
     from steerlab.sim.scenario import default_scenario, load_scenario
     from steerlab.units import rad
 
-    connect = parse_hostport(args.connect, "--connect")
-    if connect[1] == 0:
+    from steerlab.commands.serve_ship import _origin
+
+    connect = parse_hostport(args.connect, "--connect") if args.connect else None
+    if connect is not None and connect[1] == 0:
         raise InputError("--connect", "port must be in [1, 65535]")
+    origin = _origin(args.origin) if args.origin is not None else None
+    from steerlab.runtime.operator_session import OperatorSession
+
+    operator = OperatorSession.from_env(args.operator_token_env)
     key = load_key(args.key_file, args.key_env)
     origins = allowed_origins(args)
     check_report_every(args)
@@ -141,6 +157,12 @@ def build_autopilot(args):
     if args.heading is not None:
         require_finite_range("--heading", args.heading, -360.0, 360.0)
     streams, actuator, variation = boat_inputs(args)
+    if connect is None and getattr(actuator, "name", "") == "sim":
+        raise InputError("--connect", "give the ship server (--connect HOST:PORT), or on a boat a rudder drive "
+                                      "(--actuator serial:PATH[:BAUD] or a steerlab.actuators entry point)")
+    if connect is None and not (streams or args.nmea_listen or args.signalk_input):
+        raise InputError("--connect", "without a ship server the autopilot needs a heading sensor: "
+                                      "--nmea-serial, --nmea-tcp, --nmea-tcp-listen, --nmea-listen or --signalk-input")
     turn = scenario.guidance.rate_max_deg_s if args.turn_rate is None else args.turn_rate
     require_finite_range("--turn-rate", turn, 0.0, 30.0)
     require_finite_range("--off-course-deg", args.off_course_deg, 0.0, 180.0, lo_open=True)
@@ -176,7 +198,8 @@ def build_autopilot(args):
                    signalk_to=hp(args.signalk_to, "--signalk-to"), signalk_ws=signalk_ws,
                    allow_origins=origins, nmea_streams=streams, actuator=actuator,
                    signalk_input=hp(args.signalk_input, "--signalk-input"),
-                   mode=args.mode, settings=settings, state_file=args.state_file)
+                   mode=args.mode, settings=settings, state_file=args.state_file, origin=origin,
+                   operator=operator)
     if args.profile is not None:
         try:
             ap.configure(0.0, profile=args.profile)
@@ -258,10 +281,13 @@ def run(args) -> int:
 
     def started(a, bridge):
         if not args.quiet:
-            page = f", bridge page http://{bridge.address[0]}:{bridge.address[1]}/" if bridge else ""
+            page = f", bridge page {a.operator.url(*bridge.address)}" if bridge else ""
             if a.signalk_stream is not None:
-                page += ", Signal K ws://%s:%d/signalk/v1/stream" % tuple(a.signalk_stream.address)
-            print(f"autopilot: {a.ctrl.name} -> {a.connect[0]}:{a.connect[1]}, sample {a.config.sample_time:g} s, "
+                page += (", Signal K ws://%s:%d/signalk/v1/stream" % tuple(a.signalk_stream.address)
+                         + f" (operator: ?op={a.operator.token})")
+            drive = getattr(a.actuator, "name", "?")
+            to = f"{a.connect[0]}:{a.connect[1]}" if a.connect else f"actuator {drive} (sensors only)"
+            print(f"autopilot: {a.ctrl.name} -> {to}, sample {a.config.sample_time:g} s, "
                   f"watchdog {a.config.watchdog_timeout:g} s ({a.config.safe_action}), log {args.log}{page}; "
                   "Ctrl-C stops", file=sys.stderr, flush=True)
             if not a.key:

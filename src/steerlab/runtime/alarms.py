@@ -13,6 +13,8 @@ LINK = "link"            #: no valid ship state for longer than the watchdog tim
 OFF_COURSE = "off_course"  #: heading deviates from the set course by more than the limit
 ARRIVAL = "arrival"      #: the chart plotter's destination waypoint was reached: the last course is held
 ACTUATOR = "actuator"    #: the actuator driver reports a fault: safe action ordered, autopilot disengaged
+POSITION = "position"    #: route mode without any fresh position: the route's last reference is held
+SIGNALK_INPUT = "signalk_input"  #: the Signal K input's subscription was up and is lost (reconnecting)
 
 SEVERITY = {ARRIVAL: "alert"}
 """Signal K notification state of an alarm (specification 1.7, "Notifications": ``alert`` <

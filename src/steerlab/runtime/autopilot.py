@@ -62,7 +62,7 @@ from steerlab.errors import InputError, require_finite_range
 from steerlab.guidance.reference_models import course_reference, course_schedule
 from steerlab.guidance.reference_vector import REF_LEG, REF_PSI, REF_R, REF_XTE, initial_reference
 from steerlab.runtime import protocol as P
-from steerlab.runtime.alarms import ACTUATOR, ARRIVAL, LINK, OFF_COURSE, AlarmBoard
+from steerlab.runtime.alarms import ACTUATOR, ARRIVAL, LINK, OFF_COURSE, POSITION, SIGNALK_INPUT, AlarmBoard
 from steerlab.runtime.heading_health import HEADING_PRIORITY, MAX_TURN_RATE, HeadingHealth, select_heading
 from steerlab.runtime.link_filter import LinkFilter
 from steerlab.runtime.rate_limit import RateLimiter
@@ -184,6 +184,11 @@ class Autopilot:
         ``compass``). Switchable at run time (:meth:`set_mode`).
     settings : steerlab.runtime.controller_settings.ControllerSettings or None
         Named profiles and gains changeable at run time (:meth:`configure`).
+    origin : (float, float) or None
+        (lat, lon) [deg] of ``x_n = y_e = 0`` for GNSS positions (default: serve-ship's).
+    operator : steerlab.runtime.operator_session.OperatorSession or None
+        The operator's token (reserved slots on the bridge page and the Signal K stream);
+        None: a random one.
     state_file : path or None
         Where the set course, mode, profile and gains are kept across restarts
         (:mod:`steerlab.runtime.pilot_state`).
@@ -196,7 +201,7 @@ class Autopilot:
                  heading=None, route=None, key=None, log_path=None, engaged=True,
                  nmea_listen=None, signalk_listen=None, signalk_to=None, nmea_to=None, bind=None,
                  signalk_ws=None, allow_origins=(), nmea_streams=(), actuator=None, signalk_input=None,
-                 mode=None, settings=None, state_file=None, plotter_input=None):
+                 mode=None, settings=None, state_file=None, plotter_input=None, origin=None, operator=None):
         self.ctrl = controller
         self.connect = connect
         self.config = cfg = config.validate()
@@ -250,12 +255,22 @@ class Autopilot:
         self.signalk_nav: dict = {}    # the newest Signal K input values by path (position, rate of turn)
         self.rmc_variation = None      # (variation [rad], t) of the newest RMC that gave one
         self.rudder_feedback = None    # (rudder angle [rad], t) of the newest RSA
+        from steerlab.runtime.boat_sensors import BoatSensors
+        from steerlab.runtime.nmea import DEFAULT_ORIGIN
+
+        # position, speed, rate of turn and rudder angle from the sensors, each with its health
+        self.sensors = BoatSensors(cfg.nmea_timeout, DEFAULT_ORIGIN if origin is None else origin,
+                                   getattr(controller, "design_speed", math.nan))
+        self.measured: dict = {}       # the last sample's measured state and its sources
         self.nmea_stream_factories = tuple(nmea_streams)
         self.nmea_stream_inputs: list = []
         if actuator is None:
             from steerlab.runtime.actuator_sim import SimLinkActuator
 
             actuator = SimLinkActuator()
+        if connect is None and getattr(actuator, "name", "") == "sim":
+            raise InputError("--connect", "the sim actuator sends its orders to a ship server: give --connect "
+                                          "HOST:PORT, or a rudder drive with --actuator")
         self.actuator = actuator
         self.actuator_safe = False     # latched by an actuator fault while engaged
         self.track: deque = deque(maxlen=4000)
@@ -267,6 +282,10 @@ class Autopilot:
         self.signalk_ws = signalk_ws
         self.signalk_stream = None
         self.allow_origins = tuple(allow_origins)
+        from steerlab.runtime.operator_session import OperatorSession
+
+        #: the operator's token: a reserved slot on the bridge page and the Signal K stream
+        self.operator = operator if operator is not None else OperatorSession()
         if settings is None:
             from steerlab.runtime.controller_settings import ControllerSettings
 
@@ -276,7 +295,9 @@ class Autopilot:
         self.signalk_link = None       # SignedDeltaFilter on --signalk-listen when keyed (run)
         self.signalk_signer = None     # DeltaSigner of the status to --signalk-to when keyed (run)
         self.signalk_replies: deque = deque(maxlen=8)   # answers to the plug-in's last commands, in the status
-        self.bind = bind or local_bind_for(connect[0])   # loopback peer: loopback socket, same family
+        # loopback peer: loopback socket, same family; on a boat (no ship server) the outputs' peer
+        peer = connect or signalk_to or nmea_to
+        self.bind = bind or (local_bind_for(peer[0]) if peer else ("127.0.0.1", 0))
         self.transport = None
         self._t0 = None
         self._stop = None
@@ -299,6 +320,9 @@ class Autopilot:
         return (time.monotonic() - self._t0) * self.config.speedup
 
     def on_state_datagram(self, data: bytes, addr=None, t: float | None = None) -> None:
+        if self.connect is None:          # a boat: no ship server, a state datagram is forged
+            self.filter.counts["no_ship_server"] += 1
+            return
         msg, _ = self.filter.accept(data, time.time(), addr)
         if msg is not None:
             self.latest = msg.body
@@ -325,6 +349,7 @@ class Autopilot:
             self.rmc_variation = (got["variation"], t)
         if got["rudder"] is not None:
             self.rudder_feedback = (got["rudder"], t)
+        self.sensors.observe_nmea(got, t, self.nmea_counts)
         if got["heading"] is not None:
             if self.heading_health["nmea"].observe(got["heading"], t):
                 self.nmea_heading = (got["heading"], t)
@@ -365,6 +390,7 @@ class Autopilot:
             self.signalk_counts["implausible"] += 1
         if "steering.rudderAngle" in values:
             self.rudder_feedback = (values["steering.rudderAngle"], t)
+        self.sensors.observe_signalk(values, t, self.signalk_counts)
 
     def on_signalk_datagram(self, data: bytes, addr=None, t: float | None = None) -> None:
         """A Signal K delta on ``--signalk-listen`` (the plug-in's commands): signed with the
@@ -411,8 +437,8 @@ class Autopilot:
             return
         self.psi_set = psi
         start = self.ref[REF_PSI] if self.gd is not None else psi
-        if self.gd is None and self.latest is not None:
-            start = self.latest.psi
+        if self.gd is None and self._heading_now() is not None:
+            start = self._heading_now()
         self.gd = course_schedule(float(start), [(max(t, 0.0), psi)], self.config.turn_rate)
         self.off_course_armed = False
 
@@ -444,7 +470,8 @@ class Autopilot:
 
     def adjust(self, ddeg: float, t: float) -> None:
         """Change the set course by ``ddeg`` degrees (the bridge page's ±1/±10 buttons)."""
-        base = self.psi_set if self.psi_set is not None else (self.latest.psi if self.latest else 0.0)
+        here = self._heading_now()
+        base = self.psi_set if self.psi_set is not None else (here if here is not None else 0.0)
         self.set_course(base + rad(float(ddeg)), t)
 
     def engage(self, t: float) -> None:
@@ -523,12 +550,27 @@ class Autopilot:
             return course, kind, False
         return None, None, False
 
-    def _heading(self, t: float):
+    def _heading_now(self):
+        """The newest ship state's heading [rad], else (a boat) the one the last sample steered
+        by, else None."""
+        if self.latest is not None:
+            return self.latest.psi
+        return self.steered[0]
+
+    def _heading(self, t: float, state_fresh: bool = True):
         """``(heading [rad], source)``: a fresh NMEA HDT/THS heading, unless the ship state is
         signed (a key) and ``nmea_heading_over_signed`` is off: then the signed state's heading,
-        so an unauthenticated sender on the NMEA port cannot steer the ship by a false heading."""
+        so an unauthenticated sender on the NMEA port cannot steer the ship by a false heading.
+        Without a fresh state (a boat: no ship server) the sensors' priority without ``state``."""
+        if not state_fresh:
+            order = tuple(n for n in HEADING_PRIORITY if n != "state")
+            return select_heading(t, order, self.heading_health, None, self.alarms)
         order = HEADING_PRIORITY if (not self.key or self.config.nmea_heading_over_signed) else ("state",)
         return select_heading(t, order, self.heading_health, self.latest.psi, self.alarms)
+
+    def _sensor_heading_fresh(self, t: float) -> bool:
+        """Whether a sensor (NMEA, Signal K) gives a fresh heading at ``t``."""
+        return any(h.heading(t) is not None for h in self.heading_health.values())
 
     def sample(self, t: float, now: float | None = None) -> dict:
         """Run one sample at ship time ``t`` (the clock reads ``now``, default ``t``).
@@ -538,20 +580,43 @@ class Autopilot:
         cfg = self.config
         st = self.latest
         age = (t if now is None else now) - self.latest_t
-        link_ok = st is not None and age <= cfg.watchdog_timeout
-        self.alarms.set(LINK, not link_ok and (st is not None or t > cfg.watchdog_timeout), t,
-                        f"no valid ship state for more than {cfg.watchdog_timeout:g} s")
+        # no ship server (a boat): a state datagram is nobody's, never a measurement
+        state_fresh = self.connect is not None and st is not None and age <= cfg.watchdog_timeout
+        if self.connect is not None:
+            # the ship server's link (its orders go over it too): its watchdog decides
+            link_ok = state_fresh
+            self.alarms.set(LINK, not link_ok and (st is not None or t > cfg.watchdog_timeout), t,
+                            f"no valid ship state for more than {cfg.watchdog_timeout:g} s")
+        else:
+            # a boat: the sensors alone; steering needs a fresh heading from one of them
+            link_ok = self._sensor_heading_fresh(t)
+            if not link_ok:
+                self._heading(t, False)          # the heading sources' own alarms, kept current
+            self.alarms.set(LINK, not link_ok and t > cfg.watchdog_timeout, t,
+                            "no fresh heading from any sensor (NMEA, Signal K)")
+        if self.signalk_source is not None:
+            self.alarms.set(SIGNALK_INPUT, self.signalk_source.lost(), t,
+                            f"Signal K input {self.signalk_input[0]}:{self.signalk_input[1]}: connection lost, "
+                            "reconnecting")
         cmd = None
         psi = src = None
         if link_ok:
-            psi, src = self._heading(t)
+            psi, src = self._heading(t, state_fresh)
             self.steered = (psi, src)
-            rudder = st.delta
-            if self.rudder_feedback is not None and t - self.rudder_feedback[1] <= cfg.nmea_timeout:
-                rudder = self.rudder_feedback[0]        # a fresh RSA: the rudder's own sensor
-            x = self.ctrl.measured_state(st.x_n, st.y_e, psi, st.u, st.v, st.r, rudder)
-            self.track.append((st.x_n, st.y_e))
-            if self.route is not None:       # the simulator's guidance kernel, same call
+            m = self.measured = self.sensors.measure(t, psi, st if state_fresh else None,
+                                                     self.actuator.rudder(t), self.last_cmd, self.alarms)
+            has_pos = m["x_n"] is not None
+            x = self.ctrl.measured_state(m["x_n"] if has_pos else 0.0, m["y_e"] if has_pos else 0.0, psi,
+                                         m["u"], m["v"], m["r"], m["delta"])
+            if has_pos:
+                self.track.append((m["x_n"], m["y_e"]))
+            self.alarms.set(POSITION, self.route is not None and not has_pos, t,
+                            "route mode needs a position (state, NMEA RMC/GGA or Signal K): holding the set course")
+            if self.route is not None and not has_pos:     # the route's last reference, held
+                if self.psi_set is None:
+                    self.psi_set = self.ref[REF_PSI] = psi
+                self.ref[REF_R] = 0.0
+            elif self.route is not None:       # the simulator's guidance kernel, same call
                 self.route.guide(t, x, self.route.gd, self.gz, self.ref, cfg.sample_time)
                 self.psi_set = float(self.ref[REF_PSI])
                 self.gd = self.route.gd
@@ -594,14 +659,16 @@ class Autopilot:
             self.last_cmd = cmd
         self.cmd_sent = cmd
         self.samples += 1
+        m = self.measured if link_ok else {}
         row = {
             "t": t, "wall": time.time(), "t_sim": st.t_sim if st else math.nan,
             "state_age": age if st else math.nan, "link_ok": int(link_ok), "mode": self.mode,
             "psi_deg": deg(psi) if psi is not None else math.nan,
-            "r_deg_s": deg(st.r) if link_ok else math.nan,
-            "delta_deg": deg(st.delta) if link_ok else math.nan,
-            "u": st.u if link_ok else math.nan,
-            "x_n": st.x_n if link_ok else math.nan, "y_e": st.y_e if link_ok else math.nan,
+            "r_deg_s": deg(m["r"]) if link_ok else math.nan,
+            "delta_deg": deg(st.delta if state_fresh else m["delta"]) if link_ok else math.nan,
+            "u": m["u"] if link_ok else math.nan,
+            "x_n": m["x_n"] if link_ok and m["x_n"] is not None else math.nan,
+            "y_e": m["y_e"] if link_ok and m["y_e"] is not None else math.nan,
             "psi_set_deg": deg(self.psi_set) if self.psi_set is not None else math.nan,
             "psi_ref_deg": deg(self.ref[REF_PSI]) if self.gd is not None else math.nan,
             "r_ref_deg_s": deg(self.ref[REF_R]) if self.gd is not None else math.nan,
@@ -662,6 +729,8 @@ class Autopilot:
         """
         st = self.latest
         r = self.last_row
+        m = self.measured
+        boat = st is None and bool(m)          # no ship state: the sensors' measurement
         return {
             "t": r.get("t", 0.0), "mode": self.mode, "link_ok": bool(r.get("link_ok", 0)),
             "state_age": r.get("state_age"),
@@ -670,9 +739,11 @@ class Autopilot:
             "heading_source": self.steered[1], "course_source": self.course_source,
             "set_course": None if self.psi_set is None else wrap_to_2pi(self.psi_set),
             "reference": None if self.gd is None else wrap_to_2pi(float(self.ref[REF_PSI])),
-            "yaw_rate": None if st is None else st.r, "rudder": None if st is None else st.delta,
-            "rudder_cmd": self.cmd_sent, "speed": None if st is None else st.u,
-            "position": None if st is None else [st.x_n, st.y_e],
+            "yaw_rate": m["r"] if boat else (None if st is None else st.r),
+            "rudder": m["delta"] if boat else (None if st is None else st.delta),
+            "rudder_cmd": self.cmd_sent, "speed": m["u"] if boat else (None if st is None else st.u),
+            "position": ((None if m["x_n"] is None else [m["x_n"], m["y_e"]]) if boat
+                         else (None if st is None else [st.x_n, st.y_e])),
             "alarms": self.alarms.snapshot(), "controller": self.ctrl.name,
             "link": {k: v for k, v in self.filter.counts.items()},
             "nmea": dict(self.nmea_counts), "signalk": dict(self.signalk_counts),
@@ -681,6 +752,7 @@ class Autopilot:
             "off_course_limit": self.config.off_course_limit,
             "ship_status": None if st is None else st.status,
             "heading_sources": {n: h.status(r.get("t", 0.0)) for n, h in self.heading_health.items()},
+            "sensor_sources": self.sensors.status(r.get("t", 0.0)),
             "variation": self._variation_now(),
             "rudder_feedback": None if self.rudder_feedback is None else self.rudder_feedback[0],
             "actuator": {"name": self.actuator.name, "rudder": self.actuator.rudder(r.get("t", 0.0)),
@@ -720,7 +792,7 @@ class Autopilot:
         if self.signalk_stream is not None:
             from steerlab.runtime.signalk import autopilot_values, state_values
 
-            values = state_values(self.latest) if self.last_row.get("link_ok") else {}
+            values = state_values(self.latest) if self.last_row.get("link_ok") and self.latest is not None else {}
             self.signalk_stream.publish({**values, **autopilot_values(self)}, time.time())
 
     def _open_log(self):
@@ -792,7 +864,7 @@ class Autopilot:
 
                 self.signalk_stream = await SignalKStreamServer(
                     *self.signalk_ws, on_put=lambda path, v: autopilot_put(self, path, v, self.clock()),
-                    allow_origins=self.allow_origins).start()
+                    allow_origins=self.allow_origins, operator=self.operator).start()
             # the whole controller registry loaded now, not inside the loop: the first refused
             # setting's message (the scenario schema's) reads it, which blocked the loop ~2 s
             from steerlab.control.registry import CONTROLLERS
@@ -810,7 +882,7 @@ class Autopilot:
                 t = k * cfg.sample_time
                 if duration > 0 and t > duration + 1e-9:
                     break
-                if k % hello_every == 0:
+                if k % hello_every == 0 and self.connect is not None:
                     send(self.transport, self.sender.pack(P.Hello(), time.time()), self.connect)
                 row = self.sample(t, self.clock())
                 self._send_order(t)

@@ -59,6 +59,7 @@ class ControllerRuntime:
         self.x = np.zeros(self.nx)
         self.z = np.asarray(s.z0, dtype=float).copy()
         self.delta_max = gear.delta_max
+        self.design_speed = float(s.x0[IU])   #: the design speed [m/s] (used when nothing measures one)
         self.kernel(self.z.copy(), self.p, 0.0, s.x0.copy(), np.zeros(2), self.h)   # load or compile now
         self.settings = self.scenario.model_dump()["controller"]   #: the ``[controller]`` settings in effect
 

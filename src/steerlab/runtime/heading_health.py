@@ -22,13 +22,12 @@ watchdog's (alarm ``link``); its integrity is the link filter's.
 
 from __future__ import annotations
 
-import math
-from collections import Counter
-
 from steerlab.angles import wrap_to_pi
+from steerlab.runtime.source_health import FRESH, IMPLAUSIBLE, STALE, UNSEEN, SourceHealth
 from steerlab.units import deg, rad
 
-UNSEEN, FRESH, STALE, IMPLAUSIBLE = "unseen", "fresh", "stale", "implausible"
+__all__ = ["FRESH", "HEADING_PRIORITY", "IMPLAUSIBLE", "JUMP_TOLERANCE", "MAX_TURN_RATE", "STALE", "UNSEEN",
+           "HeadingHealth", "heading_alarm", "select_heading"]
 HEADING_PRIORITY = ("nmea", "signalk", "state")
 """Heading sources, first fresh one wins: ``nmea`` (HDT/THS/HDG/HDM from any NMEA input: UDP,
 serial, TCP), ``signalk`` (a Signal K server's ``navigation.headingTrue`` or
@@ -45,8 +44,13 @@ def heading_alarm(name: str) -> str:
     return f"heading_{name}"
 
 
-class HeadingHealth:
-    """One heading source's health; clock [s] and angles [rad] supplied by the caller.
+def _wrapped(a, b) -> float:
+    return abs(wrap_to_pi(float(a) - float(b)))
+
+
+class HeadingHealth(SourceHealth):
+    """One heading source's health (:class:`~steerlab.runtime.source_health.SourceHealth` with
+    the angle difference wrapped); clock [s] and angles [rad] supplied by the caller.
 
     Parameters
     ----------
@@ -63,65 +67,17 @@ class HeadingHealth:
 
     def __init__(self, name: str, timeout: float, max_rate: float = MAX_TURN_RATE,
                  tolerance: float = JUMP_TOLERANCE, recover: int = 3):
-        self.name = name
-        self.timeout = float(timeout)
-        self.max_rate = float(max_rate)
-        self.tolerance = float(tolerance)
-        self.recover = int(recover)
-        self.last = None          # (psi, t) of the newest reading, plausible or not
-        self.good = None          # (psi, t) of the newest usable reading
-        self.implausible = False
-        self.agreeing = 0         # consecutive plausible readings since the last jump
-        self.counts: Counter = Counter()
-
-    def observe(self, psi: float, t: float) -> bool:
-        """Take a reading; True when it is usable (plausible and not in an implausible spell)."""
-        psi = float(psi)
-        if not math.isfinite(psi):
-            self.counts["implausible"] += 1
-            return False
-        jump = False
-        if self.last is not None:
-            dt = max(0.0, t - self.last[1])
-            jump = abs(wrap_to_pi(psi - self.last[0])) > self.max_rate * dt + self.tolerance
-        self.last = (psi, t)
-        if jump:
-            self.implausible = True
-            self.agreeing = 0
-            self.counts["implausible"] += 1
-            return False
-        if self.implausible:
-            self.agreeing += 1
-            if self.agreeing < self.recover:
-                self.counts["implausible"] += 1
-                return False
-            self.implausible = False
-        self.good = (psi, t)
-        self.counts["accepted"] += 1
-        return True
-
-    def status(self, t: float) -> str:
-        """:data:`UNSEEN`, :data:`FRESH`, :data:`STALE` or :data:`IMPLAUSIBLE` at time ``t``."""
-        if self.last is None:
-            return UNSEEN
-        if self.implausible and t - self.last[1] <= self.timeout:
-            return IMPLAUSIBLE
-        if self.good is not None and t - self.good[1] <= self.timeout:
-            return FRESH
-        return STALE
+        super().__init__(name, timeout, max_rate, tolerance, recover, distance=_wrapped, quantity="heading")
 
     def heading(self, t: float):
         """The usable heading [rad] if the source is fresh at ``t``, else None."""
-        return self.good[0] if self.status(t) == FRESH else None
+        return self.value(t)
 
     def describe(self, t: float) -> str:
         """One line for the alarm: what is wrong with the source."""
-        st = self.status(t)
-        if st == STALE:
-            return f"{self.name} heading stale (nothing plausible for more than {self.timeout:g} s)"
-        if st == IMPLAUSIBLE:
+        if self.status(t) == IMPLAUSIBLE:
             return f"{self.name} heading implausible (jumped faster than {deg(self.max_rate):g} deg/s)"
-        return f"{self.name} heading {st}"
+        return super().describe(t)
 
 
 def select_heading(t: float, order, sources: dict, fallback: float, alarms=None):

@@ -50,6 +50,7 @@ from pynmea2 import TalkerSentence
 from steerlab.units import KNOT, deg, rad
 from steerlab.guidance.los import los_heading
 from steerlab.runtime.nmea_magnetic import MagneticRejected, compass_heading, rmc_variation, true_from_magnetic
+from steerlab.runtime.nmea_nav import NAV_SENTENCES, NavRejected, nav_from_sentence
 
 EARTH_RADIUS = 6_371_000.0
 MAX_LINE = 96
@@ -373,7 +374,8 @@ def _rudder_from(s):
     return v
 
 
-USED = ("HDT", "THS", "HDG", "HDM", "APB", "RMB", "HTC", "XTE", "RSA")   #: the sentences the autopilot reads
+USED = ("HDT", "THS", "HDG", "HDM", "APB", "RMB", "HTC", "XTE", "RSA") + NAV_SENTENCES
+"""The sentences the autopilot reads (RMC, GGA, VTG, ROT: :mod:`steerlab.runtime.nmea_nav`)."""
 
 
 def steering_inputs(data: bytes, lookahead: float = 500.0, variation: float | None = None) -> dict:
@@ -383,7 +385,7 @@ def steering_inputs(data: bytes, lookahead: float = 500.0, variation: float | No
     ``courses`` has the last course of each source: ``{"APB": {"course", "dest", "arrived"}, ...}``;
     ``course_source`` names the source of ``course``. Every non-empty line is counted once:
     ``accepted`` (a sentence the autopilot reads, :data:`USED`, that passed the checks),
-    ``ignored`` (a valid sentence of another type, e.g. RMC) or rejected: ``reasons`` counts the
+    ``ignored`` (a valid sentence of another type, e.g. GSV) or rejected: ``reasons`` counts the
     rejections by reason (:data:`REJECT_REASONS`: range, status, magnetic-only...), ``rejected``
     is their total. Lines past :data:`MAX_LINES` are counted (``too_many_lines``), not parsed.
     Never raises.
@@ -392,9 +394,12 @@ def steering_inputs(data: bytes, lookahead: float = 500.0, variation: float | No
     configured one; None: unknown) for HDG/HDM and magnetic APB/HTC; an RMC line that carries
     one (counted ``accepted``) applies to the lines after it and is returned as ``variation``
     [rad]. ``rudder`` [rad] is the last RSA rudder angle (> 0 to starboard), or None.
+    ``position`` ((lat, lon) [deg], RMC/GGA), ``sog`` (speed over ground [m/s], RMC/VTG) and
+    ``rot`` (rate of turn [rad/s], ROT) are the last ones given
+    (:func:`steerlab.runtime.nmea_nav.nav_from_sentence`), or None.
     """
     out = {"heading": None, "course": None, "course_source": None, "courses": {}, "xte_m": None,
-           "rudder": None, "variation": None,
+           "rudder": None, "variation": None, "position": None, "sog": None, "rot": None,
            "accepted": 0, "ignored": 0, "rejected": 0, "reasons": Counter()}
     var_deg = None if variation is None else deg(variation)
     reasons = out["reasons"]
@@ -413,21 +418,21 @@ def steering_inputs(data: bytes, lookahead: float = 500.0, variation: float | No
             reasons["malformed"] += 1
             continue
         kind = type(s).__name__
-        if kind == "RMC":
+        if kind in NAV_SENTENCES:
             try:
-                v = rmc_variation(s)
-            except MagneticRejected as why:
+                v = rmc_variation(s) if kind == "RMC" else None
+                nav = nav_from_sentence(s)
+            except (MagneticRejected, NavRejected) as why:
                 reasons[why.reason] += 1
                 continue
             except Exception:
                 reasons["bad_field"] += 1
                 continue
-            if v is None:
-                out["ignored"] += 1
-            else:
+            if v is not None:
                 var_deg = v
                 out["variation"] = rad(v)
-                out["accepted"] += 1
+            out.update(nav)
+            out["accepted"] += 1
             continue
         if kind not in USED:
             out["ignored"] += 1

@@ -4,8 +4,8 @@
 ``ws://HOST:PORT/signalk/v1/stream?subscribe=none``, reconnecting every second) and subscribes,
 for ``vessels.self`` with policy ``instant`` (every update as it comes), to :data:`INPUT_PATHS`: ``navigation.headingTrue`` and
 ``navigation.headingMagnetic`` (+ ``navigation.magneticVariation`` to turn it true),
-``navigation.position``, ``navigation.rateOfTurn`` and ``steering.rudderAngle`` (SI: radians,
-rad/s, degrees of latitude/longitude). Every delta is checked (:func:`input_values`: finite,
+``navigation.position``, ``navigation.rateOfTurn``, ``navigation.speedOverGround`` and
+``steering.rudderAngle`` (SI: radians, rad/s, m/s, degrees of latitude/longitude). Every delta is checked (:func:`input_values`: finite,
 headings in [0, 2 pi], variation within +-30 deg, rudder within +-90 deg) and handed to
 ``on_values({path: value})`` (:meth:`steerlab.runtime.autopilot.Autopilot.on_signalk_values`);
 what fails is counted by reason, never raises. A signalk-server, or ``serve-ship
@@ -23,7 +23,8 @@ from collections import Counter
 from steerlab.runtime.nmea_magnetic import MAX_VARIATION_DEG
 
 INPUT_PATHS = ("navigation.headingTrue", "navigation.headingMagnetic", "navigation.magneticVariation",
-               "navigation.position", "navigation.rateOfTurn", "steering.rudderAngle")
+               "navigation.position", "navigation.rateOfTurn", "navigation.speedOverGround",
+               "steering.rudderAngle")
 
 
 def _stderr(line: str) -> None:
@@ -40,7 +41,8 @@ def input_values(values: dict, counts: Counter) -> dict:
     out = {}
     limits = {"navigation.headingTrue": (0.0, 2 * math.pi), "navigation.headingMagnetic": (0.0, 2 * math.pi),
               "navigation.magneticVariation": (-math.radians(MAX_VARIATION_DEG), math.radians(MAX_VARIATION_DEG)),
-              "navigation.rateOfTurn": (-math.pi, math.pi), "steering.rudderAngle": (-math.pi / 2, math.pi / 2)}
+              "navigation.rateOfTurn": (-math.pi, math.pi), "navigation.speedOverGround": (0.0, 50.0),
+              "steering.rudderAngle": (-math.pi / 2, math.pi / 2)}
     for path, v in values.items():
         if path not in INPUT_PATHS or v is None:
             continue
@@ -75,7 +77,12 @@ class SignalKInput:
         self.log = log
         self.counts: Counter = Counter()
         self.connected = False
+        self.ever_connected = False
         self._task = None
+
+    def lost(self) -> bool:
+        """True when the subscription was up once and is down now (the ``signalk_input`` alarm)."""
+        return self.ever_connected and not self.connected
 
     async def start(self) -> "SignalKInput":
         self._task = asyncio.get_running_loop().create_task(self._run())
@@ -95,7 +102,7 @@ class SignalKInput:
         while True:
             try:
                 async with connect(url, open_timeout=10, max_size=1 << 20) as ws:
-                    self.connected, said = True, False
+                    self.connected, said, self.ever_connected = True, False, True
                     self.counts["connected"] += 1
                     await ws.send(sub)
                     async for msg in ws:

@@ -145,7 +145,7 @@ class SignalKStreamServer:
 
     def __init__(self, host: str = "127.0.0.1", port: int = 0, on_put=None, field: str = "--signalk-ws",
                  name: str = "steerlab", max_clients: int = 8, max_buffer: int = 256 * 1024,
-                 msg_rate: float = 20.0, put_rate: float = 5.0, allow_origins=()):
+                 msg_rate: float = 20.0, put_rate: float = 5.0, allow_origins=(), operator=None):
         self.host, self.port = host, port
         self.on_put = on_put
         self.field = field
@@ -162,7 +162,12 @@ class SignalKStreamServer:
         self.slots = ClientSlots(max_clients)
         self.counts = {"clients": 0, "sent": 0, "skipped_slow": 0, "subscriptions": 0, "put_ok": 0,
                        "put_refused": 0, "rejected": 0, "rate_limited": 0, "put_rate_limited": 0, "refused_http": 0,
-                       "refused_full": 0}
+                       "refused_full": 0, "operator": 0, "operator_refused": 0}
+        if operator is None:
+            from steerlab.runtime.operator_session import OperatorSession
+
+            operator = OperatorSession()
+        self.operator = operator
         self.server = None
 
     # ------------------------------------------------------------ HTTP side
@@ -192,10 +197,17 @@ class SignalKStreamServer:
         if not is_upgrade(request):
             return _response(HTTPStatus.UPGRADE_REQUIRED, b"the Signal K stream is a WebSocket: send Upgrade: websocket\n",
                              "text/plain")
-        if not self.slots.make_room():          # full, and every client spoke within the last second
+        op = self.operator.check(request)
+        if op is None:
+            self.counts["operator_refused"] += 1
+            return _response(HTTPStatus.FORBIDDEN, b"wrong operator token\n", "text/plain")
+        if not self.slots.make_room(op):        # full, and every client spoke within the last second
             self.counts["refused_full"] += 1
-            return _response(HTTPStatus.SERVICE_UNAVAILABLE, b"too many Signal K clients\n", "text/plain")
-        self.slots.add(connection)
+            return _response(HTTPStatus.SERVICE_UNAVAILABLE,
+                             b"too many Signal K clients; the operator's token (?op= or Bearer) has a reserved slot\n",
+                             "text/plain")
+        self.counts["operator"] += int(op)
+        self.slots.add(connection, op)
         return None
 
     # ------------------------------------------------------------ a connection

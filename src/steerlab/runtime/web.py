@@ -132,11 +132,13 @@ class BridgeServer:
     ``allow_origins``: browser origins allowed besides loopback pages; ``action_rate``: actions
     applied per second per connection (bursts of twice that; no shared limit, so a flooding page
     cannot lock the operator out); ``max_clients`` pages at most, a new page taking the slot of
-    the one quiet longest when full (:class:`~steerlab.runtime.client_slots.ClientSlots`).
+    the one quiet longest when full (:class:`~steerlab.runtime.client_slots.ClientSlots`);
+    ``operator``: the run's :class:`~steerlab.runtime.operator_session.OperatorSession` (default:
+    the autopilot's ``operator``, else a new one) whose token gives a page a reserved slot.
     """
 
     def __init__(self, autopilot, host: str = "127.0.0.1", port: int = 8080, period: float = 0.2,
-                 allow_origins=(), action_rate: float = 5.0, max_clients: int = 8):
+                 allow_origins=(), action_rate: float = 5.0, max_clients: int = 8, operator=None):
         self.ap = autopilot
         self.host, self.port = host, port
         self.period = period
@@ -146,7 +148,13 @@ class BridgeServer:
         self.access = AccessPolicy(host, allow_origins)
         self.action_rate = action_rate
         self.limiter = RateLimiter(action_rate, 2 * action_rate, max_sources=4 * max_clients)
-        self.counts = {"refused_http": 0, "rate_limited": 0, "refused_full": 0}
+        if operator is None:
+            from steerlab.runtime.operator_session import OperatorSession
+
+            operator = getattr(autopilot, "operator", None) or OperatorSession()
+        self.operator = operator
+        self.counts = {"refused_http": 0, "rate_limited": 0, "refused_full": 0, "operator": 0,
+                       "operator_refused": 0}
 
     @property
     def clients(self) -> int:
@@ -167,10 +175,17 @@ class BridgeServer:
         if path == "/ws":
             if not is_upgrade(request):
                 return _response(HTTPStatus.UPGRADE_REQUIRED, b"a WebSocket: send Upgrade: websocket\n", "text/plain")
-            if not self.slots.make_room():      # full and every page spoke within the last second
+            op = self.operator.check(request)
+            if op is None:
+                self.counts["operator_refused"] += 1
+                return _response(HTTPStatus.FORBIDDEN, b"wrong operator token\n", "text/plain")
+            if not self.slots.make_room(op):    # full and every page spoke within the last second
                 self.counts["refused_full"] += 1
-                return _response(HTTPStatus.SERVICE_UNAVAILABLE, b"too many bridge pages\n", "text/plain")
-            self.slots.add(connection)
+                return _response(HTTPStatus.SERVICE_UNAVAILABLE,
+                                 b"too many bridge pages; the operator's address (with #op=) has a reserved slot\n",
+                                 "text/plain")
+            self.counts["operator"] += int(op)
+            self.slots.add(connection, op)
             return None
         if path == "/status.json":
             body = json.dumps(_json_safe(self.ap.status())).encode()

@@ -143,7 +143,10 @@
   function send(obj) { if (ws && ws.readyState === 1) ws.send(JSON.stringify(obj)); }
 
   function connect() {
-    ws = new WebSocket((location.protocol === "https:" ? "wss://" : "ws://") + location.host + "/ws");
+    // the operator's token, from the address's fragment (#op=...): a reserved slot (issue 35)
+    const op = new URLSearchParams((location.hash || "").slice(1)).get("op");
+    ws = new WebSocket((location.protocol === "https:" ? "wss://" : "ws://") + location.host + "/ws"
+                       + (op ? "?op=" + encodeURIComponent(op) : ""));
     ws.onmessage = (ev) => {
       const m = JSON.parse(ev.data);
       if (m.type === "status") show(m);
