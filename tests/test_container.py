@@ -5,8 +5,8 @@
 * Linearisation against Son & Nomoto's PUBLISHED linear model (MSS Lcontainer.m, Fossen 2021
   App. D) at its U0 = 7 m/s: the system matrix on [v, r, p, phi] within 3 % of each row's
   largest entry; the rudder column 14-17 % above the published b' (stated, not tuned: the
-  published b' corresponds to a slower rudder inflow, u'_R^2 = 0.704, than container.m's
-  propeller-rudder model gives at self-propulsion, 0.82); every eigenvalue within 10 %.
+  published b' corresponds to a slower rudder inflow, u'_R^2 = 0.69-0.71, than container.m's
+  propeller-rudder model gives at self-propulsion, 0.815); every eigenvalue within 10 %.
 * Course stability: all four eigenvalues (sway-yaw and roll) in the left half-plane, in the
   published model and in steerlab's; roll natural frequency 0.217 rad/s in both. The sway-yaw
   model steerlab's designs use residualises the roll (stable, same steady gain); deleting the
