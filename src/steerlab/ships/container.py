@@ -42,16 +42,20 @@ cos phi sin psi``, ``y_e' = u sin psi + v cos phi cos psi``, ``psi' = r cos phi`
 **What is carried over, what is not.** Every force term above is container.m's. The shaft rate
 is held at the rate :func:`pack` is given (container.m's shaft follows its command through a
 first-order lag; with a constant command and the shaft starting at it, that is the same
-thing), so the eighth and ninth states are ``p`` and ``phi`` only. container.m's own steering
+thing), so the states after the planar six are ``p`` and ``phi`` only. container.m's own steering
 gear (10 deg, 5 deg/s) and shaft limit (160 rpm) are not in the kernel: the gear is steerlab's
-(``[gear]``), the shaft limit is the range :func:`pack` accepts. Also read: ``W_RUDDER``
-(added to delta), ``W_YAW_MOMENT`` (added to ``r'``), the current (track only).
+(``[gear]``), the shaft limit is the range :func:`pack` accepts (and the speed range
+the self-propulsion rates up to it give, 2-16.75 m/s: not a range the source tested).
+
+The sway-yaw model the designs use (:func:`linearise`) residualises the roll
+(:func:`residualise_roll`): the truncated ``[v, r]`` block is course-unstable although the
+coupled ship is stable. Also read: ``W_RUDDER`` (added to delta), ``W_YAW_MOMENT`` (added
+to the yaw acceleration), the current (track only).
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 from functools import lru_cache
 
 import numba
