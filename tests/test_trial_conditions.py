@@ -70,6 +70,21 @@ def test_bad_trial_conditions_one_line_exit_2(extra, field, capsys):
     assert len(err) == 1 and field in err[0]
 
 
+@pytest.mark.parametrize("extra,field,given", [
+    (["--ship", "kvlcc2-l7", "--propeller-rpm", "990"], "--propeller-rpm", "990 rpm"),   # model: 180.9-965 rpm
+    (["--ship", "kvlcc2-l7", "--propeller-rps", "16.5"], "--propeller-rps", "16.5 rev/s"),
+    (["--ship", "mss-tanker", "--propeller-rpm", "90"], "--propeller-rpm", "90 rpm"),    # tanker.m: <= 80 rpm
+    (["--ship", "mss-tanker", "--propeller-rps", "2"], "--propeller-rps", "2 rev/s"),
+])
+def test_model_range_refusal_names_the_propeller_flag_the_user_gave(extra, field, given, capsys):
+    """The ship's own range check (field ``ship.rpm``) is reported under the flag given, with the
+    value in the user's unit; never the other flag."""
+    assert main(["trial", "turning", *extra, "--quiet"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    other = "--propeller-rps" if field == "--propeller-rpm" else "--propeller-rpm"
+    assert len(err) == 1 and field in err[0] and other not in err[0] and f"you gave {given}" in err[0]
+
+
 def test_model_scale_turning_defaults_and_the_propeller_rate(capsys):
     """Defaults: service speed 1.179 m/s, Froude-scaled gear, IMO verdict marked as model scale;
     at the test conditions with 11 rev/s the advance is the sensitivity table's 3.159 L."""

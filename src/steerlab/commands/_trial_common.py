@@ -97,7 +97,7 @@ def conditions_from_args(args):
     cond = TrialConditions(ship=args.ship, speed_kn=speed_kn, options=options,
                            gear=not args.no_gear, gear_config=gear, dt=args.dt, rpm=rpm)
     try:
-        return with_flag_names(cond.resolved)
+        return with_flag_names(cond.resolved, flags=flag_names(args))
     except InputError as err:
         if speed_m_s is not None and err.field == "--speed-kn":
             raise InputError("--speed-m-s", f"{speed_m_s:g} m/s = {err.message}") from None
@@ -130,14 +130,36 @@ def _checked_depth(ship_name: str, depth: float) -> float:
     return float(depth)
 
 
-def with_flag_names(fn, *a, **kw):
-    """Call ``fn``; re-raise an :class:`InputError` with the CLI flag name of its field."""
+def flag_names(args) -> dict:
+    """:data:`FLAG_NAMES` with the propeller rate (``ship.rpm``) named by the flag the user gave
+    (``--propeller-rpm`` or ``--propeller-rps``), and the rate they gave in their own unit."""
+    names = dict(FLAG_NAMES)
+    rpm = getattr(args, "propeller_rpm", None)
+    if rpm is not None:
+        names["ship.rpm"] = ("--propeller-rpm", f"{rpm:g} rpm = {rpm / 60.0:.4g} rev/s")
+    rps = getattr(args, "propeller_rps", None)
+    if rps is not None:
+        names["ship.rpm"] = ("--propeller-rps", f"{rps:g} rev/s = {60.0 * rps:.4g} rpm")
+    return names
+
+
+def with_flag_names(fn, *a, flags: dict | None = None, **kw):
+    """Call ``fn``; re-raise an :class:`InputError` with the CLI flag name of its field.
+
+    ``flags``: field -> flag name, or ``(flag name, what the user gave)`` (:func:`flag_names`;
+    default :data:`FLAG_NAMES`).
+    """
+    flags = FLAG_NAMES if flags is None else flags
     try:
         return fn(*a, **kw)
     except InputError as err:
-        if err.field in FLAG_NAMES:
+        if err.field in flags:
             msg = err.message
             if err.field == "ship.options.depth_m":
                 msg = f"water depth [m] {msg} (the model refuses depths at or below the draught)"
-            raise InputError(FLAG_NAMES[err.field], msg) from None
+            flag = flags[err.field]
+            if isinstance(flag, tuple):
+                flag, given = flag
+                msg = f"{msg} (you gave {given})"
+            raise InputError(flag, msg) from None
         raise

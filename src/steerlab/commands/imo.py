@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from steerlab.commands._trial_common import add_ship_arguments, conditions_from_args, with_flag_names
+from steerlab.commands._trial_common import add_ship_arguments, conditions_from_args, flag_names, with_flag_names
 
 EXAMPLES = """examples:
   steerlab imo --ship esso --out out/imo-esso
@@ -34,7 +34,7 @@ def cmd_imo(args) -> int:
 
     say = _progress(args.quiet)
     cond = conditions_from_args(args)
-    report, trials = with_flag_names(run_imo, cond, progress=say)
+    report, trials = with_flag_names(run_imo, cond, flags=flag_names(args), progress=say)
     with staged_output(Path(args.out)) as stage:
         figs = {}
         for i, (label, kind, trial) in enumerate(trials):

@@ -9,7 +9,7 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-from steerlab.commands._trial_common import add_ship_arguments, conditions_from_args, with_flag_names
+from steerlab.commands._trial_common import add_ship_arguments, conditions_from_args, flag_names, with_flag_names
 
 EXAMPLES = """examples:
   steerlab trial zigzag --ship esso --rudder 20 --heading 20 --json
@@ -94,10 +94,10 @@ def cmd_trial(args) -> int:
 
     say = _progress(args.quiet)
     cond = conditions_from_args(args)
-    with_flag_names(check_trial_options, args.trial_kind, cond, **_options(args))
+    with_flag_names(check_trial_options, args.trial_kind, cond, flags=flag_names(args), **_options(args))
     say(f"{args.trial_kind} trial on {cond.ship} at {cond.speed_kn:g} kn "
         f"(first run compiles the ship's trial loop, a few seconds)")
-    trial, metrics = with_flag_names(run_trial, args.trial_kind, cond, **_options(args))
+    trial, metrics = with_flag_names(run_trial, args.trial_kind, cond, flags=flag_names(args), **_options(args))
     if args.out:
         with staged_output(Path(args.out)) as stage:
             dump_json(metrics, stage / f"{args.trial_kind}.json")
