@@ -6,6 +6,7 @@ Usage::
     git worktree add --detach /tmp/old COMMIT
     python benchmarks/bench_startup_ab.py --old /tmp/old --new . --repeats 9
     python benchmarks/bench_startup_ab.py --old /tmp/old --new . --json > ab.json
+    python benchmarks/bench_startup_ab.py --old /tmp/old --new . --main /tmp/main   # three sides
 
 Each round runs, in an order shuffled per round (seeded), for both checkouts (``PYTHONPATH`` at
 the checkout's ``src``, a driver cache of its own, warmed first; bytecode compiled first):
@@ -110,12 +111,15 @@ def measure(sides: dict[str, Path], repeats: int, seed: int = 0, progress=print)
                                            "wall_s": round(statistics.median(wall[(side, case)]), 3),
                                            "cpu_min_s": round(min(c), 3), "cpu_max_s": round(max(c), 3)}
     names = list(sides)
-    if len(names) == 2:
-        a, b = names
-        res["ratios_cpu"] = {case: round(res["cases"][f"{b}: {case}"]["cpu_s"] / res["cases"][f"{a}: {case}"]["cpu_s"], 3)
-                             for case in CASES}
-        res["ratios_wall"] = {case: round(res["cases"][f"{b}: {case}"]["wall_s"] / res["cases"][f"{a}: {case}"]["wall_s"], 3)
-                              for case in CASES}
+    if "new" in sides:
+        for a in names:
+            if a == "new":
+                continue
+            suffix = "" if a == "old" else f"_vs_{a}"     # new / old; new / each further side
+            for what, key in (("cpu", "cpu_s"), ("wall", "wall_s")):
+                res[f"ratios_{what}{suffix}"] = {
+                    case: round(res["cases"][f"new: {case}"][key] / res["cases"][f"{a}: {case}"][key], 3)
+                    for case in CASES}
     load = os.getloadavg() if hasattr(os, "getloadavg") else None
     res["load_average_1min_at_end"] = load[0] if load else None
     return res
@@ -125,6 +129,8 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--old", type=Path, required=True, help="the checkout to compare against")
     ap.add_argument("--new", type=Path, default=Path(__file__).resolve().parent.parent)
+    ap.add_argument("--main", type=Path, default=None,
+                    help="a third checkout measured in the same rounds (ratios new / main as well)")
     ap.add_argument("--repeats", type=int, default=7)
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--json", action="store_true")
@@ -132,19 +138,23 @@ def main(argv=None) -> int:
     if args.repeats < 1:
         print("bench_startup_ab: error: --repeats: must be >= 1", file=sys.stderr)
         return 2
-    for name in ("old", "new"):
+    for name in ("old", "new", "main"):
+        if name == "main" and args.main is None:
+            continue
         if not (getattr(args, name) / "src" / "steerlab" / "__init__.py").is_file():
             print(f"bench_startup_ab: error: --{name}: {getattr(args, name)} is not a steerlab checkout", file=sys.stderr)
             return 2
-    res = measure({"old": args.old.resolve(), "new": args.new.resolve()}, args.repeats, args.seed,
-                  progress=lambda m: print(m, file=sys.stderr, flush=True))
+    sides = {"old": args.old.resolve(), "new": args.new.resolve()}
+    if args.main is not None:
+        sides["main"] = args.main.resolve()
+    res = measure(sides, args.repeats, args.seed, progress=lambda m: print(m, file=sys.stderr, flush=True))
     if args.json:
         print(json.dumps(res, indent=2))
     else:
         for k, v in res["cases"].items():
             print(f"{k:45s} CPU {v['cpu_s']:.3f} s  wall {v['wall_s']:.3f} s")
-        for k in ("ratios_cpu", "ratios_wall"):
-            print(k, res.get(k))
+        for k in sorted(k for k in res if k.startswith("ratios_")):
+            print(k, res[k])
         print("load", res["load_average_1min_at_end"])
     return 0
 

@@ -89,7 +89,9 @@ LAYER = textwrap.dedent("""
 """)
 
 
-def _run(script, *args, env_extra=None, timeout=600):
+# a hang guard only: on a cold cache each script compiles the vector env's parallel drivers,
+# which took more than 600 s on the loaded 2-core machine (numba 0.67, .ci/run-pins oldest)
+def _run(script, *args, env_extra=None, timeout=1800):
     env = {k: v for k, v in os.environ.items() if k != "NUMBA_THREADING_LAYER"}
     env.update(env_extra or {})
     p = subprocess.run([sys.executable, "-c", script, *args], env=env, capture_output=True, text=True,

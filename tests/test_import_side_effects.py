@@ -3,7 +3,9 @@
 function is cached and loaded exactly as without steerlab (same files, same index), and
 ``scipy.linalg``, ``atexit``, ``os.environ``, the import system and numba's settings are as
 numba and Python left them; steerlab's own kernels still carry the package stamp, also under
-numba's ``NUMBA_CACHE_LOCATOR_CLASSES``."""
+numba's ``NUMBA_CACHE_LOCATOR_CLASSES``. steerlab's own kernels load light
+(``steerlab.jit.numba_cache_load``, on their own cache instances): after those loads the user's
+function is compiled, saved and loaded again exactly as numba alone does it."""
 
 from __future__ import annotations
 
@@ -38,6 +40,7 @@ from numba.core import caching, config
 before = {"layer": numba.config.THREADING_LAYER, "locators": os.environ.get("NUMBA_CACHE_LOCATOR_CLASSES", ""),
           "load": caching.Cache.load_overload, "meta_path": list(sys.meta_path), "hooks": list(sys.path_hooks)}
 stamp = None
+light = {}
 if mode != "plain":
     import steerlab
     from steerlab.angles import wrap_to_pi
@@ -47,6 +50,8 @@ if mode != "plain":
         import steerlab as sl
         sc = sl.default_scenario()
         sl.simulate(sc)
+    from steerlab.jit import numba_cache_load
+    light = dict(numba_cache_load.STATS)     # steerlab's own kernels, loaded light before the user's
 import usermod
 value = usermod.user_kernel(2.0)
 stats = usermod.user_kernel.stats
@@ -66,6 +71,7 @@ print(json.dumps({
     "load_same": caching.Cache.load_overload is before["load"],
     "meta_path_same": [type(f) for f in sys.meta_path] == [type(f) for f in before["meta_path"]],
     "hooks_same": sys.path_hooks == before["hooks"],
+    "light": light, "user_cache_plain": "load_overload" not in vars(usermod.user_kernel._cache),
     "steerlab_modules_outside": sorted(n for n, m in sys.modules.items()
                                        if type(m).__module__.startswith("steerlab") and not n.startswith("steerlab")),
 }))
@@ -109,6 +115,7 @@ def _check_untouched(r: dict) -> None:
     assert r["atexit_same"] and r["environ_same"] and r["layer_same"] and r["load_same"]
     assert r["meta_path_same"] and r["hooks_same"]
     assert r["steerlab_modules_outside"] == []
+    assert r["user_cache_plain"]                # the user's cache loads the numba way
 
 
 @pytest.mark.parametrize("mode", ["import", "simulate"])
@@ -126,12 +133,19 @@ def test_a_users_cached_function_and_the_process_are_as_without_steerlab(tmp_pat
     for key in ("value", "locator", "cache_path", "linalg_file", "blas_file"):
         assert with_steerlab[key] == plain[key], key
     assert "steerlab" in with_steerlab["steerlab_stamp"]  # steerlab's own kernels: the package stamp
+    if mode == "simulate":      # the user's function compiled (and below loads) after steerlab's light loads
+        assert with_steerlab["light"]["light"] >= 1 and with_steerlab["light"]["fallback"] == 0
     _check_untouched(with_steerlab)
     _check_untouched(plain)
 
     again = _run(tmp_path, "plain")                      # numba alone loads what was written beside steerlab
     assert (again["hits"], again["misses"]) == (1, 0)
-    assert _run(tmp_path, mode)["hits"] == 1 and _cache_files(user) == files
+    loaded = _run(tmp_path, mode)                        # loaded by numba beside steerlab's light loads
+    assert (loaded["hits"], loaded["misses"]) == (1, 0) and loaded["value"] == plain["value"]
+    assert _cache_files(user) == files
+    if mode == "simulate":
+        assert loaded["light"]["light"] >= 1
+    _check_untouched(loaded)
 
 
 def test_numbas_locator_list_from_the_environment_keeps_the_package_stamp(tmp_path):

@@ -1,5 +1,7 @@
-"""Cached kernels load without numba's compile-time registries (steerlab.jit.numba_cache_load), give
-the same numbers, and a later compilation in the same process still gets the registries."""
+"""steerlab's own cached kernels load without numba's compile-time registries
+(steerlab.jit.numba_cache_load), in any process that imports steerlab, and give the same numbers;
+a user's own cached kernel loads the numba way beside them, and a later compilation in the same
+process still gets the registries. numba's ``Cache`` class is not touched."""
 
 from __future__ import annotations
 
@@ -33,14 +35,16 @@ def everything(n):
 SCRIPT = '''
 import json, sys
 import numpy as np
-import steerlab
-from steerlab.jit import command, numba_cache_load
-command.settings()                    # the steerlab command's settings (not import steerlab's)
+from numba.core import caching
+numba_load = caching.Cache.load_overload
+import steerlab                       # a library user's process: no command settings
+from steerlab.jit import numba_cache_load
+from steerlab.environment.iir_filter import _transposed_df2, lfilter
+y = lfilter(np.array([1.0]), np.array([1.0, -0.5]), np.ones(4))      # a steerlab kernel, cached
+registries_after_steerlab = "numba.np.arraymath" in sys.modules
+light = dict(numba_cache_load.STATS)
 import kmod
-value = kmod.everything(6)
-from steerlab.environment.iir_filter import lfilter
-y = lfilter(np.array([1.0]), np.array([1.0, -0.5]), np.ones(4))
-registries = "numba.misc.cffiimpl" in sys.modules
+value = kmod.everything(6)                                         # the user's, cached: numba's load
 compiled = None
 if "--compile" in sys.argv:           # a compile after the light load (the other runs need none)
     from numba import njit
@@ -49,8 +53,12 @@ if "--compile" in sys.argv:           # a compile after the light load (the othe
         return np.linalg.norm(a) + len({"x": b})
     compiled = fresh(np.ones(4), 1.0)
 print(json.dumps({"value": value, "y": y.tolist(), "hits": sum(kmod.everything.stats.cache_hits.values()),
-                  "stats": numba_cache_load.STATS, "registries_before_compiling": registries,
-                  "compiled": compiled, "installed": numba_cache_load.INSTALLED}))
+                  "steerlab_hits": sum(_transposed_df2.stats.cache_hits.values()),
+                  "stats": light, "registries_after_steerlab": registries_after_steerlab,
+                  "registries_after_user": "numba.np.arraymath" in sys.modules,
+                  "user_cache_plain": "load_overload" not in vars(kmod.everything._cache),
+                  "class_same": caching.Cache.load_overload is numba_load,
+                  "compiled": compiled, "enabled": numba_cache_load.enabled()}))
 '''
 
 
@@ -62,16 +70,19 @@ def _run(tmp_path: Path, *args: str, **env) -> dict:
     return json.loads(r.stdout.strip().splitlines()[-1])
 
 
-def test_a_cached_kernel_loads_light_with_the_same_numbers_and_compiling_still_works(tmp_path):
+def test_steerlabs_kernels_load_light_a_users_the_numba_way_and_compiling_still_works(tmp_path):
     (tmp_path / "kmod.py").write_text(KERNELS)
     compiled = _run(tmp_path)                                      # compiles kmod, caches it
-    light = _run(tmp_path, "--compile")                            # loads it light, then compiles
+    light = _run(tmp_path, "--compile")                            # steerlab's light, kmod numba's, then a compile
     numba_way = _run(tmp_path, STEERLAB_LIGHT_CACHE_LOAD="0")
-    assert light["installed"] and not numba_way["installed"]
-    assert light["hits"] == 1 and numba_way["hits"] == 1
-    assert light["stats"]["light"] >= 2 and light["stats"]["fallback"] == 0
-    assert not light["registries_before_compiling"]               # loading needed none of them
-    assert numba_way["registries_before_compiling"]
+    assert light["enabled"] and not numba_way["enabled"]
+    assert light["hits"] == numba_way["hits"] == 1 and light["steerlab_hits"] == numba_way["steerlab_hits"] == 1
+    assert light["stats"]["light"] >= 1 and light["stats"]["fallback"] == 0 and light["stats"]["given"] >= 1
+    assert numba_way["stats"] == {"given": 0, "light": 0, "fallback": 0}
+    assert not light["registries_after_steerlab"]                  # loading steerlab's kernel needed none
+    assert numba_way["registries_after_steerlab"]
+    assert light["registries_after_user"]                          # the user's load: numba's full refresh
+    assert light["user_cache_plain"] and light["class_same"]
     for key in ("value", "y"):
         assert light[key] == numba_way[key] == compiled[key], key
     assert light["compiled"] == 2.0 + 1.0                          # norm([1, 1, 1, 1]) + len({"x": 1.0})

@@ -90,10 +90,10 @@ def package_modules(package: str, skip: Iterable[str] = (), recursive: bool = Fa
     ``recursive``), except names starting with ``_`` and the base names in ``skip``. The one
     scanner behind the registries, the experiments and the CLI commands."""
     pkg = importlib.import_module(package)
-    walk = pkgutil.walk_packages if recursive else pkgutil.iter_modules
-    kw = {"prefix": pkg.__name__ + "."} if recursive else {}
+    found = (pkgutil.walk_packages(pkg.__path__, prefix=pkg.__name__ + ".") if recursive
+             else pkgutil.iter_modules(pkg.__path__))
     skip = set(skip) | {"__init__"}
-    for mod in sorted(walk(pkg.__path__, **kw), key=lambda m: m.name):
+    for mod in sorted(found, key=lambda m: m.name):
         base = mod.name.rsplit(".", 1)[-1]
         if base in skip or base.startswith("_"):
             continue
@@ -233,7 +233,8 @@ class Registry(Mapping[str, S]):
             return []
         if isinstance(derive, str):
             module, _, name = derive.partition(":")
-            derive = self.derive = getattr(importlib.import_module(module), name)
+            loaded: Callable[[S], Iterable[S]] = getattr(importlib.import_module(module), name)
+            derive = self.derive = loaded
         known = self._derived.get(spec.name)
         if known is None or known[0] is not spec:
             known = self._derived[spec.name] = (spec, list(derive(spec)))

@@ -173,7 +173,8 @@ def pid_gains(ctrl: Controller) -> tuple[float, float, float]:
     """``(Kp, Ki, Kd)`` of a controller run by the PID kernel, else :class:`InputError`."""
     from steerlab.control.pid import C_KD, C_KI, C_KP, pid_update
 
-    if ctrl.spec.update is not pid_update:
+    update: object = ctrl.spec.update      # a compiled kernel either way (numba 0.67's stubs type
+    if update is not pid_update:            # njit's result as a Dispatcher, not a Callable)
         raise InputError("type", f"controller {ctrl.type!r} is not linear; python-control export is for the "
                                  "PID-family laws run by the PID kernel (pid, lq_pd, ...)")
     p = ctrl.params

@@ -9,7 +9,8 @@ compiled loops that join them. Here, and only here, live:
 * how a kernel is named across processes and which user sources key it
   (:mod:`~steerlab.jit.kernel_refs`, :mod:`~steerlab.jit.kernel_sources`);
 * the glue to numba's on-disk cache (:mod:`~steerlab.jit.numba_cache`,
-  :mod:`~steerlab.jit.numba_cache_load`, :mod:`~steerlab.jit.disk_memo`);
+  :mod:`~steerlab.jit.numba_cache_load`: steerlab's own kernels load without numba's
+  compile-time registries, :mod:`~steerlab.jit.disk_memo`);
 * calls into compiled code by address (:mod:`~steerlab.jit.numba_call_at`) and the
   counter-based random numbers built from one LLVM instruction (:mod:`~steerlab.jit.philox`);
 * what the rest of steerlab may ask about compiled functions (:mod:`~steerlab.jit.dispatch`);
@@ -17,8 +18,8 @@ compiled loops that join them. Here, and only here, live:
 * the ``steerlab`` command's process-wide settings (:mod:`~steerlab.jit.command`): numba's
   threading layer (:mod:`~steerlab.jit.threading_layer`), OpenBLAS threads
   (:mod:`~steerlab.jit.blas_threads`), numba's BLAS probe (:mod:`~steerlab.jit.numba_blas_probe`),
-  the light cache load and the command's fast exit (:mod:`~steerlab.jit.fast_exit`), made by
-  the command only: ``import steerlab`` changes nothing outside steerlab.
+  and the command's fast exit (:mod:`~steerlab.jit.fast_exit`), made by the command only:
+  ``import steerlab`` changes nothing outside steerlab.
 
 It is the only package that may use numba's or another library's internals or change another
 library's modules (``tests/test_layering.py`` enforces it).

@@ -148,7 +148,7 @@ def _make_locator(base):
             for locator_class in _INNER:
                 inner = locator_class.from_function(py_func, py_file)
                 if inner is not None:
-                    return cls(inner, name)
+                    return cls._claimed(py_func, cls(inner, name))
             if driver and p.exists():
                 # no writable folder anywhere (a read-only cache, no user cache): the driver's
                 # own folder still serves its checked machine code; a save there warns once
@@ -158,10 +158,20 @@ def _make_locator(base):
                     if "UserProvided" in locator_class.__name__ and not config.CACHE_DIR:
                         continue                       # numba's NUMBA_CACHE_DIR locator, unset
                     try:
-                        return cls(locator_class(py_func, py_file), name)
+                        locator = cls(locator_class(py_func, py_file), name)
                     except Exception:  # noqa: BLE001 - a locator of another shape: try the next
                         continue
+                    return cls._claimed(py_func, locator)
             return None
+
+        @staticmethod
+        def _claimed(py_func, locator):
+            """The locator of a steerlab function, after giving the cache numba is making for
+            it the light load (:mod:`steerlab.jit.numba_cache_load`)."""
+            from steerlab.jit import numba_cache_load
+
+            numba_cache_load.give_to_cache_being_made(py_func)
+            return locator
 
     _PackageStampLocator.__name__ = _PackageStampLocator.__qualname__ = "PackageStampLocator"
     _PackageStampLocator.__module__ = __name__

@@ -1,10 +1,11 @@
-"""Loading a cached kernel without numba's compile-time registries: about 0.1 s less per process.
+"""steerlab's own cached kernels load without numba's compile-time registries.
 
 Before numba loads a compiled function from its disk cache, ``Cache.load_overload`` calls
 ``target_context.refresh()``, which imports and installs numba's typing and lowering
-registries (``numba.np.arraymath``, ``numba.cpython.unicode``, cffi's parser, ...): 0.1-0.2 s
-of CPU, the largest cost of a warm ``steerlab run`` after the imports. Loading machine code
-needs none of it: only the symbols that code links against. Those come from
+registries (``numba.np.arraymath``, ``numba.np.random.*``, cffi's parser, ...) and, through
+them, numba's BLAS probe, which imports ``scipy.linalg``: 0.4-0.7 s of CPU on the first load of
+a process, the largest cost of a library user's first ``sl.simulate`` after the imports.
+Loading machine code needs none of it: only the symbols that code links against. Those come from
 
 * numba's helper library, C maths and exception objects (installed when the target context
   is created, before any load);
@@ -13,31 +14,48 @@ needs none of it: only the symbols that code links against. Those come from
   imported;
 * third-party numba extensions (``numba.core.entrypoints.init_all``).
 
-:func:`install` replaces ``load_overload`` by one that prepares exactly these and then loads.
-Compiling is unchanged: numba's compiler refreshes the context itself before every
-compilation, so a process that compiles later (a cache miss, a new kernel) gets the
-registries then. A load that fails for any reason is retried the numba way (full refresh).
+Only steerlab's own dispatchers load that way. numba's ``Cache`` class is not touched: while
+numba makes the cache of a function in a steerlab file (a package kernel or a generated driver,
+the files :class:`steerlab.jit.numba_cache.PackageStampLocator` claims), the locator calls
+:func:`give_to_cache_being_made`, which finds that cache instance (the ``Cache.__init__`` that
+asked the locator, a few frames up) and gives it, as an attribute of that one instance, a
+``load_overload`` that prepares exactly the symbols above and then loads (:func:`give`). A
+user's own ``@numba.njit(cache=True)`` functions, and any code that is not steerlab's, load as
+numba loads them (``tests/test_import_side_effects.py``). Compiling is unchanged: numba's
+compiler refreshes the context itself before every compilation, so a process that compiles
+later (a user's function, a cache miss) gets the registries then. A light load that fails for
+any reason is retried the numba way (full refresh).
 
-It patches a numba internal (``numba.core.caching.Cache``; written against numba 0.68), so it
-is made by the ``steerlab`` command only (:mod:`steerlab.jit.command`), never at ``import
-steerlab``, and only on the numba versions the tests cover (:mod:`steerlab.jit.numba_gate`);
-if the names it needs are missing, :func:`install` changes nothing. Set
-``STEERLAB_LIGHT_CACHE_LOAD=0`` to switch it off.
+It reaches numba internals (the shape of ``Cache.__init__`` and ``Cache._load_overload``,
+written against numba 0.68), so it acts only on the numba versions the tests cover
+(:mod:`steerlab.jit.numba_gate`); elsewhere, or if the names it needs are missing, steerlab's
+kernels load the numba way. Set ``STEERLAB_LIGHT_CACHE_LOAD=0`` (before ``import steerlab``)
+to switch it off.
 
-Measured with ``python benchmarks/bench_startup.py --switches`` (2026-11-28, the warm default
-run with this setting switched off against all on, medians of 5 interleaved rounds, CPU of
-the process tree; the machine was loaded, 1-minute load 17, so wall times were 5x the idle
-ones and only CPU is quoted; ``benchmarks/RESULTS.md``): 1.88 s of CPU without it against 1.64 s
-with it: 0.24 s.
+Measured with ``python benchmarks/bench_startup_ab.py`` (2026-11-29, ``benchmarks/RESULTS.md``,
+"Start-up after the light load of steerlab's own kernels"): a library user's first
+``sl.simulate(sl.default_scenario())`` with a warm cache costs what the tree before the compile
+boundary (``a91f3ce``) did, where it was 1.55x that tree's CPU without it.
 """
 
 from __future__ import annotations
 
 import os
+import sys
 
 ENV = "STEERLAB_LIGHT_CACHE_LOAD"
-STATS = {"light": 0, "fallback": 0}
-"""Loads done the light way, and loads that fell back to numba's (this process)."""
+STATS = {"given": 0, "light": 0, "fallback": 0}
+"""In this process: steerlab caches given the light load, loads done the light way, and loads
+that fell back to numba's."""
+
+
+def enabled() -> bool:
+    """Whether steerlab's own caches get the light load in this process (module docstring)."""
+    if os.environ.get(ENV, "1") == "0":
+        return False
+    from steerlab.jit import numba_gate
+
+    return numba_gate.internals_allowed()
 
 
 def _prepare(target_context) -> None:
@@ -50,44 +68,58 @@ def _prepare(target_context) -> None:
     entrypoints.init_all()
 
 
-def install() -> bool:
-    """Replace numba's ``Cache.load_overload`` (idempotent); returns whether it is in place."""
-    global INSTALLED
-    if os.environ.get(ENV, "1") == "0":
-        return False
-    from steerlab.jit import numba_gate
-
-    if not numba_gate.internals_allowed():
-        return False
+def give(cache) -> bool:
+    """Give one numba cache instance (a steerlab function's) the light load; returns whether it
+    has it. The instance's own ``load_overload`` attribute shadows the class's method for that
+    instance only; numba's class is unchanged."""
+    if "load_overload" in vars(cache):
+        return getattr(cache.load_overload, "_steerlab", False)
+    numba_load = type(cache).load_overload
     try:
-        from numba.core import caching
-
-        cache = caching.Cache
-        original = cache.load_overload
-        load, guard = cache._load_overload, cache._guard_against_spurious_io_errors  # noqa: F841
-    except (ImportError, AttributeError):  # pragma: no cover - depends on the numba version
+        load, guard = cache._load_overload, cache._guard_against_spurious_io_errors
+    except AttributeError:  # pragma: no cover - depends on the numba version: numba's load
         return False
-    if getattr(original, "_steerlab", False):
-        return True
 
-    def load_overload(self, sig, target_context):
+    def load_overload(sig, target_context):
         try:
             _prepare(target_context)
-            with self._guard_against_spurious_io_errors():
-                data = self._load_overload(sig, target_context)
+            with guard():
+                data = load(sig, target_context)
             STATS["light"] += 1
             return data
         except Exception:  # noqa: BLE001 - anything unexpected: numba's own way
             STATS["fallback"] += 1
-            return original(self, sig, target_context)
+            return numba_load(cache, sig, target_context)
 
     load_overload._steerlab = True  # type: ignore[attr-defined]
-    load_overload.__doc__ = original.__doc__
+    load_overload.__doc__ = numba_load.__doc__
     cache.load_overload = load_overload
-    INSTALLED = True
+    STATS["given"] += 1
     return True
 
 
-INSTALLED = False
-"""Whether :func:`install` replaced numba's load in this process (the ``steerlab`` command does,
-unless ``STEERLAB_LIGHT_CACHE_LOAD=0``)."""
+def give_to_cache_being_made(py_func) -> bool:
+    """Called by :class:`steerlab.jit.numba_cache.PackageStampLocator` when it claims
+    ``py_func``'s file: give the light load to the cache numba is making for ``py_func`` (the
+    ``self`` of the ``Cache.__init__`` frame that asked the locator, identified by its code
+    object and its ``_py_func``). Returns whether it did; anything unexpected (another call
+    shape, another numba) leaves that cache as numba made it."""
+    if not enabled():
+        return False
+    try:
+        from numba.core import caching
+
+        init = caching.Cache.__init__.__code__
+        frame = sys._getframe(1)
+    except (ImportError, AttributeError, ValueError):  # pragma: no cover - another numba/Python
+        return False
+    for _ in range(6):                     # locator <- CacheImpl.__init__ <- Cache.__init__
+        if frame is None:
+            return False
+        if frame.f_code is init:
+            cache = frame.f_locals.get("self")
+            if isinstance(cache, caching.Cache) and getattr(cache, "_py_func", None) is py_func:
+                return give(cache)
+            return False
+        frame = frame.f_back
+    return False
