@@ -36,10 +36,17 @@ from them, the speed and the noise level by the thesis' rules (above). What the 
 adds is the range of the identified ``K*``, ``tau*``: the thesis' ``[0.2, 5]`` and
 ``[0.2, 10]`` (Sec. 4.6.3; the ``gains = "paper"`` preset) widened to contain an octave
 ``[x0/2, 2 x0]`` around the ship's own values, so a ship whose ``K*`` is above 5 (the Capella's
-Norrbin models, ``K* ~ 7``) is designed instead of refused. A course-unstable ship (``T < 0``)
-is refused in one line naming ``controller.type`` and the laws that design it
-(``nonlinear_adrc``, ``backstepping_b``, ``sliding_mode``): the MRAS identification and the
-reference model assume a course-stable ship (thesis 4.3.2). Anti-windup: the integral ``Ki`` of
+Norrbin models, ``K* ~ 7``) is designed instead of refused. A course-unstable ship (``K < 0``,
+``T < 0``) is designed with the identification off: the MRAS identification runs a parallel
+model of the ship, which diverges on an unstable one (thesis 4.3.2), so ``K*``, ``tau*`` stay
+at the design model's (both < 0; the kernel skips PAREST while ``a* = 1/tau* < 0``); the
+course-keeping ``Kd`` rules take their ``tau < 0`` form (:mod:`~steerlab.control.asa_schedule`:
+the same closed-loop condition), the hold time and the integral ``|tau|``. A servo too slow
+for the instability is refused as by every law
+(:func:`~steerlab.control.design_model.require_servo_for_unstable`). ``gains = "paper"``
+refuses a course-unstable ship in one line naming ``controller.type`` and laws that design it.
+Designed from ``(K, T)`` alone (no speed), the cruising speed is :func:`nomoto_only_speed`
+(``K* = 1``). Anti-windup: the integral ``Ki`` of
 course keeping integrates only while the order is not limited or the error drives it back, and
 is clamped to the limit; in course changing the adaptation stops while the order is limited
 (Landau 1979).
@@ -80,6 +87,7 @@ from steerlab.control.asa_modes import MODE_CHANGING, asa_mode_step
 from steerlab.control.asa_mras import mras_gain_step, mras_identify_step
 from steerlab.control.asa_reference import lyapunov_p12_p22, reference_model_step
 from steerlab.control.asa_schedule import kd_damping, kd_lq, keeping_kp
+from steerlab.control.design_model import design_model, require_servo_for_unstable
 from steerlab.control.law_design import GAINS, GainsMode
 from steerlab.control.registry import ControllerSpec
 from steerlab.control.wave_filter import PARAMS as WF_PARAMS
@@ -142,8 +150,8 @@ class ASA(NamedTuple):
         require_finite_range(f"{f}.tau_star_max", ts_hi, ts_lo, 100.0)
         if self.K_star0 < 0.0 and self.tau_star0 < 0.0:
             # a course-unstable model (design rule): no identification, so the bounds do not apply
-            require_finite_range(f"{f}.K_star0", self.K_star0, -100.0, 0.0, hi_open=True)
-            require_finite_range(f"{f}.tau_star0", self.tau_star0, -100.0, 0.0, hi_open=True)
+            require_finite_range(f"{f}.K_star0", self.K_star0, -1e6, 0.0, hi_open=True)
+            require_finite_range(f"{f}.tau_star0", self.tau_star0, -1e6, 0.0, hi_open=True)
         else:
             self._check_stable_start(f, ks_lo, ks_hi, ts_lo, ts_hi)
         if self.kd_rule not in ("lq", "damping"):
@@ -384,6 +392,8 @@ def build(cfg: ASAConfig, ctx):
         ks0 = K * L / U_design
         ts0 = T * U_design / L
         unstable = math.isfinite(K) and math.isfinite(T) and K < 0.0 and T < 0.0 and cfg.gains == "design"
+        if unstable:     # a servo too slow for the ship's instability: refused as by every law
+            require_servo_for_unstable(design_model(ctx), "asa")
         if not (math.isfinite(K) and math.isfinite(T) and K > 0.0 and T > 0.0) and not unstable:
             raise InputError("controller.type", (
                 f"asa: ship {ctx.ship.name!r} at {U_design:.3g} m/s has the Nomoto model K = {K:.4g} 1/s, "
@@ -422,4 +432,5 @@ CONTROLLER = ControllerSpec(
     params=PARAMS,
     design_rule=("initial K*, tau* from the ship's Nomoto model, gains by the thesis' rules (Kp = mu/2 U0/U, Kd "
                  "LQ-optimal, MRAS course changing; van Amerongen 1982 4.6), identification bounds widened to an "
-                 "octave around the ship's K*, tau*; clamping anti-windup on Ki; course-unstable ships refused"))
+                 "octave around the ship's K*, tau*; clamping anti-windup on Ki; course-unstable ships with the "
+                 "identification off and Kd in its tau < 0 form; from (K, T) alone at U0 = K L (K* = 1)"))

@@ -177,6 +177,22 @@ def unstable_turn_rate(m: DesignModel, omega_n: float, turn: float = DESIGN_TURN
     return asked, m.b * m.delta_max / abs(m.a)
 
 
+def require_servo_for_unstable(m: DesignModel, law: str = "", omega_n: float | None = None) -> None:
+    """Refuse (:class:`InputError` naming ``gear.T_sg``) a course-unstable model whose loop must
+    be faster than the servo allows: ``omega_n`` (default ``UNSTABLE_FLOOR |a|``) above the
+    servo cap ``SERVO_FRACTION / T_sg`` (Fossen 2011, Sec. 12.2.7). A law with a rule of its
+    own (asa) asks this too."""
+    if not m.unstable:
+        return
+    w = UNSTABLE_FLOOR * abs(m.a) if omega_n is None else omega_n
+    cap = SERVO_FRACTION / m.T_sg
+    if w > cap:
+        who = f"{law}: " if law else ""
+        raise InputError("gear.T_sg", f"{who}the course-unstable design model (T = {m.T:.4g} s) needs "
+                         f"omega_n >= {w:.3g} rad/s; a servo of T_sg = {m.T_sg:.3g} s allows "
+                         f"{cap:.3g}: give T_sg <= {SERVO_FRACTION / w:.3g}")
+
+
 def bandwidth(m: DesignModel, turn: float = DESIGN_TURN, law: str = "") -> float:
     """The closed-loop natural frequency ``omega_n`` [rad/s] of every law's default design.
 
@@ -201,10 +217,7 @@ def bandwidth(m: DesignModel, turn: float = DESIGN_TURN, law: str = "") -> float
             return gear_cap
         w = max(gear_cap, UNSTABLE_FLOOR * abs(m.a))
         who = f"{law}: " if law else ""
-        if w > caps["servo"]:
-            raise InputError("gear.T_sg", f"{who}the course-unstable design model (T = {m.T:.4g} s) needs "
-                             f"omega_n >= {w:.3g} rad/s; a servo of T_sg = {m.T_sg:.3g} s allows "
-                             f"{caps['servo']:.3g}: give T_sg <= {SERVO_FRACTION / w:.3g}")
+        require_servo_for_unstable(m, law, w)
         asked, held = unstable_turn_rate(m, w, turn)
         if asked > held:
             lim = asked * abs(m.a) / m.b
