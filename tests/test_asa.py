@@ -210,15 +210,16 @@ def test_course_unstable_ship_needs_explicit_tau_star():
     assert err.value.field == "controller.type" and "nonlinear_adrc" in str(err.value)
 
 
-def test_course_unstable_ship_needs_explicit_initial_model():
-    """Esso at 16 kn is course-unstable (Nomoto K, T < 0): the default initial K*, tau* would be
-    negative; the error says why and what to give, and giving them works."""
+def test_course_unstable_ship_needs_explicit_initial_model_with_the_paper_preset():
+    """Esso at 16 kn is course-unstable (Nomoto K, T < 0): the thesis' preset (identification on)
+    would start negative K*, tau*; the error says why and what to give, and giving them works.
+    The design rule designs it with the identification off (tests/test_nonlinear_design_rules.py)."""
     from steerlab.errors import InputError
     from steerlab.sim.scenario import scenario_from_dict
     from steerlab.sim.setup import build
 
     with pytest.raises(InputError) as err:
-        build(scenario_from_dict({"ship": {"model": "esso"}, "controller": {"type": "asa"}}))
+        build(scenario_from_dict({"ship": {"model": "esso"}, "controller": {"type": "asa", "gains": "paper"}}))
     msg = str(err.value)
     assert err.value.field == "controller.type" and "nonlinear_adrc" in msg and "\n" not in msg
     assert "course-unstable" in msg and "tau_star0" in msg and "T = -" in msg

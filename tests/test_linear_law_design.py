@@ -105,9 +105,17 @@ def test_a_design_without_a_model_names_nomoto():
     assert ei.value.field == "nomoto"
 
 
-def test_gain_shaping_refuses_an_unstable_model_naming_type_and_the_laws_that_can():
+def test_gain_shaping_designs_an_unstable_model_by_pole_placement_and_its_paper_rule_refuses():
+    """T < 0: the gain-shaping zero would cancel the unstable pole, so the design rule places the
+    poles as pid does (the same gains); the paper's rule (gains = "paper") refuses in one line."""
+    gear = {"delta_max_deg": 30.0, "rate_max_deg_s": 3.0}
+    gsp = controller("gain_shaping_pid", nomoto=(-0.05, -120.0), gear=gear)
+    np.testing.assert_array_equal(gsp.params, controller("pid", nomoto=(-0.05, -120.0), gear=gear).params)
+    assert gsp.params[0] > 0.0                 # a design, not the paper's fixed gains
+    stable = controller("gain_shaping_pid", nomoto=(0.05, 120.0), gear=gear)
+    assert not np.array_equal(stable.params, controller("pid", nomoto=(0.05, 120.0), gear=gear).params)
     with pytest.raises(InputError) as ei:
-        controller("gain_shaping_pid", nomoto=(-0.05, -120.0))
+        controller("gain_shaping_pid", nomoto=(-0.05, -120.0), gains="paper")
     assert ei.value.field == "type" and "\n" not in str(ei.value)
     assert '"pid"' in str(ei.value) and '"lq_pd"' in str(ei.value)
 
@@ -135,19 +143,17 @@ PLANTS = [(0.05, 80.0, 35.0, 2.33), (0.3, 25.0, 25.0, 5.0), (0.02, 300.0, 30.0, 
 
 @pytest.mark.parametrize("law", LAWS)
 def test_designed_from_K_T_alone_holds_a_20_deg_change_on_both_signs(law):
-    held = refused = 0
+    held = 0
     for K, T, dmax_deg, rate_deg in PLANTS:
         gear = {"delta_max_deg": dmax_deg, "rate_max_deg_s": rate_deg, "T_sg": 1.0}
         try:
             log = _step(law, K, T, gear, rad(dmax_deg), rad(rate_deg))
-        except InputError as err:
-            assert law == "gain_shaping_pid" and T < 0.0 and err.field == "type", str(err)
-            refused += 1
-            continue
+        except InputError as err:     # every law designs these six (gain_shaping_pid's T < 0 by pole placement)
+            raise AssertionError(f"{law} refused ({K}, {T}): {err}") from None
         tail = log[log[:, 0] >= 3000.0, 1]     # the slowest plant's integral pole: ~1 200 s
         assert np.all(np.abs(tail - rad(20.0)) < rad(1.0)), (law, K, T, math.degrees(np.max(np.abs(tail - rad(20.0)))))
         held += 1
-    assert held >= 3 and held + refused == len(PLANTS)
+    assert held == len(PLANTS)
 
 
 def test_itae_pid_from_nomoto_alone_is_the_unscheduled_design():

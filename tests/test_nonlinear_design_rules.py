@@ -273,14 +273,31 @@ def test_asa_design_widens_the_identification_bounds_to_the_ship():
     assert err.value.field == "controller.K_star0"
 
 
-def test_asa_refuses_a_course_unstable_ship_in_one_line_naming_laws_that_can():
+def test_asa_designs_a_course_unstable_ship_and_its_paper_preset_refuses_in_one_line():
+    """The course-unstable Esso: the design rule starts K*, tau* < 0 with no identification; the
+    thesis' preset (identification on, bounds > 0) refuses in one line naming laws that can."""
+    c = obj("esso", {"type": "asa"}, speed_kn=16.0)
+    assert c.K_star0 < 0.0 and c.tau_star0 < 0.0
     with pytest.raises(InputError) as err:
-        obj("esso", {"type": "asa"}, speed_kn=16.0)
+        obj("esso", {"type": "asa", "gains": "paper"}, speed_kn=16.0)
     msg = str(err.value)
     assert err.value.field == "controller.type" and "nonlinear_adrc" in msg and "\n" not in msg
 
 
-@pytest.mark.parametrize("law", ["adrc", "nonlinear_adrc", "sliding_mode", "backstepping_a", "backstepping_b"])
+def test_asa_kd_rules_place_a_stable_loop_for_either_sign():
+    """Kd of (3.6) and (4.2) and their course-unstable form: the closed loop s^2 + (a + b Kd) s
+    + b Kp has a + b Kd = sqrt(a^2 + 2 b Kp) (LQ) and 2 zeta sqrt(b Kp) (damping) for both signs."""
+    from steerlab.control.asa_schedule import kd_damping, kd_lq
+
+    LU, kp = 12.0, 1.5
+    for Ks, ts in ((1.3, 2.0), (-1.3, -2.0)):
+        K, tau = Ks / LU, ts * LU
+        a, b = 1.0 / tau, K / tau
+        assert a + b * kd_lq(Ks, ts, kp, LU) == pytest.approx(math.sqrt(a * a + 2.0 * b * kp), rel=1e-12)
+        assert a + b * kd_damping(Ks, ts, kp, 0.8, LU) == pytest.approx(1.6 * math.sqrt(b * kp), rel=1e-12)
+
+
+@pytest.mark.parametrize("law", ["adrc", "nonlinear_adrc", "sliding_mode", "backstepping_a", "backstepping_b", "asa"])
 def test_designed_from_K_T_alone_of_either_sign_holds_a_20_deg_change(law):
     """sl.controller(type, nomoto=(K, T)) with no ship, no speed: a plain-Python Nomoto plant
     behind a rate-limited gear settles within 1 deg of a 20 deg change, course-stable or not."""

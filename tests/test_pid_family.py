@@ -281,8 +281,11 @@ def test_K_and_T_of_opposite_signs_are_refused(ctrl):
     build(_scenario(dict(CONTROLLERS[ctrl], T=50.0), ship=ship))   # an explicit design T is accepted
 
 
-def test_gain_shaping_refuses_a_course_unstable_ship_naming_the_laws_that_can():
+def test_gain_shaping_paper_rule_refuses_a_course_unstable_ship_naming_the_laws_that_can():
+    """The course-unstable Esso: the design rule places the poles (tests/test_linear_law_design.py);
+    the paper's rule would cancel the unstable pole and refuses in one line."""
     from steerlab.sim.setup import build
+    build(_scenario({"type": "gain_shaping_pid"}, ship={"model": "esso", "speed_kn": 16.0}))
     with pytest.raises(InputError) as ei:
         build(_scenario("gain_shaping_pid", ship={"model": "esso", "speed_kn": 16.0}))
     assert ei.value.field == "controller.type" and "\n" not in str(ei.value)

@@ -238,7 +238,8 @@ def controller(type: str, *, ship: Optional[str] = None, speed_kn: Optional[floa
     ------
     InputError
         Naming the argument to give or fix (e.g. ``nomoto`` when the law needs a model,
-        ``speed_kn`` when it needs a speed, ``K_star0`` for ASA on a course-unstable ship).
+        ``speed_kn`` when it needs a speed, ``type`` for ASA's paper preset on a
+        course-unstable ship).
     """
     from steerlab.components.design import design_context
 

@@ -36,10 +36,17 @@ from them, the speed and the noise level by the thesis' rules (above). What the 
 adds is the range of the identified ``K*``, ``tau*``: the thesis' ``[0.2, 5]`` and
 ``[0.2, 10]`` (Sec. 4.6.3; the ``gains = "paper"`` preset) widened to contain an octave
 ``[x0/2, 2 x0]`` around the ship's own values, so a ship whose ``K*`` is above 5 (the Capella's
-Norrbin models, ``K* ~ 7``) is designed instead of refused. A course-unstable ship (``T < 0``)
-is refused in one line naming ``controller.type`` and the laws that design it
-(``nonlinear_adrc``, ``backstepping_b``, ``sliding_mode``): the MRAS identification and the
-reference model assume a course-stable ship (thesis 4.3.2). Anti-windup: the integral ``Ki`` of
+Norrbin models, ``K* ~ 7``) is designed instead of refused. A course-unstable ship (``K < 0``,
+``T < 0``) is designed with the identification off: the MRAS identification runs a parallel
+model of the ship, which diverges on an unstable one (thesis 4.3.2), so ``K*``, ``tau*`` stay
+at the design model's (both < 0; the kernel skips PAREST while ``a* = 1/tau* < 0``); the
+course-keeping ``Kd`` rules take their ``tau < 0`` form (:mod:`~steerlab.control.asa_schedule`:
+the same closed-loop condition), the hold time and the integral ``|tau|``. A servo too slow
+for the instability is refused as by every law
+(:func:`~steerlab.control.design_model.require_servo_for_unstable`). ``gains = "paper"``
+refuses a course-unstable ship in one line naming ``controller.type`` and laws that design it.
+Designed from ``(K, T)`` alone (no speed), the cruising speed is :func:`nomoto_only_speed`
+(``K* = 1``). Anti-windup: the integral ``Ki`` of
 course keeping integrates only while the order is not limited or the error drives it back, and
 is clamped to the limit; in course changing the adaptation stops while the order is limited
 (Landau 1979).
@@ -80,6 +87,7 @@ from steerlab.control.asa_modes import MODE_CHANGING, asa_mode_step
 from steerlab.control.asa_mras import mras_gain_step, mras_identify_step
 from steerlab.control.asa_reference import lyapunov_p12_p22, reference_model_step
 from steerlab.control.asa_schedule import kd_damping, kd_lq, keeping_kp
+from steerlab.control.design_model import design_model, require_servo_for_unstable
 from steerlab.control.law_design import GAINS, GainsMode
 from steerlab.control.registry import ControllerSpec
 from steerlab.control.wave_filter import PARAMS as WF_PARAMS
@@ -140,12 +148,12 @@ class ASA(NamedTuple):
         require_finite_range(f"{f}.K_star_max", ks_hi, ks_lo, 100.0)
         require_finite_range(f"{f}.tau_star_min", ts_lo, 0.0, 100.0, lo_open=True)
         require_finite_range(f"{f}.tau_star_max", ts_hi, ts_lo, 100.0)
-        require_finite_range(f"{f}.K_star0", self.K_star0, ks_lo, ks_hi)
-        if not (self.tau_star0 > 0.0):
-            raise InputError(f"{f}.tau_star0",
-                             f"must be > 0 (got {self.tau_star0!r}): ASA's MRAS identification needs a "
-                             "course-stable ship (thesis 4.3.2); give tau_star0 explicitly for this ship")
-        require_finite_range(f"{f}.tau_star0", self.tau_star0, ts_lo, ts_hi)
+        if self.K_star0 < 0.0 and self.tau_star0 < 0.0:
+            # a course-unstable model (design rule): no identification, so the bounds do not apply
+            require_finite_range(f"{f}.K_star0", self.K_star0, -1e6, 0.0, hi_open=True)
+            require_finite_range(f"{f}.tau_star0", self.tau_star0, -1e6, 0.0, hi_open=True)
+        else:
+            self._check_stable_start(f, ks_lo, ks_hi, ts_lo, ts_hi)
         if self.kd_rule not in ("lq", "damping"):
             raise InputError(f"{f}.kd_rule", f"must be 'lq' or 'damping', got {self.kd_rule!r}")
         require_finite_range(f"{f}.change_threshold", self.threshold, 0.0, math.pi, lo_open=True)
@@ -162,6 +170,14 @@ class ASA(NamedTuple):
                             "kd_rule": 0.0 if self.kd_rule == "lq" else 1.0, "K_star_min": ks_lo,
                             "K_star_max": ks_hi, "tau_star_min": ts_lo, "tau_star_max": ts_hi,
                             "use_estimator": 1.0 if self.use_estimator else 0.0})
+
+    def _check_stable_start(self, f, ks_lo, ks_hi, ts_lo, ts_hi) -> None:
+        require_finite_range(f"{f}.K_star0", self.K_star0, ks_lo, ks_hi)
+        if not (self.tau_star0 > 0.0):
+            raise InputError(f"{f}.tau_star0",
+                             f"must be > 0 (got {self.tau_star0!r}): ASA's MRAS identification needs a "
+                             "course-stable ship (thesis 4.3.2); give tau_star0 explicitly for this ship")
+        require_finite_range(f"{f}.tau_star0", self.tau_star0, ts_lo, ts_hi)
 
     def init_state(self, x0, ref0) -> np.ndarray:
         """Course keeping at the initial order; filter at the measured state; K*, tau* initial."""
@@ -191,6 +207,8 @@ def asa_update(z, p, t, x, ref, h):
     r = x[IR]
     u_freeze = p[P_U_FREEZE]
     U = x[IU]
+    if U != U:   # NaN: no speed measurement (a design from K, T alone): the cruising speed
+        U = p[P_U0]
     frozen = U < u_freeze
     Us = max(U, u_freeze)
     LU = p[P_L] / Us
@@ -245,14 +263,17 @@ def asa_update(z, p, t, x, ref, h):
         e = wrap_to_pi(z[Z_PSI_SET] - psi_h)
         ud = kp * e - kd * r_h + z[Z_KI]
         if not frozen and (abs(ud) <= lim or e * ud < 0.0):
-            z[Z_KI] = z[Z_KI] + h * kp * e / (p[P_N_TI] * tau)
+            z[Z_KI] = z[Z_KI] + h * kp * e / (p[P_N_TI] * abs(tau))
         z[Z_KI] = min(max(z[Z_KI], -lim), lim)
-        z[Z_KI_MEAN] = z[Z_KI_MEAN] + min(h / tau, 1.0) * (z[Z_KI] - z[Z_KI_MEAN])
+        z[Z_KI_MEAN] = z[Z_KI_MEAN] + min(h / abs(tau), 1.0) * (z[Z_KI] - z[Z_KI_MEAN])
     # 5. DELLIM: rudder limit
     u = min(max(ud, -lim), lim)
     z[Z_SAT] = 1.0 if u != ud else 0.0
     z[Z_DELTA_LIM] = lim
-    # 6. PAREST: identification of K*, tau* (model I), decreasing noise-scaled gains
+    # 6. PAREST: identification of K*, tau* (model I), decreasing noise-scaled gains; none for a
+    # course-unstable model (a* = 1/tau* < 0: the parallel model would diverge, thesis 4.3.2)
+    if z[Z_A] < 0.0:
+        return u
     if frozen:
         aid = 0.0
         bid = 0.0
@@ -331,28 +352,61 @@ def bounds(cfg: ASAConfig, name: str, x0: float) -> tuple[float, float]:
     return lo, hi
 
 
+#: Largest initial ``tau*`` [-] of a design from ``(K, T)`` alone: half the largest ``tau_star_max``
+#: (100), so the design rule's octave ``[tau*/2, 2 tau*]`` fits.
+TAU_STAR_CAP = 50.0
+
+
+def nomoto_only_speed(ctx, L: float) -> float:
+    """The cruising speed ``U0 = K L`` [m/s] of a design from ``(K, T)`` alone (no speed given).
+
+    ASA's gains do not depend on ``L/U`` (``Kp`` is non-dimensional, ``Kd`` and the closed
+    loop follow from ``K tau = K* tau*``); ``L/U`` sets the rudder limit of course changing
+    (4.85), ``f_delta r_max L/U``, which the thesis writes for a ship with ``K* = 1``. Taking
+    ``L/U = 1/K`` makes this ship's ``K* = 1``: the limit is ``f_delta`` times the stationary
+    rudder ``r_max/K`` for the user's rate of turn, as the rule intends. A very slow ship
+    (``K T > TAU_STAR_CAP``) takes ``L/U = |T| / TAU_STAR_CAP`` instead, so that its ``tau*``
+    and the octave of identification bounds around it stay within ASA's range (``tau* <= 100``);
+    its limit is then wider than ``f_delta`` stationary rudders. The kernel uses ``U0`` as the
+    speed when it is given none (a NaN speed).
+    """
+    K, T = ctx.nomoto()
+    U0 = L / max(1.0 / abs(float(K)), abs(float(T)) / TAU_STAR_CAP)
+    if not (math.isfinite(U0) and 0.0 < U0 <= 50.0):
+        raise InputError("length_m", f"asa designed from K = {K:.4g} 1/s, T = {T:.4g} s alone runs at U0 = "
+                                     f"{U0:.4g} m/s for L = {L:.4g} m (K* = 1); give a length_m for which U0 "
+                                     "<= 50 m/s, or speed_kn")
+    return U0
+
+
 def build(cfg: ASAConfig, ctx):
     """ASA from its settings; K*, tau* initialised from the ship's Nomoto model at the speed."""
     L = cfg.L if cfg.L is not None else ship_length(ctx)
-    U0 = knots_to_ms(cfg.cruise_speed_kn) if cfg.cruise_speed_kn is not None else ctx.speed
+    U_design = ctx.speed
+    if not math.isfinite(U_design) and None in (cfg.K_star0, cfg.tau_star0, cfg.cruise_speed_kn):
+        U_design = nomoto_only_speed(ctx, L)      # a design from (K, T) alone
+    U0 = knots_to_ms(cfg.cruise_speed_kn) if cfg.cruise_speed_kn is not None else U_design
     ks0 = ts0 = math.nan
     if cfg.K_star0 is None or cfg.tau_star0 is None:
         K, T = ctx.nomoto()
-        ks0 = K * L / ctx.speed
-        ts0 = T * ctx.speed / L
-        if not (math.isfinite(K) and math.isfinite(T) and K > 0.0 and T > 0.0):
+        ks0 = K * L / U_design
+        ts0 = T * U_design / L
+        unstable = math.isfinite(K) and math.isfinite(T) and K < 0.0 and T < 0.0 and cfg.gains == "design"
+        if unstable:     # a servo too slow for the ship's instability: refused as by every law
+            require_servo_for_unstable(design_model(ctx), "asa")
+        if not (math.isfinite(K) and math.isfinite(T) and K > 0.0 and T > 0.0) and not unstable:
             raise InputError("controller.type", (
-                f"asa: ship {ctx.ship.name!r} at {ctx.speed:.3g} m/s has the Nomoto model K = {K:.4g} 1/s, "
+                f"asa: ship {ctx.ship.name!r} at {U_design:.3g} m/s has the Nomoto model K = {K:.4g} 1/s, "
                 f"T = {T:.4g} s ({'course-unstable' if K * T > 0 else 'not finite'}); ASA identifies and adapts "
-                "to a course-stable model (thesis 4.3.2), so use nonlinear_adrc, backstepping_b or sliding_mode "
-                "(or give K_star0 and tau_star0 > 0)"))
+                "to a course-stable model (thesis 4.3.2), so use gains = \"design\" (no identification), or "
+                "nonlinear_adrc, pid, lq_pd or sliding_mode (or give K_star0 and tau_star0 > 0)"))
     ks_lo, ks_hi = bounds(cfg, "K_star", ks0 if cfg.K_star0 is None else math.nan)
     ts_lo, ts_hi = bounds(cfg, "tau_star", ts0 if cfg.tau_star0 is None else math.nan)
-    if cfg.K_star0 is None or cfg.tau_star0 is None:
+    if (cfg.K_star0 is None or cfg.tau_star0 is None) and ks0 > 0.0:
         for name, value, lo, hi in (("K_star0", ks0, ks_lo, ks_hi), ("tau_star0", ts0, ts_lo, ts_hi)):
             if getattr(cfg, name) is None and lo <= hi and not lo <= value <= hi:   # (lo > hi: its own error)
                 raise InputError(f"controller.{name}", (
-                    f"ship {ctx.ship.name!r} at {ctx.speed:.3g} m/s (L = {L:.4g} m) has the Nomoto model "
+                    f"ship {ctx.ship.name!r} at {U_design:.3g} m/s (L = {L:.4g} m) has the Nomoto model "
                     f"K = {K:.4g} 1/s, T = {T:.4g} s, so the initial {name[:-1]} = {value:.4g} lies outside "
                     f"[{lo}, {hi}]; give {name} in that range, or widen {name[:-1]}_min/{name[:-1]}_max"))
     ks0 = cfg.K_star0 if cfg.K_star0 is not None else ks0
@@ -378,4 +432,5 @@ CONTROLLER = ControllerSpec(
     params=PARAMS,
     design_rule=("initial K*, tau* from the ship's Nomoto model, gains by the thesis' rules (Kp = mu/2 U0/U, Kd "
                  "LQ-optimal, MRAS course changing; van Amerongen 1982 4.6), identification bounds widened to an "
-                 "octave around the ship's K*, tau*; clamping anti-windup on Ki; course-unstable ships refused"))
+                 "octave around the ship's K*, tau*; clamping anti-windup on Ki; course-unstable ships with the "
+                 "identification off and Kd in its tau < 0 form; from (K, T) alone at U0 = K L (K* = 1)"))

@@ -7,8 +7,8 @@ Source: van Amerongen (1982), Sec. 4.6 (first paragraph) and 4.6.1 (initial valu
   set heading in use by more than a threshold (thesis: five degrees); smaller changes of the
   order are taken over directly by the course-keeping controller;
 * after the (series) reference model has reached the new heading the autopilot stays in the
-  course-changing mode (tight control) for about ten ship time constants ``tau = tau* L/U``,
-  then switches to course keeping;
+  course-changing mode (tight control) for about ten ship time constants ``|tau| = |tau*| L/U``
+  (the magnitude: a course-unstable model has ``tau < 0``), then switches to course keeping;
 * on entering the course-changing mode the series model starts from the estimated ship state
   (so the turn starts smoothly), ``Kp0 = Kp_cc U0/U`` (4.77, 4.82), ``Kd0`` by (4.2) with
   ``zeta = 1`` (4.83), ``Ki0`` = the mean Ki of the preceding course keeping (4.84), and the
@@ -71,5 +71,5 @@ def asa_mode_step(z, p, t, psi_ref, psi_hat, r_hat, Ks, taus, L_over_U, U0_over_
         if (abs(wrap_to_pi(psi_ref - z[Z_PSI_M])) < REACHED_TOL
                 and abs(z[Z_R_M]) < 0.05 * p[P_R_MAX]):
             z[Z_T_REACHED] = t
-    elif t - z[Z_T_REACHED] >= p[P_N_HOLD] * taus * L_over_U:
+    elif t - z[Z_T_REACHED] >= p[P_N_HOLD] * abs(taus) * L_over_U:
         z[Z_MODE] = MODE_KEEPING

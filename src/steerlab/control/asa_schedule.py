@@ -16,6 +16,11 @@ design brief. Non-dimensional ship parameters ``K* = K L/U``, ``tau* = tau U/L``
 * Kd, either LQ-optimal for criterion (3.1) (eq 3.6 with 4.92):
   ``Kd = (sqrt(1 + 2 K tau Kp) - 1) / K``, or constant damping (eq 4.2):
   ``Kd = (2 zeta sqrt(K tau Kp) - 1) / K`` (clipped at 0), with ``K tau = K* tau*``.
+  Both are the closed loop ``s^2 + (a + b Kd) s + b Kp`` (``a = 1/tau``, ``b = K/tau``) with
+  ``a + b Kd = sqrt(a^2 + 2 b Kp)`` (LQ) or ``2 zeta sqrt(b Kp)``; for a course-unstable
+  model (``K < 0``, ``tau < 0``, ``b > 0``) the same conditions give ``+1`` for ``-1`` and
+  ``|K|`` for ``K``: ``Kd = (sqrt(1 + 2 K tau Kp) + 1) / |K|`` and
+  ``(2 zeta sqrt(K tau Kp) + 1) / |K|`` (steerlab's extension; the thesis treats stable ships).
 * Course changing, eqs (4.77), (4.82), (4.83): ``Kp0 = Kp_cc U0/U`` (``Kp_cc = 2.5``),
   ``Kd0`` by (4.2) with ``zeta = 1``.
 * The closed loop of the nominal ship with (Kp, Kd) has ``omega_n = sqrt(K Kp / tau)``
@@ -34,13 +39,19 @@ import numba
 
 @numba.njit(cache=True)
 def kd_lq(Ks, taus, kp, L_over_U):
-    """LQ-optimal Kd [s] of (3.6): ``(sqrt(1 + 2 K* tau* Kp) - 1) L / (K* U)``."""
+    """LQ-optimal Kd [s] of (3.6): ``(sqrt(1 + 2 K* tau* Kp) - 1) L / (K* U)`` (``+ 1``, ``|K*|``
+    for a course-unstable ``tau* < 0``: module docstring)."""
+    if taus < 0.0:
+        return (math.sqrt(1.0 + 2.0 * Ks * taus * kp) + 1.0) * L_over_U / abs(Ks)
     return (math.sqrt(1.0 + 2.0 * Ks * taus * kp) - 1.0) * L_over_U / Ks
 
 
 @numba.njit(cache=True)
 def kd_damping(Ks, taus, kp, zeta, L_over_U):
-    """Kd [s] for damping ``zeta`` (4.2): ``(2 zeta sqrt(K* tau* Kp) - 1) L / (K* U)``, >= 0."""
+    """Kd [s] for damping ``zeta`` (4.2): ``(2 zeta sqrt(K* tau* Kp) - 1) L / (K* U)``, >= 0 (``+ 1``,
+    ``|K*|`` for a course-unstable ``tau* < 0``: module docstring)."""
+    if taus < 0.0:
+        return (2.0 * zeta * math.sqrt(Ks * taus * kp) + 1.0) * L_over_U / abs(Ks)
     return max(2.0 * zeta * math.sqrt(Ks * taus * kp) - 1.0, 0.0) * L_over_U / Ks
 
 

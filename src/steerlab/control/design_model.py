@@ -17,8 +17,11 @@ Laws design in the ``(a, b)`` form: it stays well conditioned when ``|T|`` is ve
 [rad/s] shared by every law: it follows the ship's response to its rudder ``b = K/T`` and is
 capped by what the steering gear can deliver in the reference turn (its limit, its rate limit
 and its servo lag).
-For a course-unstable ship it must exceed the unstable pole by a margin, or the design is
-refused in one line that says which gear would do.
+For a course-unstable ship it must exceed the unstable pole by a margin; where the gear caps
+are below that margin the loop is designed at a smaller one all the same and the gear
+saturates in the reference turn, provided the yaw rate the saturated loop asks for stays below the
+largest one the rudder can hold (:func:`unstable_turn_rate`); otherwise the design is refused
+in one line that says which gear would do.
 """
 
 from __future__ import annotations
@@ -36,6 +39,13 @@ DESIGN_TURN = rad(20.0)
 ZETA = 0.9
 #: A course-unstable ship: ``omega_n`` at least this many times its unstable pole ``|a|``.
 UNSTABLE_MARGIN = 2.0
+#: A course-unstable ship whose gear cannot give ``UNSTABLE_MARGIN |a|``: ``omega_n`` at least
+#: this many times ``|a|``. A PD loop ``s^2 + (2 zeta omega_n) s + omega_n^2`` on a ship with
+#: the pole ``+|a|`` stays stable for loop gains down to ``|a| / (2 zeta omega_n + |a|)`` (the
+#: rudder's saturation lowers the gain): at ``1.2 |a|`` down to 0.32, a lower gain margin of
+#: about 10 dB (Fossen 2011, Sec. 12.2.7, PD on the Nomoto model; the lower margin of an
+#: open-loop unstable plant, Skogestad & Postlethwaite 2005, Sec. 2.4).
+UNSTABLE_FLOOR = 1.2
 #: Fraction of the gear's limit a design may command in the reference turn [-].
 GEAR_USE = 0.7
 #: ``omega_n`` at most this fraction of the servo's bandwidth ``1/T_sg`` [-] (Fossen 2011,
@@ -150,6 +160,39 @@ def bandwidth_caps(m: DesignModel, turn: float = DESIGN_TURN) -> dict:
             "servo": SERVO_FRACTION / m.T_sg}
 
 
+def unstable_turn_rate(m: DesignModel, omega_n: float, turn: float = DESIGN_TURN) -> tuple[float, float]:
+    """``(asked, held)`` [rad/s]: the yaw rate a saturated loop at ``omega_n`` asks for in the
+    reference turn, and the largest the rudder can hold on a course-unstable ship.
+
+    While the rudder is at its stop, a PD loop ``delta = Kp e - Kd r`` (pole placement,
+    :mod:`steerlab.control.pole_placement`) turns the ship towards ``Kp e = Kd r``: at the start
+    of the turn ``r = (Kp/Kd) turn = omega_n^2 turn / (2 zeta omega_n - a)`` (``asked``). A
+    course-unstable ship ``r' = |a| r + b delta`` can be brought back from a yaw rate only
+    while ``b delta_max > |a| |r|``: ``held = b delta_max / |a| = |K| delta_max``. A loop that
+    asks for more loses the ship at the stops (it spins); one that asks for less turns at
+    that rate and settles (van Amerongen 1982, Sec. 3.2: the rudder must overcome the ship's
+    instability; the steady yaw rate of a Nomoto ship is ``K delta``).
+    """
+    asked = omega_n * omega_n * turn / (2.0 * ZETA * omega_n - m.a)
+    return asked, m.b * m.delta_max / abs(m.a)
+
+
+def require_servo_for_unstable(m: DesignModel, law: str = "", omega_n: float | None = None) -> None:
+    """Refuse (:class:`InputError` naming ``gear.T_sg``) a course-unstable model whose loop must
+    be faster than the servo allows: ``omega_n`` (default ``UNSTABLE_FLOOR |a|``) above the
+    servo cap ``SERVO_FRACTION / T_sg`` (Fossen 2011, Sec. 12.2.7). A law with a rule of its
+    own (asa) asks this too."""
+    if not m.unstable:
+        return
+    w = UNSTABLE_FLOOR * abs(m.a) if omega_n is None else omega_n
+    cap = SERVO_FRACTION / m.T_sg
+    if w > cap:
+        who = f"{law}: " if law else ""
+        raise InputError("gear.T_sg", f"{who}the course-unstable design model (T = {m.T:.4g} s) needs "
+                         f"omega_n >= {w:.3g} rad/s; a servo of T_sg = {m.T_sg:.3g} s allows "
+                         f"{cap:.3g}: give T_sg <= {SERVO_FRACTION / w:.3g}")
+
+
 def bandwidth(m: DesignModel, turn: float = DESIGN_TURN, law: str = "") -> float:
     """The closed-loop natural frequency ``omega_n`` [rad/s] of every law's default design.
 
@@ -158,30 +201,31 @@ def bandwidth(m: DesignModel, turn: float = DESIGN_TURN, law: str = "") -> float
     through its limit, rate and lag (Fossen 2011, Sec. 12.2.7: the closed-loop bandwidth
     above the ship's corner ``1/|T|`` and below the steering machine's). A course-unstable
     model also needs ``omega_n >= UNSTABLE_MARGIN |a|``: it is raised to that when the gear
-    allows it, else :class:`InputError` names ``gear.rate_max`` (or ``gear.delta_max``) with
-    the value that would do.
+    allows it. Where the gear's limit and rate caps are below that, ``omega_n`` is the larger
+    of the gear cap and ``UNSTABLE_FLOOR |a|``: the rudder may saturate in the reference turn,
+    which a course-unstable ship survives while the saturated loop asks for no more yaw rate
+    than the rudder can hold (:func:`unstable_turn_rate`); otherwise :class:`InputError` names
+    ``gear.delta_max`` with the value that would do (``gear.T_sg`` when the servo cap is below
+    ``UNSTABLE_FLOOR |a|``: the servo cap is never exceeded).
     """
     caps = bandwidth_caps(m, turn)
     gear_cap = min(caps["limit"], caps["rate"], caps["servo"])
     w = gear_cap
     if m.unstable:
         need = UNSTABLE_MARGIN * abs(m.a)
-        if need > gear_cap:
-            who = f"{law}: " if law else ""
-            if caps["rate"] <= min(caps["limit"], caps["servo"]):
-                rate = need ** 3 * turn / (GEAR_USE * m.b)
-                raise InputError("gear.rate_max", f"{who}the course-unstable design model (T = {m.T:.4g} s) needs "
-                                 f"omega_n >= {need:.3g} rad/s; a gear of {deg(m.rate_max):.3g} deg/s allows "
-                                 f"{gear_cap:.3g}: give rate_max_deg_s >= {deg(rate):.3g}")
-            if caps["limit"] <= caps["servo"]:
-                lim = need ** 2 * turn / (GEAR_USE * m.b)
-                raise InputError("gear.delta_max", f"{who}the course-unstable design model (T = {m.T:.4g} s) needs "
-                                 f"omega_n >= {need:.3g} rad/s; a {deg(m.delta_max):.3g} deg rudder allows "
-                                 f"{gear_cap:.3g}: give delta_max_deg >= {deg(lim):.3g}")
-            raise InputError("gear.T_sg", f"{who}the course-unstable design model (T = {m.T:.4g} s) needs "
-                             f"omega_n >= {need:.3g} rad/s; a servo of T_sg = {m.T_sg:.3g} s allows "
-                             f"{gear_cap:.3g}: give T_sg <= {SERVO_FRACTION / need:.3g}")
-        w = max(w, need)
+        if need <= gear_cap:
+            return gear_cap
+        w = max(gear_cap, UNSTABLE_FLOOR * abs(m.a))
+        who = f"{law}: " if law else ""
+        require_servo_for_unstable(m, law, w)
+        asked, held = unstable_turn_rate(m, w, turn)
+        if asked > held:
+            lim = asked * abs(m.a) / m.b
+            raise InputError("gear.delta_max", f"{who}the course-unstable design model (K = {m.K:.4g} 1/s, T = "
+                             f"{m.T:.4g} s) needs omega_n >= {w:.3g} rad/s, whose turn asks for "
+                             f"{deg(asked):.3g} deg/s, and a {deg(m.delta_max):.3g} deg rudder holds at most "
+                             f"|K| delta_max = {deg(held):.3g} deg/s: give delta_max_deg >= {deg(lim):.3g}")
+        return w        # above the gear's limit/rate caps: the rudder saturates in the reference turn
     return w
 
 

@@ -41,8 +41,13 @@ Settings (``gains`` in the config; a value the user gives always wins):
   rule for its berthing ship).
 
 A course-unstable design model (``T < 0``) cannot be designed by this rule: the cancelled ship
-pole ``-1/T > 0`` stays a closed-loop pole. Such a ship is refused in one line naming
-``controller.type`` and the laws that design it (``pid``, ``lq_pd``).
+pole ``-1/T > 0`` would stay a closed-loop pole. With ``gains = "design"`` such a model is
+designed instead by PID pole placement on the same Nomoto model (Fossen 2011, Sec. 12.2.7;
+:func:`steerlab.control.pole_placement.pid_pole_placement`, the rule of ``pid``), which places
+every closed-loop pole at the shared bandwidth and cancels nothing; ``describe()`` names the
+rule that was used. ``gains = "paper"`` (or a given ``T01``) keeps the paper's rule and
+refuses a course-unstable model in one line naming ``controller.type`` and the laws that
+design it (``pid``, ``lq_pd``).
 """
 
 from __future__ import annotations
@@ -56,7 +61,7 @@ import math
 
 from steerlab.control.design_model import DESIGN_TURN, GEAR_USE, bandwidth, design_model
 from steerlab.control.pid import N_STATE, PID, pid_update
-from steerlab.control.pole_placement import INTEGRAL_DIVISOR
+from steerlab.control.pole_placement import INTEGRAL_DIVISOR, pid_pole_placement
 from steerlab.control.registry import ControllerSpec
 from steerlab.control.pid import PARAMS as PID_PARAMS
 from steerlab.errors import InputError, require_finite_range
@@ -66,7 +71,8 @@ PAPER_T01 = 20.0
 DESIGN_RULE = ("first-order closed-loop gain shaping on the Nomoto heading model (berthing paper 2019, eqs 17-19): "
                "kp = 1/(K T01), kd = T/(K T01); T01 = max(1/omega_n, 20 deg/(0.7 delta_max K)) from the shared "
                "bandwidth rule, ki = kp/(10 T01) with clamping anti-windup (gains = 'paper': T01 = 20 s, ki = 0); "
-               "course-unstable ships refused (use pid or lq_pd)")
+               "a course-unstable model (T < 0) is not cancelled: PID pole placement on the Nomoto model instead "
+               "(Fossen 2011, 12.2.7, as pid)")
 
 
 def gain_shaping_gains(T01: float, a2: float, a1: float, a0: float, b0: float) -> tuple[float, float, float]:
@@ -104,11 +110,17 @@ def design_T01(m) -> float:
 
 def build(cfg: GainShapingPIDConfig, ctx):
     m = design_model(ctx, cfg.K, cfg.T)
+    paper = cfg.gains == "paper"
+    if m.T < 0.0 and not paper and cfg.T01 is None:
+        # course-unstable: the gain-shaping zero would cancel the unstable pole -1/T > 0 (module doc);
+        # pole placement on the same model instead
+        d = pid_pole_placement(m, law="gain_shaping_pid")
+        c = PID(Kp=d.Kp, Ki=d.Ki if cfg.Ki is None else cfg.Ki, Kd=d.Kd, u_max=ctx.u_max(cfg.u_max_deg))
+        return c, c.pack()
     if not (m.T > 0.0 and math.isfinite(m.T)):
         raise InputError("controller.type", f"gain_shaping_pid cancels the ship pole -1/T, which stays a closed-loop "
                          f"pole: the design model (K = {m.K:.4g} 1/s, T = {m.T:.4g} s) is not course-stable; use "
-                         f"type = \"pid\" or \"lq_pd\"")
-    paper = cfg.gains == "paper"
+                         f"type = \"pid\" or \"lq_pd\" (or gains = \"design\" without T01)")
     T01 = cfg.T01 if cfg.T01 is not None else (PAPER_T01 if paper else design_T01(m))
     kp, ki, kd = nomoto_gain_shaping_gains(T01, m.K, m.T)
     if cfg.Ki is not None:
