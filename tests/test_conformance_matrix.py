@@ -147,6 +147,27 @@ def test_run_length_follows_the_ship_and_stays_bounded():
         assert 1000.0 <= duration - 50.0 <= 8000.0 and 300.0 <= hold <= 0.5 * (duration - 50.0)
 
 
+def test_a_scale_model_meets_the_froude_scaled_sea_and_is_judged_in_full_scale_time():
+    """The KVLCC2 L7 model (lambda = 45.7) gets sea state 5 at model scale, Hs / lambda and
+    Tp / sqrt(lambda), not the full-scale waves (3.25 m on a 7 m model); a full-size ship gets
+    the sea state itself; and the model's record is judged with time x sqrt(lambda)."""
+    from steerlab.conformance.cases import SEA, scenario_dict, sea_block
+    from steerlab.conformance.matrix import full_scale_time
+    from steerlab.environment.sea_state import sea_state
+
+    model, ship = get_ship("kvlcc2-l7"), get_ship("esso")
+    lam = model.model_scale
+    assert lam == pytest.approx(320.0 / 7.0, rel=1e-4)     # the catalogue stores 45.714
+    row = sea_state(5, "sea_state")
+    wave = sea_block(model)
+    assert wave["Hs"] == pytest.approx(row.Hs / lam) and wave["Tp"] == pytest.approx(row.Tp / math.sqrt(lam))
+    assert "sea_state" not in wave and wave["wave_angle_deg"] == SEA["wave_angle_deg"]
+    assert sea_block(ship) == SEA and full_scale_time(ship) == 1.0
+    assert full_scale_time(model) == pytest.approx(math.sqrt(lam))
+    case = Case("kvlcc2-l7", "pid", operating_points(model)[1], SEA5)
+    assert scenario_dict(case, 100.0)["environment"]["wave"] == wave
+
+
 def test_reused_sea_is_the_full_build():
     """build_case reuses a ship's sea for the next controller: the same setup, array for array."""
     from dataclasses import fields

@@ -12,7 +12,8 @@ import math
 import numpy as np
 import pytest
 
-from steerlab.control.adrc import HERBST, NO_CLAMP, OBSERVER_MULTIPLE
+from steerlab.control.adrc import HERBST, NO_CLAMP
+from steerlab.control.design_context import OBSERVER_MULTIPLE, OBSERVER_MULTIPLE_FILTERED
 from steerlab.control.backstepping_a import PAPER_GAINS, design_gains, stiffness
 from steerlab.control.design_model import ZETA, bandwidth, design_model
 from steerlab.control.estimators import PAPER_L, eso_poles
@@ -106,6 +107,25 @@ def test_adrc_designs_the_thesis_ships_with_c0_from_the_design_model(ship):
     with pytest.raises(InputError, match="block coefficient") as err:
         obj(ship, {"type": "adrc", "c0": "estimate"})
     assert err.value.field == "controller.c0"
+
+
+@pytest.mark.parametrize("law", ["adrc", "nonlinear_adrc"])
+def test_an_observer_behind_the_wave_filter_is_slower_than_on_a_direct_measurement(law):
+    """Behind the wave filter (``law+wf``) the ESO's bandwidth is OBSERVER_MULTIPLE_FILTERED
+    times the loop's, not OBSERVER_MULTIPLE: the residual wave motion the filter passes would
+    otherwise reach the rudder as (w_o / w_n)^3 (issue 30's sea leg: 10-16 reversals a minute)."""
+    ship = "capella-nomoto-10deg"
+    direct, filtered = obj(ship, {"type": law}), obj(ship, {"type": law + "+wf"}).inner
+    w = bandwidth(design_model(ctx_of(ship)))
+    assert OBSERVER_MULTIPLE_FILTERED < OBSERVER_MULTIPLE
+    if law == "adrc":
+        np.testing.assert_allclose(np.sort(eso_poles(direct.L).real), [-OBSERVER_MULTIPLE * w] * 3, rtol=1e-4)
+        np.testing.assert_allclose(np.sort(eso_poles(filtered.L).real), [-OBSERVER_MULTIPLE_FILTERED * w] * 3,
+                                   rtol=1e-4)
+        assert (filtered.Kp, filtered.Kd, filtered.c0) == (direct.Kp, direct.Kd, direct.c0)   # only the ESO moves
+    else:
+        assert filtered.beta[0] == pytest.approx(direct.beta[0] * OBSERVER_MULTIPLE_FILTERED / OBSERVER_MULTIPLE)
+        assert (filtered.k1, filtered.k2, filtered.b) == (direct.k1, direct.k2, direct.b)
 
 
 def test_adrc_design_of_a_course_unstable_ship_uses_the_exact_b2_and_a_loop_above_its_pole():

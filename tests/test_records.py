@@ -202,10 +202,10 @@ def test_wrapper_records_compose_with_the_inner_layout():
 
     assert (wrapper.Z_CALLS, wrapper.Z_PSI, wrapper.Z_R, wrapper.OFF_X) == (0, 1, 2, 3)
     assert (wrapper.P_HI, wrapper.P_SPSI, wrapper.P_DROP, wrapper.P_M, wrapper.OFF_P) == (0, 2, 6, 7, 8)
-    assert (wave_filter.F_PSI, wave_filter.F_R, wave_filter.F_XI, wave_filter.N_WF) == (0, 1, 6, 7)
-    assert (wave_filter.WF_TLF, wave_filter.WF_XIMIN, wave_filter.N_WF_PARAMS) == (0, 3, 4)
+    assert (wave_filter.F_PSI, wave_filter.F_R, wave_filter.F_XI, wave_filter.F_BIAS, wave_filter.N_WF) == (0, 1, 6, 7, 8)
+    assert (wave_filter.WF_TLF, wave_filter.WF_XIMIN, wave_filter.WF_KB, wave_filter.N_WF_PARAMS) == (0, 3, 4, 5)
     wf = wave_filtered
-    assert (wf.P_K, wf.P_T, wf.OFF_P, wf.OFF_X, wf.OFF_Z) == (4, 5, 6, 7, 7 + wf.NX_MAX)
+    assert (wf.P_K, wf.P_T, wf.OFF_P, wf.OFF_X, wf.OFF_Z) == (5, 6, 7, 8, 8 + wf.NX_MAX)
 
     inner = pid.PID(Kp=2.5, Ki=0.01, Kd=30.0, u_max=0.5)
     sensed = wrapper.sensed_layout(pid.PARAMS)
@@ -234,7 +234,8 @@ def test_wave_filter_config_comes_from_the_declaration():
 
     schema = wave_filter.WaveFilterConfig.model_json_schema()["properties"]
     for f in wave_filter.PARAMS.fields:
-        assert schema[f.name]["default"] == f.default and schema[f.name]["exclusiveMinimum"] == f.lo
+        assert schema[f.name]["default"] == f.default
+        assert schema[f.name]["exclusiveMinimum" if f.lo_open else "minimum"] == f.lo
         assert schema[f.name]["maximum"] == f.hi and f"[{f.unit}]" in schema[f.name]["description"]
     assert wave_filter.WaveFilterConfig().params() == wave_filter.WaveFilterParams()
     import pickle                                  # generated types travel to batch workers

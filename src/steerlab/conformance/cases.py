@@ -7,7 +7,9 @@ user would write: the ship at that point, the controller with its **default sett
 :func:`ship_gear`), ``dt`` = :data:`DT`, and a course change of
 :data:`~steerlab.conformance.judge.CHANGE_DEG` to starboard at :data:`T_CHANGE`. The sea is
 calm, or a JONSWAP spectrum of WMO sea state 5 (Hs 3.25 m, Tp 9.7 s) from 45 deg off the bow,
-seed :data:`SEA_SEED` (:data:`SEA`).
+seed :data:`SEA_SEED` (:data:`SEA`); on a scale model (``ShipSpec.model_scale`` = ``lambda``)
+the same sea Froude-scaled to the model, Hs / lambda and Tp / sqrt(lambda), as a towing tank
+sets it (:func:`sea_block`: the KVLCC2 L7 model, ``lambda`` = 45.7, gets Hs 7.1 cm, Tp 1.43 s).
 
 How long it runs follows the ship, not the law (:func:`time_scale`): a heading loop on the
 first-order Nomoto model ``r' = -r/T + (K/T) delta`` cannot be much faster than the gear lets
@@ -57,6 +59,21 @@ SEA = {"model": "spectrum", "spectrum": "jonswap", "sea_state": 5, "wave_angle_d
 """``[environment.wave]`` of the sea leg."""
 SEA_SEED = 1
 """Seed of the sea realisation (one realisation per case)."""
+
+
+def sea_block(spec) -> dict:
+    """``[environment.wave]`` of the sea leg on ship ``spec``: :data:`SEA`, or on a scale model
+    (``spec.model_scale`` = ``lambda`` = L_full / L_model) its Froude-scaled equivalent
+    ``Hs / lambda``, ``Tp / sqrt(lambda)`` (the full-scale sea state 5 at model scale: the ship's
+    lengths scale with ``lambda`` and its times with ``sqrt(lambda)``; ITTC 7.5-02-07-02.1)."""
+    lam = getattr(spec, "model_scale", None)
+    if not lam:
+        return dict(SEA)
+    from steerlab.environment.sea_state import sea_state
+
+    row = sea_state(SEA["sea_state"], "environment.wave.sea_state")
+    d = {k: v for k, v in SEA.items() if k != "sea_state"}
+    return {**d, "Hs": row.Hs / lam, "Tp": row.Tp / math.sqrt(lam)}
 
 
 def _default_gear() -> dict:
@@ -137,13 +154,14 @@ def scenario_dict(case: Case, duration: float) -> dict:
     """The scenario of ``case`` as a plain dict (the TOML shape; degrees and knots)."""
     from steerlab.ships.registry import get_ship
 
+    spec = get_ship(case.ship)
     ship = {"model": case.ship, "speed_kn": case.point.speed_kn}
     if case.point.rpm is not None:
         ship["options"] = {"rpm": case.point.rpm}
     d = {"name": f"conformance-{case.ship}-{case.controller}-{case.point.label}-{case.sea}",
-         "seed": SEA_SEED, "dt": DT, "duration": duration, "ship": ship, "gear": ship_gear(get_ship(case.ship)),
+         "seed": SEA_SEED, "dt": DT, "duration": duration, "ship": ship, "gear": ship_gear(spec),
          "controller": {"type": controller_type(case.controller, case.sea)},
          "guidance": {"psi0_deg": 0.0, "changes": [{"t": T_CHANGE, "psi_deg": CHANGE_DEG}]}}
     if case.sea == SEA5:
-        d["environment"] = {"wave": dict(SEA)}
+        d["environment"] = {"wave": sea_block(spec)}
     return d

@@ -191,10 +191,22 @@ def run_case(case: Case) -> Outcome:
             out.reason = f"crashed: the run raised {_one_line(err)}"
             out.seconds, out.cpu = time.perf_counter() - t0, time.process_time() - c0
             return out
-    j = judge(res.time, res.psi, res.delta, T_CHANGE, 0.0, math.radians(CHANGE_DEG), hold, case.sea == SEA5)
+    k = full_scale_time(spec)
+    j = judge(res.time * k, res.psi, res.delta, T_CHANGE * k, 0.0, math.radians(CHANGE_DEG), hold * k,
+              case.sea == SEA5)
     out.verdict, out.reason, out.metrics = j.verdict, j.reason, j.metrics
     out.seconds, out.cpu = time.perf_counter() - t0, time.process_time() - c0
     return out
+
+
+def full_scale_time(spec) -> float:
+    """Factor [-] from a run's time to the full-scale ship's: ``sqrt(lambda)`` for a scale model
+    (``spec.model_scale`` = ``lambda``; Froude's law), else 1. A scale model's record is judged in
+    full-scale time, so "six rudder reversals a minute" and the 60 s mean mean what they mean on
+    the ship (the model's sea is Froude-scaled too: :func:`~steerlab.conformance.cases.sea_block`);
+    its ``settle_time`` is reported in full-scale seconds."""
+    lam = getattr(spec, "model_scale", None)
+    return math.sqrt(lam) if lam else 1.0
 
 
 def _run_task(task: list[Case]) -> list[Outcome]:

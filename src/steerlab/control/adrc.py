@@ -39,8 +39,9 @@ Design rule (``gains = "design"``, the default; every value the user gives wins)
   placed at ``-omega_n``, capped by the gear's limit, rate and lag; a course-unstable ship gets
   ``omega_n >= 2 |1/T|`` (the ESO treats ``-r/T`` as part of the total disturbance) or a
   one-line refusal naming the gear field.
-* ``observer = "design"``: a triple ESO pole at ``-OBSERVER_MULTIPLE * 6 / T_settle``
-  (``OBSERVER_MULTIPLE = 5``; Gao 2003 advises an observer 3-10 times faster than the loop).
+* ``observer = "design"``: a triple ESO pole at ``-m * 6 / T_settle`` with ``m = 5`` (Gao 2003
+  advises an observer 3-10 times faster than the loop), ``m = 2`` behind the wave filter
+  (``"adrc+wf"``: :func:`steerlab.control.design_context.observer_multiple`).
 
 ``gains = "paper"``: unset values as in the paper's runs (``T_settle = 150 s``,
 ``c0 = "estimate"``, the paper's observer ``L``).
@@ -65,6 +66,7 @@ from steerlab.angles import wrap_to_pi
 from steerlab.config_base import FrozenConfig
 from steerlab.control.estimators import (ESO, PAPER_L, check_discrete_eso, eso_gains_bandwidth,
                                          eso_gains_lqr, eso_step)
+from steerlab.control.design_context import observer_multiple
 from steerlab.control.law_design import GAINS, GainsMode, law_bandwidth, law_model
 from steerlab.control.registry import ControllerSpec
 from steerlab.errors import InputError, require_finite_range
@@ -96,8 +98,6 @@ LAWS = ("stable", "printed")
 KD_RULES = ("herbst", "printed")
 #: The clamp value that means "off" (records hold finite numbers only).
 NO_CLAMP = 1e300
-#: ESO bandwidth of the design rule, in multiples of the loop's pole ``6 / T_settle`` [-].
-OBSERVER_MULTIPLE = 5.0
 #: ``T_settle`` = ``HERBST / omega_n``: the double pole of (38) at ``-omega_n``.
 HERBST = 6.0
 
@@ -229,7 +229,7 @@ def build(cfg: ADRCConfig, ctx):
     elif observer == "bandwidth":
         L = eso_gains_bandwidth(cfg.observer_bandwidth)
     elif observer == "design":
-        L = eso_gains_bandwidth(OBSERVER_MULTIPLE * HERBST / T_settle)
+        L = eso_gains_bandwidth(observer_multiple(ctx) * HERBST / T_settle)
     else:
         L = eso_gains_lqr(cfg.lqr_q, cfg.lqr_r)
     field = "controller.L" if cfg.L is not None else (
@@ -249,5 +249,5 @@ CONTROLLER = ControllerSpec(
     source="Zwierzewicz, Dorobczynski, Artyszuk (2021) Energies 14:7937, Secs 2 and 5, eqs (7), (38)",
     params=PARAMS,
     design_rule=("T_settle = 6/omega_n (Herbst's double pole of eq 38 at the shared bandwidth omega_n), ESO "
-                 "triple pole at 5x the loop's (Gao 2003), c0 = the design model's b2 (exact linearisation, "
+                 "triple pole at 5x the loop's (Gao 2003; 2x behind the wave filter), c0 = the design model's b2 (exact linearisation, "
                  "else K/T); anti-windup: ESO fed the limited order, |xh3| <= |c0| u_max"))

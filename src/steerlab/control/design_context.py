@@ -26,6 +26,7 @@ class DesignContext:
     dt: float
     sample_time: float
     ship_options: object = None
+    measurement: str = "direct"
 
     def b2(self, method: str) -> float:
         """Rudder efficiency ``b2`` [1/s^2] at the design speed: ``"exact"`` or ``"estimate"`` (eq 29)."""
@@ -38,3 +39,23 @@ class DesignContext:
     def u_max(self, u_max_deg: float | None) -> float:
         """The controller's output limit [rad]: the configured one, or the gear's limit."""
         return rad(u_max_deg) if u_max_deg is not None else self.gear.delta_max
+
+
+OBSERVER_MULTIPLE = 5.0
+"""Bandwidth of a law's extended-state observer in multiples of its loop's, on a direct
+measurement [-] (Gao 2003 advises 3-10)."""
+OBSERVER_MULTIPLE_FILTERED = 2.0
+"""The same behind the wave filter [-]. The filter's low-frequency heading still carries a
+residual of the wave motion; a third-order observer turns a ripple ``e`` at the encounter
+frequency ``w_e`` into a disturbance estimate of about ``w_o^3 e / w_e`` and a rudder order
+of that over ``b2``, so the ripple reaches the rudder as ``(w_o / w_n)^3``: 5x the loop's
+bandwidth gave 10-16 rudder reversals a minute in sea state 5 on the conformance matrix's
+ships, 2x gives 2-5 while the course is held (docs/conformance.md). Below Gao's range, which
+assumes a clean measurement."""
+
+
+def observer_multiple(ctx) -> float:
+    """The observer's bandwidth over the loop's [-] for the measurement of ``ctx``
+    (:data:`OBSERVER_MULTIPLE` direct, :data:`OBSERVER_MULTIPLE_FILTERED` behind the wave filter)."""
+    return OBSERVER_MULTIPLE_FILTERED if getattr(ctx, "measurement", "direct") == "wave-filtered" \
+        else OBSERVER_MULTIPLE

@@ -47,7 +47,8 @@ the gear's rate and lag and above a course-unstable ship's pole. So by default
 * ``b``: the design model's ``b2`` (exact linearisation, else ``K/T``; a neutral ship with
   infinite ``K``, ``T``: its ``b2``);
 * ``omega_c = omega_n`` (NLSEF linear zone ``s^2 + 2 omega_c s + omega_c^2``, above);
-* ``omega_o = OBSERVER_MULTIPLE * omega_c`` (``OBSERVER_MULTIPLE = 5``, Gao 2003: 3-10).
+* ``omega_o = m omega_c``, ``m = 5`` (Gao 2003: 3-10); ``m = 2`` behind the wave filter
+  (:func:`steerlab.control.design_context.observer_multiple`).
 
 The ESO lumps ``-r/T`` into the total disturbance ``f``, so a course-unstable ship (``T < 0``,
 ``b > 0``) is designed like any other once ``omega_n`` exceeds its unstable pole (the shared
@@ -75,6 +76,7 @@ from pydantic import Field, create_model, field_validator
 
 from steerlab.angles import wrap_to_pi
 from steerlab.config_base import FrozenConfig
+from steerlab.control.design_context import observer_multiple
 from steerlab.control.law_design import GAINS, law_bandwidth, law_model
 from steerlab.control.nonlinear_eso import NLESO, fal, nleso_gains_bandwidth, nleso_step
 from steerlab.control.registry import ControllerSpec
@@ -119,8 +121,6 @@ PARAMS = Layout("controller", "N_", [
                 lo=0.0, hi=1.0, default=0.0),
 ], size_name="N_PARAMS")
 PARAMS.export(globals())   # N_B = 0, N_BETA1..3, N_A01, ..., N_UMAX = 16, N_FMAX = 17, N_ESOIN = 18, N_PARAMS = 19
-#: ESO bandwidth of the design rule in multiples of the NLSEF's ``omega_c`` [-].
-OBSERVER_MULTIPLE = 5.0
 STATE = Layout("controller state", "Z_", TD.fields + NLESO.fields, size_name="N_STATE")
 STATE.export(globals())    # TD: Z_V1 = 0, Z_V2 = 1; ESO: Z_Z1 = 2, Z_Z2 = 3, Z_Z3 = 4; N_STATE = 5
 
@@ -269,7 +269,7 @@ def build(cfg: NonlinearADRCConfig, ctx):
         if omega_o is None and cfg.beta is None and cfg.reference_b is None:
             if omega_c is None:
                 omega_c = law_bandwidth(ctx, "nonlinear_adrc")[1]
-            omega_o = OBSERVER_MULTIPLE * omega_c
+            omega_o = observer_multiple(ctx) * omega_c
     if cfg.reference_b is not None:
         if cfg.k1 is None or cfg.k2 is None or cfg.beta is None:
             raise InputError("controller.reference_b", "needs k1, k2 and beta (the reference ship's setting)")

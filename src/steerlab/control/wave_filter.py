@@ -29,6 +29,24 @@ Update with the measured heading ``psi`` (eqs 4.75-4.76 [reconstructed: alpha-be
     psi^   = psi- + k_psi eps
     r^     = r-   + k_r eps / h
 
+Yaw-bias state (steerlab's addition, ``bias_gain`` > 0; off in the thesis' filter and with
+``gains = "paper"``): the prediction uses ``K delta + tau b`` for ``K delta``, i.e. the model
+``tau r' + r = K delta + tau b`` with a constant yaw-acceleration bias ``b`` [rad/s^2], and
+``b`` is corrected as the third state of an alpha-beta-gamma tracker::
+
+    b^     = b- + bias_gain (k_r^2 / (2 k_psi)) eps / h^2
+
+(``gamma = beta^2 / (2 alpha)`` with ``alpha = k_psi`` and ``beta = k_r``: the steady-state
+relation of the alpha-beta-gamma tracker in Kalata's (1984) convention; the error dynamics are
+stable for every ``0 < k_psi <= 1``, checked in tests/test_wave_filter_bias.py; at
+``k_psi = 0.002`` the slowest pole has a time constant of about 200 s).
+Without it a model that is wrong at low frequency (a 3-DOF ship whose ``b2`` is not ``K/T``,
+a mean rudder that holds the course against an asymmetry or a drift moment) leaves a
+low-frequency innovation, which the noise-adaptive gain reads as "no waves": ``xi`` rises
+10-15-fold and the filter passes the waves to the rudder (issue 30's sea leg: the B-481 and
+the Mariner behind ``pid+wf``, 13.5 reversals a minute; with the bias state 3-4 and the
+course held). Fossen's heading observer carries the same kind of bias state (Fossen 2011, Ch. 11).
+
 Noise-adaptive gains (eqs 4.66-4.73 [reconstructed]). The innovation is split by a
 first-order low-pass of time constant ``T_lf`` into a low-frequency part ``eps_L`` (model
 error: wind, wrong K or tau) and a high-frequency part ``eps_H = eps - eps_L`` (waves); their
@@ -80,6 +98,7 @@ STATE = Layout("wave filter state", "F_", [
     RecordField("PL", "P_L", "rad^2", "power of the LF innovation"),
     RecordField("PH", "P_H", "rad^2", "power of the HF innovation"),
     RecordField("XI", "xi", "-", "noise level xi = k_psi (1: no noise seen)"),
+    RecordField("BIAS", "yaw_bias", "rad/s^2", "estimated yaw-acceleration bias b (the model's error)"),
 ], size_name="N_WF")
 STATE.export(globals())          # F_PSI = 0, F_R = 1, F_DELTA = 2, F_ELF = 3, F_PL = 4, F_PH = 5, F_XI = 6, N_WF = 7
 
@@ -91,6 +110,8 @@ PARAMS = Layout("controller.wave_filter", "WF_", [
     RecordField("P0", "P0", "rad^2", "noise floor (xi -> 1 below it)", 0.0, 1.0, lo_open=True, default=1e-8),
     RecordField("XIMIN", "xi_min", "-", "lower bound of xi and of the filter gain k_psi", 0.0, 1.0, lo_open=True,
                 default=0.02),
+    RecordField("KB", "bias_gain", "-", "gain of the yaw-bias estimate b, in units of the alpha-beta-gamma "
+                "tracker's gamma (0: no bias state, the thesis' filter)", 0.0, 10.0, default=0.0),
 ], size_name="N_WF_PARAMS")
 PARAMS.export(globals())         # WF_TLF = 0, WF_TPOW = 1, WF_P0 = 2, WF_XIMIN = 3, N_WF_PARAMS = 4
 
@@ -108,7 +129,7 @@ WaveFilterParams.__module__ = __name__
 
 class _WaveFilterConfigBase(FrozenConfig):
     def params(self) -> "WaveFilterParams":
-        return WaveFilterParams(self.T_lf, self.T_pow, self.P0, self.xi_min)
+        return WaveFilterParams(self.T_lf, self.T_pow, self.P0, self.xi_min, self.bias_gain)
 
 
 WaveFilterConfig = create_model(
@@ -120,10 +141,11 @@ WaveFilterConfig.__module__ = __name__
 
 DESIGN_H = 1.0
 """Sample time [s] at which the designed filter settings were tuned (the default scenario)."""
-DESIGN_FILTER = WaveFilterParams(T_lf=60.0, T_pow=60.0, P0=1e-10, xi_min=0.002)
+DESIGN_FILTER = WaveFilterParams(T_lf=60.0, T_pow=60.0, P0=1e-10, xi_min=0.002, bias_gain=1.0)
 """The filter settings tuned at :data:`DESIGN_H` for a sea: the bundled default scenario's
 (Esso, sea state 6, 1 s sample: 59 rudder reversals in 1 500 s against 296 without the
-filter, the same heading error; src/steerlab/scenarios/default.toml)."""
+filter, the same heading error; src/steerlab/scenarios/default.toml), with the yaw-bias state on
+(``bias_gain = 1``, module docstring)."""
 
 
 def design_filter(sample_time: float) -> WaveFilterParams:
@@ -167,6 +189,7 @@ def wave_filter_init(zf, psi, r, delta):
     zf[F_PL] = 0.0
     zf[F_PH] = 0.0
     zf[F_XI] = 1.0
+    zf[F_BIAS] = 0.0
 
 
 @numba.njit(cache=True)
@@ -187,7 +210,7 @@ def wave_filter_step(zf, pf, K, tau, psi_meas, delta, h):
     d = 0.5 * (zf[F_DELTA] + delta)
     a = math.exp(-h / tau)
     r0 = zf[F_R]
-    drive = K * d - r0
+    drive = K * d + tau * zf[F_BIAS] - r0
     r_pred = r0 + (1.0 - a) * drive
     psi_pred = zf[F_PSI] + h * r0 + (h - tau * (1.0 - a)) * drive
     eps = wrap_to_pi(psi_meas - psi_pred)
@@ -205,6 +228,7 @@ def wave_filter_step(zf, pf, K, tau, psi_meas, delta, h):
     k_r = k_psi * k_psi / (2.0 - k_psi)
     zf[F_PSI] = wrap_to_pi(psi_pred + k_psi * eps)
     zf[F_R] = r_pred + k_r * eps / h
+    zf[F_BIAS] += pf[WF_KB] * (k_r * k_r / (2.0 * k_psi)) * eps / (h * h)
     zf[F_DELTA] = delta
     zf[F_ELF] = elf
     zf[F_PL] = pl

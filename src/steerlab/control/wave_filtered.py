@@ -46,6 +46,7 @@ controller's block plus ``wave_filter = {...}``::
 
 from __future__ import annotations
 
+from dataclasses import is_dataclass, replace
 from functools import lru_cache
 from typing import Literal, NamedTuple, Optional
 
@@ -183,7 +184,7 @@ def wave_filtered(spec: ControllerSpec) -> ControllerSpec:
         data = cfg.model_dump(exclude={"wave_filter", "filter_K", "filter_T"})
         data["type"] = spec.name
         inner_cfg = spec.config.model_validate(data)
-        inner, inner_p = spec.build(inner_cfg, ctx)
+        inner, inner_p = spec.build(inner_cfg, _behind_filter(ctx))
         if ctx.ship.n_states + 1 > NX_MAX:
             raise InputError("ship.model", f"plant state of {ctx.ship.n_states + 1} > {NX_MAX} values: "
                              "too large for '+wf'")
@@ -201,6 +202,11 @@ def wave_filtered(spec: ControllerSpec) -> ControllerSpec:
         source=f"{spec.source}; wave filter: van Amerongen (1982) Fig. 4.13-4.14", design_rule=spec.design_rule,
         params=None if spec.params is None else wave_filtered_layout(spec.params),
         recipe=(wave_filtered, (spec,)))
+
+
+def _behind_filter(ctx):
+    """``ctx`` with ``measurement = "wave-filtered"``: the inner law sees the filter's estimates."""
+    return replace(ctx, measurement="wave-filtered") if is_dataclass(ctx) and hasattr(ctx, "measurement") else ctx
 
 
 def wave_filtered_variants(spec: ControllerSpec) -> list:
