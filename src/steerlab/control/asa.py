@@ -45,7 +45,11 @@ the same closed-loop condition), the hold time and the integral ``|tau|``. A ser
 for the instability is refused as by every law
 (:func:`~steerlab.control.design_model.require_servo_for_unstable`). ``gains = "paper"``
 refuses a course-unstable ship in one line naming ``controller.type`` and laws that design it.
-Designed from ``(K, T)`` alone (no speed), the cruising speed is :func:`nomoto_only_speed`
+Its wave filter (``wave_filter = {...}``, every setting unset) is the one designed for the
+sample time (:func:`steerlab.control.wave_filter.design_filter`: the noise floor scaled as
+``h^4`` and the yaw-bias state, as for every ``"<law>+wf"``); with ``gains = "paper"`` the
+thesis' per-sample defaults, which at a 0.1 s step pass the waves (issue 30's sea-state-5 leg:
+ASA held the course in 1 of 79 cases with them). Designed from ``(K, T)`` alone (no speed), the cruising speed is :func:`nomoto_only_speed`
 (``K* = 1``). Anti-windup: the integral ``Ki`` of
 course keeping integrates only while the order is not limited or the error drives it back, and
 is clamped to the limit; in course changing the adaptation stops while the order is limited
@@ -91,7 +95,8 @@ from steerlab.control.design_model import design_model, require_servo_for_unstab
 from steerlab.control.law_design import GAINS, GainsMode
 from steerlab.control.registry import ControllerSpec
 from steerlab.control.wave_filter import PARAMS as WF_PARAMS
-from steerlab.control.wave_filter import (F_DELTA, F_PSI, F_R, F_XI, WaveFilterConfig, WaveFilterParams,
+from steerlab.control.wave_filter import WaveFilterSettings, filter_params
+from steerlab.control.wave_filter import (F_DELTA, F_PSI, F_R, F_XI, WaveFilterParams,
                                           wave_filter_init, wave_filter_step)
 from steerlab.errors import InputError, require_finite_range
 from steerlab.units import knots_to_ms, rad
@@ -323,7 +328,7 @@ class ASAConfig(FrozenConfig):
     rudder_limit_factor: float = Field(4.0, gt=0.0, le=100.0, description="f_delta of (4.85)")
     accel_margin: float = Field(0.5, gt=0.0, le=1.0, description="rho of the model's rudder limiter")
     use_estimator: bool = True
-    wave_filter: WaveFilterConfig = WaveFilterConfig()
+    wave_filter: Optional[WaveFilterSettings] = None
     u_max_deg: Optional[float] = Field(None, gt=0.0, le=90.0, description="default: gear limit")
     sample_time: Optional[float] = Field(None, gt=0.0, le=60.0, description="default: dt")
 
@@ -420,7 +425,8 @@ def build(cfg: ASAConfig, ctx):
             threshold=rad(cfg.change_threshold_deg), n_hold=cfg.hold_time_constants,
             K_star_bounds=(ks_lo, ks_hi), tau_star_bounds=(ts_lo, ts_hi),
             n_ti=cfg.integral_time_constants, rho_acc=cfg.accel_margin, f_delta=cfg.rudder_limit_factor,
-            use_estimator=cfg.use_estimator, wave_filter=cfg.wave_filter.params())
+            use_estimator=cfg.use_estimator,
+            wave_filter=filter_params(cfg.wave_filter, ctx.sample_time, cfg.gains == "paper"))
     return c, c.pack()
 
 
