@@ -109,9 +109,8 @@ def test_designed_from_K_T_only_steers_a_plain_python_plant(law, cfg):
 @pytest.mark.parametrize("law,kw,field", [
     ("adrc", {}, "nomoto"),                                    # b2 needs a model
     ("lq_pd", {}, "nomoto"),
-    ("asa", {"nomoto": (0.05, 80.0)}, "speed_kn"),             # K* = K L/U, tau* = T U/L
     ("backstepping_a", {"ship": "esso", "speed_kn": 16.0}, "type"),   # b2 != K/T: names backstepping_b
-    ("asa", {"ship": "esso", "speed_kn": 16.0}, "type"),   # course-unstable: names laws that can
+    ("asa", {"ship": "esso", "speed_kn": 16.0, "gains": "paper"}, "type"),   # the thesis' ASA, course-unstable
     ("pid", {"ship": "kosoko", "speed_kn": 16.0}, "speed_kn"),      # outside its range (no speed: design speed)
     ("pid", {"ship": "esso", "speed_kn": 16.0, "nomoto": (0.1, 50.0)}, "nomoto"),
     ("pid", {"Kp": -1.0}, "Kp"),

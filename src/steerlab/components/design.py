@@ -191,15 +191,15 @@ def design_context(ship: Optional[str] = None, speed_kn: Optional[float] = None,
                                          f"[{lo / knots_to_ms(1.0):.4g}, {hi / knots_to_ms(1.0):.4g}] kn")
         opts = spec.options(ship_options) if hasattr(spec, "options") else ship_options
         if b2 is not None:
-            return GivenB2Context(spec, speed, g, sample_time, sample_time, opts, b2)
+            return GivenB2Context(spec, speed, g, sample_time, sample_time, opts, b2_value=b2)
         return DesignContext(spec, speed, g, sample_time, sample_time, opts)
     if ship_options is not None:
         raise InputError("ship_options", "only with ship=ID")
     if nomoto is not None:
         model = NomotoModel.checked(nomoto, length_m, b2)
-        return GivenB2Context(model, speed, g, sample_time, sample_time, None, model.b2_value)
+        return GivenB2Context(model, speed, g, sample_time, sample_time, None, b2_value=model.b2_value)
     if length_m is not None:
         raise InputError("length_m", "only with nomoto=(K, T)")
     if b2 is not None:
-        return GivenB2Context(NoModel(), speed, g, sample_time, sample_time, None, b2)
+        return GivenB2Context(NoModel(), speed, g, sample_time, sample_time, None, b2_value=b2)
     return DesignContext(NoModel(), speed, g, sample_time, sample_time, None)

@@ -151,7 +151,9 @@ class BridgeServer:
         if operator is None:
             from steerlab.runtime.operator_session import OperatorSession
 
-            operator = getattr(autopilot, "operator", None) or OperatorSession()
+            operator = getattr(autopilot, "operator", None)
+            if not isinstance(operator, OperatorSession):     # an autopilot without a session of its own
+                operator = OperatorSession()
         self.operator = operator
         self.counts = {"refused_http": 0, "rate_limited": 0, "refused_full": 0, "operator": 0,
                        "operator_refused": 0}

@@ -245,13 +245,19 @@ def advance_ratio_straight(c_items: tuple = tuple(sorted(COEFFICIENTS.items())))
     """Advance ratio ``J`` of the straight, upright course: ``X' = 0`` with ``v = r = phi = delta = 0``.
 
     There ``X_uu + (1 - t) 2 (D/L)^2 (1 - w_P)^2 K_T(J) / J^2 = 0`` does not depend on the
-    speed, so the self-propulsion rate is proportional to it: ``n = (1 - w_P) U / (J D)``.
+    speed, so the self-propulsion rate is proportional to it: ``n = (1 - w_P) U / (J D)``. With
+    ``K_T = 0.527 - 0.455 J`` (container.m) it is the quadratic ``X_uu J^2 - 0.455 k J + 0.527 k = 0``
+    (``k = 2 (1 - t) (D/L)^2 (1 - w_P)^2``), solved in closed form: its root with ``K_T > 0``
+    (``X_uu < 0``: the other root is negative). No scipy: listing the catalogue loads no solver.
     """
-    from scipy.optimize import brentq
-
     c = dict(c_items)
     k = 2.0 * (1.0 - c["t"]) * (c["D"] / L_CONTAINER) ** 2 * (1.0 - c["wp"]) ** 2
-    return float(brentq(lambda J: c["Xuu"] + k * (0.527 - 0.455 * J) / J**2, 0.05, 0.527 / 0.455, xtol=1e-15))
+    a, b, cc = c["Xuu"], -0.455 * k, 0.527 * k
+    roots = [(-b + sgn * math.sqrt(b * b - 4.0 * a * cc)) / (2.0 * a) for sgn in (1.0, -1.0)]
+    J = [x for x in roots if 0.0 < x < 0.527 / 0.455]
+    if len(J) != 1:
+        raise ValueError(f"container.m's straight-course advance ratio: roots {roots}, expected one in (0, 1.158)")
+    return float(J[0])
 
 
 def propeller_rate_for_speed(speed: float) -> float:
