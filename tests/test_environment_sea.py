@@ -247,6 +247,45 @@ def test_wave_routing_by_channel_probe():
     assert np.any(build(_sc(th)).w[:, W_RUDDER] != 0)
 
 
+def test_norrbin_ship_takes_spectrum_waves_superposed():
+    """A Norrbin ship gets the wave-frequency yaw rate on its rate of turn; a Nomoto ship the
+    equivalent rudder, as before; ``channel = "yaw_moment"`` still sends the moment through
+    Norrbin's equations."""
+    spec = {"wave": {"model": "spectrum", "sea_state": 5, "n_components": 64}}
+    nor = build(_sc(spec, ship="capella-norrbin", duration=50.0)).w
+    assert np.any(nor[:, W_YAW_RATE] != 0) and not np.any(nor[:, W_YAW_MOMENT]) and not np.any(nor[:, W_RUDDER])
+    lin = build(_sc(spec, ship="capella-nomoto-10deg", duration=50.0)).w
+    assert np.any(lin[:, W_RUDDER] != 0) and not np.any(lin[:, W_YAW_RATE])
+    through = {"wave": {**spec["wave"], "channel": "yaw_moment"}}
+    old = build(_sc(through, ship="capella-norrbin", duration=50.0)).w
+    assert np.any(old[:, W_YAW_MOMENT] != 0) and not np.any(old[:, W_YAW_RATE])
+
+
+@pytest.mark.parametrize("T", [40.0, -40.0, math.inf])
+def test_superposed_wave_yaw_rate_is_the_linear_hull_response(T):
+    """``wave_yaw_rate`` is the steady solution of r' + r/|T| = a_w(t): integrate that ODE on a
+    fine grid from rest and compare once the transient exp(-t/|T|) has died (T = inf: the
+    transient is a constant, removed by comparing the derivative)."""
+    from steerlab.environment.wave_superposition import wave_yaw_acceleration, wave_yaw_rate
+
+    rng = np.random.default_rng(3)
+    comp = wave_components(lambda w: jonswap(w, 3.0, 8.0), 2 * math.pi / 8.0, 32, rng, 5.0, math.radians(150.0))
+    dt, n = 0.005, 120_000                    # 600 s
+    acc = wave_yaw_acceleration(comp, n, dt, 0.01, 60.0, math.radians(150.0))
+    rw = wave_yaw_rate(comp, n, dt, 0.01, 60.0, math.radians(150.0), T)
+    a = 0.0 if math.isinf(T) else 1.0 / abs(T)
+    # the ODE holds on the grid: r' + a r = acc (central differences, O(dt^2))
+    lhs = (rw[2:] - rw[:-2]) / (2 * dt) + a * rw[1:-1]
+    np.testing.assert_allclose(lhs, acc[1:-1], rtol=0, atol=2e-4 * np.abs(acc).max())
+    if a > 0:                                 # and a run from rest reaches it (trapezoid rule)
+        r = np.zeros(n)
+        e = (1 - a * dt / 2) / (1 + a * dt / 2)
+        for k in range(n - 1):
+            r[k + 1] = e * r[k] + dt / 2 * (acc[k] + acc[k + 1]) / (1 + a * dt / 2)
+        tail = slice(n // 2, None)            # 300 s = 7.5 |T|: the transient is e^-7.5 of it
+        np.testing.assert_allclose(r[tail], rw[tail], rtol=0, atol=2e-3 * np.abs(rw).max())
+
+
 def test_current_moves_the_track_not_the_heading():
     """Thesis 2.4.2: a uniform (and a slowly varying) current leaves the heading unchanged."""
     from steerlab.sim.engine import simulate

@@ -17,7 +17,12 @@ Routing of the wave disturbance (``[environment.wave] channel``):
   efficiency ``b2`` of the ship's linearisation, or eq 29's estimate when the ship has none,
   equals the wave's; at wave frequencies this, not the low-frequency Nomoto ``K/T``, is the
   rudder's effect: for the course-unstable Esso tanker ``K/T`` is 2.5 times smaller than
-  ``b2``). ``auto``: ``yaw_moment`` if the ship reads it, otherwise ``rudder``. Large
+  ``b2``); ``yaw_rate``: the wave-frequency yaw rate, the linear first-order response of that
+  yaw acceleration (:func:`~steerlab.environment.wave_superposition.wave_yaw_rate`), added to
+  the rate of turn. ``auto``: ``yaw_rate`` for a ship whose ``wave_motion`` is
+  ``"superposed"`` (Norrbin's model: its spiral polynomial is steady-turn physics, so the wave
+  motion is superposed on its output, as the thesis' wave model and every wave filter assume),
+  else ``yaw_moment`` if the ship reads it, otherwise ``rudder``. Large
   ships in oblique seas can need equivalent angles beyond the rudder limit: the wave moment
   exceeds what the rudder can oppose, which is why autopilots filter the waves out.
 * eq (39): as before, equivalent rudder (``W_RUDDER``).
@@ -44,7 +49,7 @@ from steerlab.environment.sea_state import sea_state
 from steerlab.environment.spectra import spectrum, spectrum_peak_period
 from steerlab.environment.encounter import encounter_frequency
 from steerlab.environment.wave_superposition import (daidola_gain, wave_components,
-                                                     wave_yaw_acceleration)
+                                                     wave_yaw_acceleration, wave_yaw_rate)
 from steerlab.environment.waves_thesis import thesis_wave_yaw_rate
 from steerlab.environment.wind_thesis import wind_equivalent_rudder
 from steerlab.errors import InputError
@@ -131,9 +136,10 @@ def yaw_gain(cfg, ship) -> tuple[float, float]:
 _CODES = {"yaw_rate": W_YAW_RATE, "yaw_moment": W_YAW_MOMENT, "rudder": W_RUDDER}
 
 
-def _route(cfg, ctx: SeaContext, allowed):
-    """The channel the waves go to: ``auto``'s choice, or the configured one if the model offers
-    it and the ship reads it (a channel the ship does not read would be a calm sea, silently)."""
+def _route(cfg, ctx: SeaContext, allowed, preferred=None):
+    """The channel the waves go to: ``auto``'s choice (``preferred`` if the ship reads it), or
+    the configured one if the model offers it and the ship reads it (a channel the ship does
+    not read would be a calm sea, silently)."""
     ch = cfg.channel
     if ch not in allowed and ch != "auto":
         raise InputError(f"{F}.channel", f"{ch!r} not available for model {cfg.model!r}; allowed: auto, {', '.join(allowed)}")
@@ -145,7 +151,10 @@ def _route(cfg, ctx: SeaContext, allowed):
         return reads[c]
 
     if ch == "auto":
-        ch = allowed[0] if read(allowed[0]) else "rudder"
+        if preferred is not None and read(preferred):
+            ch = preferred
+        else:
+            ch = allowed[0] if read(allowed[0]) else "rudder"
     if not read(ch):
         read_by_ship = [c for c in allowed if read(c)]
         if not read_by_ship:
@@ -180,8 +189,13 @@ def add_waves(w: np.ndarray, cfg, ctx: SeaContext, dt: float, seed: int) -> None
     # spectrum
     comp = spectrum_components(cfg, ctx.speed, seed)
     L, gain = yaw_gain(cfg, ctx.ship)
+    superposed = getattr(ctx.ship, "wave_motion", "through-hull") == "superposed"
+    route = _route(cfg, ctx, ("yaw_moment", "rudder", "yaw_rate"), "yaw_rate" if superposed else None)
+    if route == "yaw_rate":
+        _, T = ctx.nomoto()
+        w[:, W_YAW_RATE] += wave_yaw_rate(comp, n_steps + 1, dt, gain, L, gamma, T)
+        return
     acc = wave_yaw_acceleration(comp, n_steps + 1, dt, gain, L, gamma)
-    route = _route(cfg, ctx, ("yaw_moment", "rudder"))
     if route == "yaw_moment":
         w[:, W_YAW_MOMENT] += acc
     else:

@@ -108,12 +108,34 @@ def wave_elevation(comp: WaveComponents, n: int, dt: float) -> np.ndarray:
     return superpose(comp, n, dt, None, "cos")
 
 
+def _yaw_weights(comp: WaveComponents, gain: float, L: float, gamma: float) -> np.ndarray:
+    """Per-component yaw acceleration per unit amplitude [rad/s^2/m]: ``gain sin(2 gamma) k_i F_i``."""
+    k = comp.w**2 / G
+    return k * length_factor(k, L, gamma) * gain * math.sin(2.0 * gamma)
+
+
 def wave_yaw_acceleration(comp: WaveComponents, n: int, dt: float, gain: float, L: float,
                           gamma: float) -> np.ndarray:
     """Yaw acceleration [rad/s^2] on the grid ``k dt``: ``gain sin(2 gamma) sum a_i k_i F_i sin(w_e,i t + phi_i)``."""
-    k = comp.w**2 / G
-    weights = k * length_factor(k, L, gamma) * gain * math.sin(2.0 * gamma)
-    return superpose(comp, n, dt, weights, "sin")
+    return superpose(comp, n, dt, _yaw_weights(comp, gain, L, gamma), "sin")
+
+
+def wave_yaw_rate(comp: WaveComponents, n: int, dt: float, gain: float, L: float, gamma: float,
+                  T: float) -> np.ndarray:
+    """Wave-frequency yaw rate [rad/s]: the steady response of ``r_w' + r_w / |T| = a_w(t)``.
+
+    ``a_w`` is :func:`wave_yaw_acceleration`; each component ``A sin(w t + phi)`` (``w`` the
+    signed encounter frequency) gives ``A (a sin(w t + phi) - w cos(w t + phi)) / (a^2 + w^2)``
+    with ``a = 1/|T|`` [1/s] (``T = inf``: a pure inertia, ``a = 0``). This is the first-order
+    Nomoto hull's linear response, superposed on a nonlinear manoeuvring model's rate of turn
+    (``ShipSpec.wave_motion = "superposed"``); at ``w >> a`` the sign of ``T`` does not matter,
+    so a course-unstable ship's wave motion is that of its stable mirror image.
+    """
+    a = 0.0 if not math.isfinite(T) or T == 0.0 else 1.0 / abs(T)
+    w = comp.we
+    den = a * a + w * w
+    # Im[(P + iQ) e^{i theta}] = P sin(theta) + Q cos(theta), P = a/den, Q = -w/den
+    return superpose(comp, n, dt, _yaw_weights(comp, gain, L, gamma) * (a - 1j * w) / den, "sin")
 
 
 def encounter_spectrum(comp: WaveComponents, edges: np.ndarray, weights=None) -> np.ndarray:

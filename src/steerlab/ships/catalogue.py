@@ -295,7 +295,8 @@ def _make_spec(entry: CatalogueEntry):
         options_model=opts_model, nomoto_KT=nomoto_KT, speed_range=speed_range,
         equilibrium_rudder=eq_rudder, symmetric=symmetric, catalogue=entry.describe(),
         model_scale=None if entry.model_scale is None else float(entry.model_scale),
-        estimate_unavailable=unavailable)
+        estimate_unavailable=unavailable,
+        wave_motion="superposed" if entry.model == "norrbin" else "through-hull")
 
 
 @lru_cache(maxsize=None)

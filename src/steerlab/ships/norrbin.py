@@ -5,12 +5,20 @@ Pomirski eq 12; Fossen's form)::
 
     T r' + H_N(r) = K (delta + w[W_RUDDER])  (+ T w[W_YAW_MOMENT])
     H_N(r) = n3 r^3 + n2 r^2 + n2a r|r| + n1 r + n0          (spiral_polynomial)
+    psi' = r + w[W_YAW_RATE]
+
+``H_N`` is fitted to steady turns (the spiral test): it is low-frequency manoeuvring physics.
+Waves therefore reach this ship *superposed* by default (``ShipSpec.wave_motion``): the
+wave-frequency yaw rate is added to the rate of turn (``W_YAW_RATE``, as the thesis' own wave
+model does, van Amerongen 1982 Fig. 2.18, and as a wave filter assumes, psi = psi_LF +
+psi_WF), not passed through ``n3 r^3`` (whose statistical linearisation about a wave-frequency
+yaw rate of std sigma adds ``3 n3 sigma^2`` to the linear damping; docs/environment.md).
 
 ``n1 = +1`` for a course-stable ship and ``-1`` for a course-unstable one (then ``K`` and
 ``T`` are the magnitudes). In the steady state ``delta = H_N(r)/K``: the reversed spiral, so
 the thesis' coefficients ``alpha_i = c_i / c1`` (eq 2.29). ``n2`` is the (asymmetric) r^2 term
 of the thesis and of Morawski; ``n2a`` the symmetric r|r| term of Fossen's form.
-``psi' = r``; constant surge ``u``, no sway; position as in :mod:`steerlab.ships.nomoto2`.
+Constant surge ``u``, no sway; position as in :mod:`steerlab.ships.nomoto2`.
 
 Parameters, SI with r in rad/s (packed ``[K, T, n0, n1, n2, n2a, n3]``): ``K`` [1/s],
 ``T`` [s] > 0, ``n0`` [rad/s], ``n1`` [-], ``n2`` [s/rad], ``n2a`` [s/rad], ``n3`` [s^2/rad^2].
@@ -32,7 +40,7 @@ import numpy as np
 from pydantic import Field
 
 from steerlab.config_base import FrozenConfig
-from steerlab.environment.channels import W_RUDDER, W_YAW_MOMENT
+from steerlab.environment.channels import W_RUDDER, W_YAW_MOMENT, W_YAW_RATE
 from steerlab.records import Field as RecordField
 from steerlab.records import Layout
 from steerlab.ships.kinematics import earth_velocity
@@ -59,7 +67,7 @@ def norrbin_rhs(t, x, delta, w, p, dx):
     u = x[IU]
     r = x[IR]
     earth_velocity(psi, u, 0.0, w, dx)
-    dx[IPSI] = r
+    dx[IPSI] = r + w[W_YAW_RATE]
     dx[IU] = 0.0
     dx[IV] = 0.0
     h = spiral_polynomial(r, p[P_N0], p[P_N1], p[P_N2], p[P_N2A], p[P_N3])
@@ -129,7 +137,8 @@ def _spec():
         options_model=NorrbinOptions,
         nomoto_KT=lambda speed, options=None: linear_nomoto(packed(options)),
         equilibrium_rudder=lambda speed, options=None: equilibrium_rudder(packed(options)),
-        symmetric=lambda speed, options=None: is_symmetric(packed(options)))]
+        symmetric=lambda speed, options=None: is_symmetric(packed(options)),
+        wave_motion="superposed")]
 
 
 SHIP_SPECS = _spec

@@ -77,6 +77,12 @@ class ShipSpec(PicklesByName):
     kernel_for_options: Callable | None = None
     #: ``lambda = L_full / L_model`` of a scale model, None for a full-size ship
     model_scale: float | None = None
+    #: how the spectrum wave model's ``channel = "auto"`` reaches this ship: ``"through-hull"``
+    #: (a yaw moment in the ship's equations of motion) or ``"superposed"`` (the wave-frequency
+    #: yaw rate, the linear first-order response of that moment, added to the rate of turn,
+    #: ``psi' = r + r_w``: for a manoeuvring model whose nonlinear spiral terms are fitted to
+    #: steady turns and are not wave-frequency physics; :mod:`steerlab.environment.sea`)
+    wave_motion: str = "through-hull"
     #: ``(function, args)`` that made this spec from another one (:meth:`for_options`): it
     #: pickles as that (:class:`steerlab.plugins.PicklesByName`)
     recipe: tuple | None = field(default=None, compare=False, repr=False)
