@@ -88,13 +88,15 @@ def test_serve_ship_and_autopilot_commands_run_together(tmp_path, capsys):
     sc = tmp_path / "rt.toml"
     sc.write_text(SCENARIO_TOML)
     # compile the controller first: with a cold numba cache the autopilot command would spend
-    # ~1 s (10 ship seconds) compiling while the 30 s server runs, and outlive it
+    # ~1 s (10 ship seconds) compiling while the server runs
     ControllerRuntime(load_scenario(sc), "pid", 0.125)
     log = tmp_path / "log.csv"
     port = _free_port()
     codes = {}
+    # the ship runs 100 s (10 s of wall time) for the autopilot's 20 s: on a loaded machine the
+    # autopilot's start can take seconds, and a ship that ended first cut its samples short
     server = threading.Thread(target=lambda: codes.update(server=main(
-        ["serve-ship", str(sc), "--bind", f"127.0.0.1:{port}", "--speedup", "10", "--duration", "30"])))
+        ["serve-ship", str(sc), "--bind", f"127.0.0.1:{port}", "--speedup", "10", "--duration", "100"])))
     server.start()
     try:
         assert _wait_for_ship(port)
