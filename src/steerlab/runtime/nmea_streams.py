@@ -23,6 +23,7 @@ from collections import Counter
 
 from steerlab.errors import InputError
 from steerlab.runtime.line_splitter import LineSplitter, nmea_chunks
+from steerlab.runtime.reconnecting_input import ReconnectingInput
 
 NMEA_TCP_PORT = 10110
 """The conventional TCP port of NMEA 0183 over IP (IANA "nmea-0183", used by plotters and
@@ -68,21 +69,12 @@ class NmeaSerialInput:
         await self.link.close()
 
 
-class NmeaTcpClient:
+class NmeaTcpClient(ReconnectingInput):
     """NMEA 0183 from a TCP talker, reconnecting (``connected``, ``counts``)."""
 
     def __init__(self, host: str, port: int, on_datagram, reconnect_period: float = 1.0, log=_stderr):
-        self.host, self.port = host, int(port)
+        super().__init__(host, port, reconnect_period, log)
         self.on_datagram = on_datagram
-        self.reconnect_period = float(reconnect_period)
-        self.log = log
-        self.counts: Counter = Counter()
-        self.connected = False
-        self._task = None
-
-    async def start(self) -> "NmeaTcpClient":
-        self._task = asyncio.get_running_loop().create_task(self._run())
-        return self
 
     async def _run(self) -> None:
         said_down = False
@@ -97,7 +89,7 @@ class NmeaTcpClient:
                     said_down = True
                 await asyncio.sleep(self.reconnect_period)
                 continue
-            self.connected, said_down = True, False
+            self.connected, said_down, self.ever_connected = True, False, True
             self.counts["connected"] += 1
             lines = _Lines(self.on_datagram, (self.host, self.port))
             try:
@@ -116,14 +108,6 @@ class NmeaTcpClient:
             self.counts["disconnected"] += 1
             self.log(f"--nmea-tcp: {self.host}:{self.port} closed the connection; reconnecting")
             await asyncio.sleep(self.reconnect_period)
-
-    async def close(self) -> None:
-        if self._task is not None:
-            self._task.cancel()
-            try:
-                await self._task
-            except (asyncio.CancelledError, Exception):
-                pass
 
 
 class NmeaTcpServer:

@@ -21,6 +21,7 @@ import sys
 from collections import Counter
 
 from steerlab.runtime.nmea_magnetic import MAX_VARIATION_DEG
+from steerlab.runtime.reconnecting_input import ReconnectingInput
 
 INPUT_PATHS = ("navigation.headingTrue", "navigation.headingMagnetic", "navigation.magneticVariation",
                "navigation.position", "navigation.rateOfTurn", "navigation.speedOverGround",
@@ -67,26 +68,13 @@ def input_values(values: dict, counts: Counter) -> dict:
     return out
 
 
-class SignalKInput:
-    """A subscription to a Signal K server's stream (``connected``, ``counts``)."""
+class SignalKInput(ReconnectingInput):
+    """A subscription to a Signal K server's stream (``connected``, ``counts``; ``lost()`` is
+    the ``signalk_input`` alarm: up once and down now)."""
 
     def __init__(self, host: str, port: int, on_values, reconnect_period: float = 1.0, log=_stderr):
-        self.host, self.port = host, int(port)
+        super().__init__(host, port, reconnect_period, log)
         self.on_values = on_values
-        self.reconnect_period = float(reconnect_period)
-        self.log = log
-        self.counts: Counter = Counter()
-        self.connected = False
-        self.ever_connected = False
-        self._task = None
-
-    def lost(self) -> bool:
-        """True when the subscription was up once and is down now (the ``signalk_input`` alarm)."""
-        return self.ever_connected and not self.connected
-
-    async def start(self) -> "SignalKInput":
-        self._task = asyncio.get_running_loop().create_task(self._run())
-        return self
 
     async def _run(self) -> None:
         from websockets.asyncio.client import connect
@@ -122,11 +110,3 @@ class SignalKInput:
                     said = True
             self.connected = False
             await asyncio.sleep(self.reconnect_period)
-
-    async def close(self) -> None:
-        if self._task is not None:
-            self._task.cancel()
-            try:
-                await self._task
-            except (asyncio.CancelledError, Exception):
-                pass
