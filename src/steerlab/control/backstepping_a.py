@@ -85,7 +85,7 @@ from steerlab.control.registry import ControllerSpec
 from steerlab.control.design_model import ZETA
 from steerlab.control.heading_integral import (INTEGRAL_BAND, INTEGRAL_DIVISOR, TURN_RATE_FRACTION,
                                                integral_step)
-from steerlab.control.law_design import GAINS, law_bandwidth, law_model
+from steerlab.control.law_design import GAINS, law_bandwidth
 from steerlab.control.van_leeuwen_design import design_model, design_mu, yaw_accel
 from steerlab.errors import InputError
 from steerlab.records import Field as RecordField
@@ -197,8 +197,6 @@ def backstepping_a_update(z, p, t, x, ref, h):
 
 #: Version B's design rule low-passes a differenced r' with the time constant ``RD_FILTER / omega_n`` [s].
 RD_FILTER = 0.1
-#: Version A's design rule refuses a ship whose ``b2 / (K/T)`` is outside ``[1/B2_MISMATCH, B2_MISMATCH]``.
-B2_MISMATCH = 1.25
 
 #: Table 3, ballast (GA-tuned gains of the paper), by version.
 PAPER_GAINS = {"A": {"k1": 0.020568, "k2": 176.3781, "k3": 2.545},
@@ -212,6 +210,66 @@ def design_gains(omega_n: float, zeta: float = ZETA) -> tuple[float, float]:
         raise InputError("controller.zeta", f"must be in (0, 1), got {zeta!r}")
     k = zeta * math.sqrt(2.0 / (1.0 - zeta * zeta))
     return k, math.sqrt(k * k + 2.0) / omega_n
+
+
+#: Version A's design rule: the time unit of the gains is ``A_TIME_UNIT / omega_n`` [s]. The gains
+#: that give the error system the wanted poles are real and positive for ``t_u omega_n`` in
+#: [1.42, 2.29] whatever the third pole ``p3 >= zeta omega_n`` (computed: tests); 1.8 is the
+#: geometric middle of that range. (The order does not depend on the choice: the three
+#: coefficients of the closed loop's characteristic polynomial fix the linear law.)
+A_TIME_UNIT = 1.8
+
+
+def third_pole(T1: float, T2: float, omega_n: float, zeta: float = ZETA) -> float:
+    """``p3`` [1/s] of version A's design rule: ``1/T1 + 1/T2 - 2 zeta omega_n`` (the closed
+    loop's poles sum to the design model's own, ``-(1/T1 + 1/T2)``, so the order needs no
+    ``r'``: module doc), at least ``zeta omega_n``.
+
+    ``T1, T2`` [s]: the design model's time constants (``T1 < 0`` for a course-unstable ship).
+    """
+    return max(1.0 / T1 + 1.0 / T2 - 2.0 * zeta * omega_n, zeta * omega_n)
+
+
+def design_gains_a(omega_n: float, p3: float, zeta: float = ZETA) -> tuple[float, float, float, float]:
+    """``(k1, k2, k3 [-], t_u [s])`` of version A's design rule (module doc): the error system
+    ``z' = M z`` with the poles ``-zeta omega_n +- j omega_n sqrt(1 - zeta^2)`` and ``-p3``
+    [1/s] (``p3 >= zeta omega_n``, :func:`third_pole`), in the time unit
+    ``t_u = A_TIME_UNIT / omega_n``.
+
+    ``det(sI - M) = s^3 + (k1 + k2 + k3) s^2 + (k1 k2 + k1 k3 + k2 k3 + 2) s + k1 k2 k3 + k1 + k3``
+    is matched to ``s^3 + A s^2 + B s + C``, the wanted poles in the time unit: ``k2`` is a
+    positive root of ``k^3 - A k^2 + (B - 3) k + A - C = 0`` and ``k1 <= k3`` the roots of
+    ``k^2 - (A - k2) k + (C - A + k2)/k2``; of the admissible ``k2`` the one with the smaller
+    largest gain (that gain, about ``p3 t_u``, is the last step's ``k3``, which enters the order
+    linearly).
+    """
+    if not (0.0 < zeta < 1.0):
+        raise InputError("controller.zeta", f"must be in (0, 1), got {zeta!r}")
+    if not (math.isfinite(omega_n) and omega_n > 0.0):
+        raise InputError("controller.omega_n", f"must be a finite number > 0 rad/s, got {omega_n!r}")
+    if not (math.isfinite(p3) and p3 >= zeta * omega_n * (1.0 - 1e-12)):
+        raise InputError("controller.omega_n", f"the third pole p3 = {p3!r} 1/s must be >= zeta omega_n = "
+                                               f"{zeta * omega_n:g} 1/s")
+    tu = A_TIME_UNIT / omega_n
+    W, P = omega_n * tu, p3 * tu
+    A, B, C = 2.0 * zeta * W + P, W * W + 2.0 * zeta * W * P, W * W * P
+    best = None
+    for root in np.roots([1.0, -A, B - 3.0, A - C]):
+        k2 = float(root.real)
+        if abs(root.imag) > 1e-9 * max(1.0, abs(root)) or k2 <= 0.0:
+            continue
+        s13, p13 = A - k2, (C - A + k2) / k2
+        disc = s13 * s13 - 4.0 * p13
+        if p13 <= 0.0 or disc < 0.0:
+            continue
+        k3 = 0.5 * (s13 + math.sqrt(disc))
+        k1 = p13 / k3
+        if k1 > 0.0 and (best is None or max(k2, k3) < max(best[1], best[2])):
+            best = (k1, k2, k3)
+    if best is None:   # pragma: no cover - A_TIME_UNIT is inside the admissible range for every p3
+        raise InputError("controller.omega_n", f"no positive backstepping gains for omega_n = {omega_n:g} rad/s, "
+                                               f"p3 = {p3:g} 1/s")
+    return best[0], best[1], best[2], tu
 
 
 def config_fields(type_name: str, gains=("k1", "k2", "k3")) -> dict:
@@ -256,12 +314,19 @@ def make(cfg, ctx, version: str = "A") -> tuple[Backstepping, np.ndarray]:
     gain_time = cfg.gain_time if cfg.gain_time is not None else ("s" if paper else "design")
     names = ("k1", "k2", "k3") + (("k4",) if version == "B" else ())
     given = {n: getattr(cfg, n) for n in names}
-    kd = tu = 1.0
+    kd: dict = {}
+    tu = 1.0
     law = f"backstepping_{version.lower()}"
     w = None
     if gain_time == "design" or not (paper or all(given[n] is not None for n in ("k1", "k2", "k3"))):
         w = cfg.omega_n or law_bandwidth(ctx, law)[1]
-        kd, tu = design_gains(w)
+        if version == "A":
+            ka = design_gains_a(w, third_pole(float(s[SET.index("T1")]) / mu, float(s[SET.index("T2")]) / mu, w))
+            kd = dict(zip(("k1", "k2", "k3"), ka[:3]))
+            tu = ka[3]
+        else:
+            kd, tu = design_gains(w)
+            kd = dict.fromkeys(("k1", "k2", "k3"), kd)
     if gain_time == "s":
         tu = 1.0
     elif gain_time == "ship":
@@ -273,16 +338,7 @@ def make(cfg, ctx, version: str = "A") -> tuple[Backstepping, np.ndarray]:
         elif paper:
             k[n] = PAPER_GAINS[version][n]
         else:
-            k[n] = tu / ctx.gear.T_sg if n == "k4" else kd
-    if version == "A" and not paper:
-        m = law_model(ctx)
-        if not (1.0 / B2_MISMATCH <= m.b2 / m.b <= B2_MISMATCH):
-            raise InputError("controller.type", (
-                f"backstepping_a inverts the design model with an ideal gear, and this ship's rudder efficiency "
-                f"b2 = {m.b2:.3g} 1/s^2 differs from K/T = {m.b:.3g} by a factor {m.b2 / m.b:.3g} (outside "
-                f"[{1 / B2_MISMATCH:.3g}, {B2_MISMATCH:g}]: a second-order or 3-DOF ship), so the inversion "
-                "over- or under-compensates and the loop limit-cycles; use backstepping_b (gear and rudder "
-                "feedback in the design) or nonlinear_adrc"))
+            k[n] = tu / ctx.gear.T_sg if n == "k4" else kd[n]
     c = Backstepping(k["k1"], k["k2"], k["k3"], k.get("k4", 1.0), ctx.gear.T_sg, mu, i_rdot,
                      ctx.u_max(cfg.u_max_deg), tuple(float(v) for v in s), tu, 0.0)
     if cfg.k_i is not None or not paper:
