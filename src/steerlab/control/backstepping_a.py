@@ -41,32 +41,53 @@ Design rule (``gains = "design"``, the default; a value the user gives wins). Wi
 cancelled, the errors obey the linear system (in the time unit ``t_u`` of the gains)::
 
     z' = M z,   M = [[-k1, 1, 0], [-1, -k2, 1], [0, -1, -k3]]
-    det(sI - M) = (s + k1)(s + k2)(s + k3) + (s + k1) + (s + k3)
+    det(sI - M) = s^3 + (k1 + k2 + k3) s^2 + (k1 k2 + k1 k3 + k2 k3 + 2) s + k1 k2 k3 + k1 + k3
 
-With ``k1 = k2 = k3 = k`` this is ``(s + k)((s + k)^2 + 2)``: poles ``-k`` and ``-k +- j sqrt(2)``,
-a pair of damping ``k / sqrt(k^2 + 2)``. So ``k = zeta sqrt(2 / (1 - zeta^2))`` (``zeta = ZETA``
-= 0.9, :mod:`steerlab.control.design_model`) and the time unit ``t_u = sqrt(k^2 + 2) / omega_n``
-(``gain_time = "design"``) give, in seconds, the poles ``-zeta omega_n +- j omega_n sqrt(1 - zeta^2)``
-and ``-zeta omega_n``: the error dynamics at the shared bandwidth ``omega_n``
-(:func:`steerlab.control.design_model.bandwidth`, capped by the gear's limit, rate and lag; for a
-course-unstable ship above its unstable pole). The law cancels ``f`` whatever the sign of ``T``,
-so ``K < 0, T < 0`` ships are designed like the others. (:func:`design_gains`.)
+stable for any positive gains (``V' = -k1 z1^2 - k2 z2^2 - k3 z3^2``; Krstić, Kanellakopoulos &
+Kokotović 1995). Its three coefficients fix the linear part of the order: on the chain
+``psi''' = c mu^3 u + f`` the law is ``u = (v - f) / (c mu^3)`` with
+``v = -a2 r' - a1 r - a0 e`` (``e`` the heading error; ``a2, a1, a0`` the coefficients in
+seconds). The rule places them at (:func:`design_gains_a`)::
 
-Version A has no rudder feedback: its order holds the inverse term ``(T r' + r)/K`` of the design
-model, an inner loop whose gain on the real ship is ``b2 / (K/T)`` (the rudder efficiency over
-the design model's). Where that is far from 1 (a second-order Nomoto ship with a zero, a 3-DOF
-ship: Esso, KVLCC2, the MSS tanker have ``b2 ~ 2.5 K/T``) the loop limit-cycles at the gear's
-stops, so the design rule refuses such a ship (outside ``[1/1.25, 1.25]``) in one line naming
-``backstepping_b``, which feeds the measured rudder back and designs them.
+    (s^2 + 2 zeta omega_n s + omega_n^2)(s + p3),     p3 = 1/T1 + 1/T2 - 2 zeta omega_n
+
+``omega_n`` the shared bandwidth (:func:`steerlab.control.design_model.bandwidth`, capped by the
+gear's limit, rate and lag; for a course-unstable ship above its unstable pole), ``zeta = ZETA``
+= 0.9, and ``p3`` (at least ``zeta omega_n``, :func:`third_pole`) such that the poles sum to the
+design model's own, ``a2 = 1/T1 + 1/T2``: then the ``r'`` that ``v`` feeds back cancels the
+``r'`` of ``f`` exactly, **the order does not read the yaw acceleration**, and on a first-order
+Nomoto design model (``T1 = T``, ``T2`` = the gear's ``T_sg``)::
+
+    u = ( (1 - a1 T T2) r - a0 T T2 e ) / K,   a1 = omega_n^2 + 2 zeta omega_n p3,  a0 = omega_n^2 p3
+
+a PD law whose stiffness ``a0 T T2 / K = omega_n^2 p3 T2 / b`` is the pole-placement PD's
+``omega_n^2 / b`` (Fossen 2011, Sec. 12.2.7) to within the factor ``p3 T2 ~ 1``. The time unit
+is ``t_u = A_TIME_UNIT / omega_n``; the gains follow from matching the coefficients (real and
+positive for every ``p3 >= zeta omega_n`` at that unit). The law cancels ``f`` whatever the
+sign of ``T``, so ``K < 0, T < 0`` ships are designed like the others; on a Van Leeuwen ship
+(B-481) it cancels the nonlinear ``H(r)`` as printed.
+
+Why not all error poles at ``omega_n`` (the rule before issue 30: ``k1 = k2 = k3``, the third
+pole at ``zeta omega_n``): that slows the design model's fast pole ``1/T2`` (the gear) to the
+loop's bandwidth, and the order then holds ``(T1 + T2 - a2 T1 T2) / K`` times ``r'``
+(``a2 = 3 zeta omega_n``): +443 s^2 on the Nomoto test ship at 16 kn, a positive loop
+rudder -> ``r'`` -> order of gain ``443 s^2 x K/T ~ 0.9``, and a stiffness at rest only
+``zeta omega_n T2`` times a PD's. On a ship whose rudder efficiency ``b2`` exceeds ``K/T``
+(a second-order or 3-DOF ship: Esso, KVLCC2, the MSS tanker have ``b2 ~ 2.5 K/T``) that loop
+gain passes 1 and the rudder limit-cycled between its stops (those ships were refused); in sea
+state 5 the waves' part of the differenced ``r'`` (behind the wave filter too) drove the same
+barely damped loop and the ship spun before the course change (the Nomoto test ship, the small
+tanker and frigate Nomoto models: the rudder went to -25 deg within 40 s on a straight course). With the rule above neither loop exists: no ship is refused for its
+``b2``, and those ships steer. (Designing on the first-order model whose high-frequency gain is
+``b2``, ``T1 = K/b2``, had been tried: stable but drifting.)
+
 ``gains = "paper"``: Table 3 (ballast) read per second (``gain_time = "s"``), as before, no
-integral action.
+integral action (the design rule's time unit and gains only where asked for).
 
 Integral action (design rule): the law cancels the drift of its design model but not an
-unknown constant yaw moment (a thesis ship's spiral offset ``c0``, a propeller side force);
-its own stiffness at rest is only about ``omega_n T2`` times a PD loop's (the rudder enters
-the chain at the jerk), so the design adds :mod:`steerlab.control.heading_integral`
-with ``k_i = (omega_n/10) S``, ``S`` the law's own stiffness at rest (:func:`stiffness`; a
-PD-scale ``omega_n^2/b`` would overpower that stiffness and limit-cycle), with
+unknown constant yaw moment (a thesis ship's spiral offset ``c0``, a propeller side force), so
+the design adds :mod:`steerlab.control.heading_integral` with ``k_i = (omega_n/10) S``, ``S``
+the law's own stiffness at rest (:func:`stiffness`; Fossen's ``K_i = omega_n K_p / 10``), with
 conditional-integration anti-windup.
 """
 
@@ -113,7 +134,7 @@ PARAMS = Layout("controller", "B_", [
     RecordField("IRDOT", "i_rdot", "-", "index of rdot in the plant state; -1: estimate r' from the yaw rate"),
     RecordField("UMAX", "u_max", "rad", "output limit (scenario default: the gear's limit)", lo=0.0, lo_open=True),
     RecordField("TU", "time_unit", "s", "unit of time of the gains: 1 s, L/U (gain_time = 'ship') or "
-                "sqrt(k^2 + 2)/omega_n (gain_time = 'design')",
+                "the design rule's unit (gain_time = 'design': A 1.8/omega_n, B sqrt(k^2 + 2)/omega_n)",
                 lo=0.0, lo_open=True),
     RecordField("KI", "k_i", "1/s", "integral gain on the heading error (heading_integral; 0: none, the paper)",
                 lo=0.0, default=0.0),
@@ -292,7 +313,8 @@ def config_fields(type_name: str, gains=("k1", "k2", "k3")) -> dict:
                                           description="[s], 0.001-1000 s, other ships; default gear T_sg")),
         gain_time=(Optional[Literal["s", "ship", "design"]],
                    Field(None, description="time unit of the gains: 1 s, L/U, or the design rule's "
-                                           "sqrt(k^2 + 2)/omega_n; default 'design' (design) or 's' (paper)")),
+                                           "(A: 1.8/omega_n, B: sqrt(k^2 + 2)/omega_n); default 'design' "
+                                           "(design) or 's' (paper)")),
         u_max_deg=(Optional[float], Field(None, gt=0.0, le=90.0, description="default: gear limit")),
         sample_time=(Optional[float], Field(None, gt=0.0, le=60.0, description="default: dt")))
 
@@ -372,6 +394,8 @@ CONTROLLER = ControllerSpec(
     update=backstepping_a_update, n_state=N_STATE, config=BacksteppingAConfig, build=build,
     source="Witkowska & Smierzchalski, Table 2 eqs (18)-(20), (25), (27)-(28)",
     params=PARAMS,
-    design_rule=("k1 = k2 = k3 = zeta sqrt(2/(1 - zeta^2)) in the time unit sqrt(k^2 + 2)/omega_n: error "
-                 "poles -zeta omega_n +- j omega_n sqrt(1 - zeta^2) and -zeta omega_n at the shared bandwidth "
-                 "(Krstic et al. 1995 error system); cancels f for T of either sign"))
+    design_rule=("error-system poles -zeta omega_n +- j omega_n sqrt(1 - zeta^2) at the shared bandwidth and "
+                 "-p3, p3 = 1/T1 + 1/T2 - 2 zeta omega_n (the poles sum to the design model's: the order reads "
+                 "no r'), gains by matching det(sI - M) in the time unit 1.8/omega_n (Krstic et al. 1995 error "
+                 "system; on a Nomoto model the pole-placement PD of Fossen 2011 Sec. 12.2.7 with the gear lag); "
+                 "cancels f for T of either sign"))
