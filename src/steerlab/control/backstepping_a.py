@@ -225,7 +225,8 @@ PAPER_GAINS = {"A": {"k1": 0.020568, "k2": 176.3781, "k3": 2.545},
 
 
 def design_gains(omega_n: float, zeta: float = ZETA) -> tuple[float, float]:
-    """``(k [-], t_u [s])`` of the design rule (module doc): ``k1 = k2 = k3 = k`` in the time unit
+    """``(k [-], t_u [s])`` of version B's design rule (version A's before issue 30, module doc):
+    ``k1 = k2 = k3 = k`` in the time unit
     ``t_u``, so that the error dynamics have the poles ``-zeta omega_n (1, +- j sqrt(1 - zeta^2)/zeta)``."""
     if not (0.0 < zeta < 1.0):
         raise InputError("controller.zeta", f"must be in (0, 1), got {zeta!r}")
