@@ -196,6 +196,21 @@ def test_reused_sea_is_the_full_build():
     matrix._SEAS.clear()
 
 
+@pytest.mark.parametrize("ship,sea", [("nomoto1", SEA5), ("small-tanker-nomoto-10deg", SEA5), ("esso", CALM),
+                                      ("nomoto2", CALM)])
+def test_backstepping_a_cases_issue_30_named_now_steer(ship, sea):
+    """backstepping_a's column (issue 30): the Nomoto ships it spun in sea state 5 (behind the
+    designed wave filter) and the ships whose b2 differs from K/T that its design rule refused
+    (the 3-DOF Esso, b2 = 2.5 K/T; the second-order Nomoto ship) steer the matrix's case: the
+    design rule no longer feeds r' back (control/backstepping_a.py)."""
+    from steerlab.conformance.matrix import run_case
+
+    point = [p for p in operating_points(get_ship(ship)) if p.label == "design"][0]
+    out = run_case(Case(ship, "backstepping_a", point, sea))
+    assert out.verdict == J.STEERS, out.reason
+    assert abs(out.metrics["final_error_deg"]) <= J.TOL_DEG and out.metrics["max_error_deg"] < 40.0
+
+
 # ----------------------------------------------------------------------------- the matrix
 @pytest.fixture(scope="module")
 def matrix(tmp_path_factory):

@@ -41,32 +41,53 @@ Design rule (``gains = "design"``, the default; a value the user gives wins). Wi
 cancelled, the errors obey the linear system (in the time unit ``t_u`` of the gains)::
 
     z' = M z,   M = [[-k1, 1, 0], [-1, -k2, 1], [0, -1, -k3]]
-    det(sI - M) = (s + k1)(s + k2)(s + k3) + (s + k1) + (s + k3)
+    det(sI - M) = s^3 + (k1 + k2 + k3) s^2 + (k1 k2 + k1 k3 + k2 k3 + 2) s + k1 k2 k3 + k1 + k3
 
-With ``k1 = k2 = k3 = k`` this is ``(s + k)((s + k)^2 + 2)``: poles ``-k`` and ``-k +- j sqrt(2)``,
-a pair of damping ``k / sqrt(k^2 + 2)``. So ``k = zeta sqrt(2 / (1 - zeta^2))`` (``zeta = ZETA``
-= 0.9, :mod:`steerlab.control.design_model`) and the time unit ``t_u = sqrt(k^2 + 2) / omega_n``
-(``gain_time = "design"``) give, in seconds, the poles ``-zeta omega_n +- j omega_n sqrt(1 - zeta^2)``
-and ``-zeta omega_n``: the error dynamics at the shared bandwidth ``omega_n``
-(:func:`steerlab.control.design_model.bandwidth`, capped by the gear's limit, rate and lag; for a
-course-unstable ship above its unstable pole). The law cancels ``f`` whatever the sign of ``T``,
-so ``K < 0, T < 0`` ships are designed like the others. (:func:`design_gains`.)
+stable for any positive gains (``V' = -k1 z1^2 - k2 z2^2 - k3 z3^2``; Krstić, Kanellakopoulos &
+Kokotović 1995). Its three coefficients fix the linear part of the order: on the chain
+``psi''' = c mu^3 u + f`` the law is ``u = (v - f) / (c mu^3)`` with
+``v = -a2 r' - a1 r - a0 e`` (``e`` the heading error; ``a2, a1, a0`` the coefficients in
+seconds). The rule places them at (:func:`design_gains_a`)::
 
-Version A has no rudder feedback: its order holds the inverse term ``(T r' + r)/K`` of the design
-model, an inner loop whose gain on the real ship is ``b2 / (K/T)`` (the rudder efficiency over
-the design model's). Where that is far from 1 (a second-order Nomoto ship with a zero, a 3-DOF
-ship: Esso, KVLCC2, the MSS tanker have ``b2 ~ 2.5 K/T``) the loop limit-cycles at the gear's
-stops, so the design rule refuses such a ship (outside ``[1/1.25, 1.25]``) in one line naming
-``backstepping_b``, which feeds the measured rudder back and designs them.
+    (s^2 + 2 zeta omega_n s + omega_n^2)(s + p3),     p3 = 1/T1 + 1/T2 - 2 zeta omega_n
+
+``omega_n`` the shared bandwidth (:func:`steerlab.control.design_model.bandwidth`, capped by the
+gear's limit, rate and lag; for a course-unstable ship above its unstable pole), ``zeta = ZETA``
+= 0.9, and ``p3`` (at least ``zeta omega_n``, :func:`third_pole`) such that the poles sum to the
+design model's own, ``a2 = 1/T1 + 1/T2``: then the ``r'`` that ``v`` feeds back cancels the
+``r'`` of ``f`` exactly, **the order does not read the yaw acceleration**, and on a first-order
+Nomoto design model (``T1 = T``, ``T2`` = the gear's ``T_sg``)::
+
+    u = ( (1 - a1 T T2) r - a0 T T2 e ) / K,   a1 = omega_n^2 + 2 zeta omega_n p3,  a0 = omega_n^2 p3
+
+a PD law whose stiffness ``a0 T T2 / K = omega_n^2 p3 T2 / b`` is the pole-placement PD's
+``omega_n^2 / b`` (Fossen 2011, Sec. 12.2.7) to within the factor ``p3 T2 ~ 1``. The time unit
+is ``t_u = A_TIME_UNIT / omega_n``; the gains follow from matching the coefficients (real and
+positive for every ``p3 >= zeta omega_n`` at that unit). The law cancels ``f`` whatever the
+sign of ``T``, so ``K < 0, T < 0`` ships are designed like the others; on a Van Leeuwen ship
+(B-481) it cancels the nonlinear ``H(r)`` as printed.
+
+Why not all error poles at ``omega_n`` (the rule before issue 30: ``k1 = k2 = k3``, the third
+pole at ``zeta omega_n``): that slows the design model's fast pole ``1/T2`` (the gear) to the
+loop's bandwidth, and the order then holds ``(T1 + T2 - a2 T1 T2) / K`` times ``r'``
+(``a2 = 3 zeta omega_n``): +443 s^2 on the Nomoto test ship at 16 kn, a positive loop
+rudder -> ``r'`` -> order of gain ``443 s^2 x K/T ~ 0.9``, and a stiffness at rest only
+``zeta omega_n T2`` times a PD's. On a ship whose rudder efficiency ``b2`` exceeds ``K/T``
+(a second-order or 3-DOF ship: Esso, KVLCC2, the MSS tanker have ``b2 ~ 2.5 K/T``) that loop
+gain passes 1 and the rudder limit-cycled between its stops (those ships were refused); in sea
+state 5 the waves' part of the differenced ``r'`` (behind the wave filter too) drove the same
+barely damped loop and the ship spun before the course change (the Nomoto test ship, the small
+tanker and frigate Nomoto models: the rudder went to -25 deg within 40 s on a straight course). With the rule above neither loop exists: no ship is refused for its
+``b2``, and those ships steer. (Designing on the first-order model whose high-frequency gain is
+``b2``, ``T1 = K/b2``, had been tried: stable but drifting.)
+
 ``gains = "paper"``: Table 3 (ballast) read per second (``gain_time = "s"``), as before, no
-integral action.
+integral action (the design rule's time unit and gains only where asked for).
 
 Integral action (design rule): the law cancels the drift of its design model but not an
-unknown constant yaw moment (a thesis ship's spiral offset ``c0``, a propeller side force);
-its own stiffness at rest is only about ``omega_n T2`` times a PD loop's (the rudder enters
-the chain at the jerk), so the design adds :mod:`steerlab.control.heading_integral`
-with ``k_i = (omega_n/10) S``, ``S`` the law's own stiffness at rest (:func:`stiffness`; a
-PD-scale ``omega_n^2/b`` would overpower that stiffness and limit-cycle), with
+unknown constant yaw moment (a thesis ship's spiral offset ``c0``, a propeller side force), so
+the design adds :mod:`steerlab.control.heading_integral` with ``k_i = (omega_n/10) S``, ``S``
+the law's own stiffness at rest (:func:`stiffness`; Fossen's ``K_i = omega_n K_p / 10``), with
 conditional-integration anti-windup.
 """
 
@@ -85,7 +106,7 @@ from steerlab.control.registry import ControllerSpec
 from steerlab.control.design_model import ZETA
 from steerlab.control.heading_integral import (INTEGRAL_BAND, INTEGRAL_DIVISOR, TURN_RATE_FRACTION,
                                                integral_step)
-from steerlab.control.law_design import GAINS, law_bandwidth, law_model
+from steerlab.control.law_design import GAINS, law_bandwidth
 from steerlab.control.van_leeuwen_design import design_model, design_mu, yaw_accel
 from steerlab.errors import InputError
 from steerlab.records import Field as RecordField
@@ -113,7 +134,7 @@ PARAMS = Layout("controller", "B_", [
     RecordField("IRDOT", "i_rdot", "-", "index of rdot in the plant state; -1: estimate r' from the yaw rate"),
     RecordField("UMAX", "u_max", "rad", "output limit (scenario default: the gear's limit)", lo=0.0, lo_open=True),
     RecordField("TU", "time_unit", "s", "unit of time of the gains: 1 s, L/U (gain_time = 'ship') or "
-                "sqrt(k^2 + 2)/omega_n (gain_time = 'design')",
+                "the design rule's unit (gain_time = 'design': A 1.8/omega_n, B sqrt(k^2 + 2)/omega_n)",
                 lo=0.0, lo_open=True),
     RecordField("KI", "k_i", "1/s", "integral gain on the heading error (heading_integral; 0: none, the paper)",
                 lo=0.0, default=0.0),
@@ -197,8 +218,6 @@ def backstepping_a_update(z, p, t, x, ref, h):
 
 #: Version B's design rule low-passes a differenced r' with the time constant ``RD_FILTER / omega_n`` [s].
 RD_FILTER = 0.1
-#: Version A's design rule refuses a ship whose ``b2 / (K/T)`` is outside ``[1/B2_MISMATCH, B2_MISMATCH]``.
-B2_MISMATCH = 1.25
 
 #: Table 3, ballast (GA-tuned gains of the paper), by version.
 PAPER_GAINS = {"A": {"k1": 0.020568, "k2": 176.3781, "k3": 2.545},
@@ -206,12 +225,73 @@ PAPER_GAINS = {"A": {"k1": 0.020568, "k2": 176.3781, "k3": 2.545},
 
 
 def design_gains(omega_n: float, zeta: float = ZETA) -> tuple[float, float]:
-    """``(k [-], t_u [s])`` of the design rule (module doc): ``k1 = k2 = k3 = k`` in the time unit
+    """``(k [-], t_u [s])`` of version B's design rule (version A's before issue 30, module doc):
+    ``k1 = k2 = k3 = k`` in the time unit
     ``t_u``, so that the error dynamics have the poles ``-zeta omega_n (1, +- j sqrt(1 - zeta^2)/zeta)``."""
     if not (0.0 < zeta < 1.0):
         raise InputError("controller.zeta", f"must be in (0, 1), got {zeta!r}")
     k = zeta * math.sqrt(2.0 / (1.0 - zeta * zeta))
     return k, math.sqrt(k * k + 2.0) / omega_n
+
+
+#: Version A's design rule: the time unit of the gains is ``A_TIME_UNIT / omega_n`` [s]. The gains
+#: that give the error system the wanted poles are real and positive for ``t_u omega_n`` in
+#: [1.42, 2.29] whatever the third pole ``p3 >= zeta omega_n`` (computed: tests); 1.8 is the
+#: geometric middle of that range. (The order does not depend on the choice: the three
+#: coefficients of the closed loop's characteristic polynomial fix the linear law.)
+A_TIME_UNIT = 1.8
+
+
+def third_pole(T1: float, T2: float, omega_n: float, zeta: float = ZETA) -> float:
+    """``p3`` [1/s] of version A's design rule: ``1/T1 + 1/T2 - 2 zeta omega_n`` (the closed
+    loop's poles sum to the design model's own, ``-(1/T1 + 1/T2)``, so the order needs no
+    ``r'``: module doc), at least ``zeta omega_n``.
+
+    ``T1, T2`` [s]: the design model's time constants (``T1 < 0`` for a course-unstable ship).
+    """
+    return max(1.0 / T1 + 1.0 / T2 - 2.0 * zeta * omega_n, zeta * omega_n)
+
+
+def design_gains_a(omega_n: float, p3: float, zeta: float = ZETA) -> tuple[float, float, float, float]:
+    """``(k1, k2, k3 [-], t_u [s])`` of version A's design rule (module doc): the error system
+    ``z' = M z`` with the poles ``-zeta omega_n +- j omega_n sqrt(1 - zeta^2)`` and ``-p3``
+    [1/s] (``p3 >= zeta omega_n``, :func:`third_pole`), in the time unit
+    ``t_u = A_TIME_UNIT / omega_n``.
+
+    ``det(sI - M) = s^3 + (k1 + k2 + k3) s^2 + (k1 k2 + k1 k3 + k2 k3 + 2) s + k1 k2 k3 + k1 + k3``
+    is matched to ``s^3 + A s^2 + B s + C``, the wanted poles in the time unit: ``k2`` is a
+    positive root of ``k^3 - A k^2 + (B - 3) k + A - C = 0`` and ``k1 <= k3`` the roots of
+    ``k^2 - (A - k2) k + (C - A + k2)/k2``; of the admissible ``k2`` the one with the smaller
+    largest gain (that gain, about ``p3 t_u``, is the last step's ``k3``, which enters the order
+    linearly).
+    """
+    if not (0.0 < zeta < 1.0):
+        raise InputError("controller.zeta", f"must be in (0, 1), got {zeta!r}")
+    if not (math.isfinite(omega_n) and omega_n > 0.0):
+        raise InputError("controller.omega_n", f"must be a finite number > 0 rad/s, got {omega_n!r}")
+    if not (math.isfinite(p3) and p3 >= zeta * omega_n * (1.0 - 1e-12)):
+        raise InputError("controller.omega_n", f"the third pole p3 = {p3!r} 1/s must be >= zeta omega_n = "
+                                               f"{zeta * omega_n:g} 1/s")
+    tu = A_TIME_UNIT / omega_n
+    W, P = omega_n * tu, p3 * tu
+    A, B, C = 2.0 * zeta * W + P, W * W + 2.0 * zeta * W * P, W * W * P
+    best = None
+    for root in np.roots([1.0, -A, B - 3.0, A - C]):
+        k2 = float(root.real)
+        if abs(root.imag) > 1e-9 * max(1.0, abs(root)) or k2 <= 0.0:
+            continue
+        s13, p13 = A - k2, (C - A + k2) / k2
+        disc = s13 * s13 - 4.0 * p13
+        if p13 <= 0.0 or disc < 0.0:
+            continue
+        k3 = 0.5 * (s13 + math.sqrt(disc))
+        k1 = p13 / k3
+        if k1 > 0.0 and (best is None or max(k2, k3) < max(best[1], best[2])):
+            best = (k1, k2, k3)
+    if best is None:   # pragma: no cover - A_TIME_UNIT is inside the admissible range for every p3
+        raise InputError("controller.omega_n", f"no positive backstepping gains for omega_n = {omega_n:g} rad/s, "
+                                               f"p3 = {p3:g} 1/s")
+    return best[0], best[1], best[2], tu
 
 
 def config_fields(type_name: str, gains=("k1", "k2", "k3")) -> dict:
@@ -234,7 +314,8 @@ def config_fields(type_name: str, gains=("k1", "k2", "k3")) -> dict:
                                           description="[s], 0.001-1000 s, other ships; default gear T_sg")),
         gain_time=(Optional[Literal["s", "ship", "design"]],
                    Field(None, description="time unit of the gains: 1 s, L/U, or the design rule's "
-                                           "sqrt(k^2 + 2)/omega_n; default 'design' (design) or 's' (paper)")),
+                                           "(A: 1.8/omega_n, B: sqrt(k^2 + 2)/omega_n); default 'design' "
+                                           "(design) or 's' (paper)")),
         u_max_deg=(Optional[float], Field(None, gt=0.0, le=90.0, description="default: gear limit")),
         sample_time=(Optional[float], Field(None, gt=0.0, le=60.0, description="default: dt")))
 
@@ -256,12 +337,19 @@ def make(cfg, ctx, version: str = "A") -> tuple[Backstepping, np.ndarray]:
     gain_time = cfg.gain_time if cfg.gain_time is not None else ("s" if paper else "design")
     names = ("k1", "k2", "k3") + (("k4",) if version == "B" else ())
     given = {n: getattr(cfg, n) for n in names}
-    kd = tu = 1.0
+    kd: dict = {}
+    tu = 1.0
     law = f"backstepping_{version.lower()}"
     w = None
     if gain_time == "design" or not (paper or all(given[n] is not None for n in ("k1", "k2", "k3"))):
         w = cfg.omega_n or law_bandwidth(ctx, law)[1]
-        kd, tu = design_gains(w)
+        if version == "A":
+            ka = design_gains_a(w, third_pole(float(s[SET.index("T1")]) / mu, float(s[SET.index("T2")]) / mu, w))
+            kd = dict(zip(("k1", "k2", "k3"), ka[:3]))
+            tu = ka[3]
+        else:
+            kd, tu = design_gains(w)
+            kd = dict.fromkeys(("k1", "k2", "k3"), kd)
     if gain_time == "s":
         tu = 1.0
     elif gain_time == "ship":
@@ -273,16 +361,7 @@ def make(cfg, ctx, version: str = "A") -> tuple[Backstepping, np.ndarray]:
         elif paper:
             k[n] = PAPER_GAINS[version][n]
         else:
-            k[n] = tu / ctx.gear.T_sg if n == "k4" else kd
-    if version == "A" and not paper:
-        m = law_model(ctx)
-        if not (1.0 / B2_MISMATCH <= m.b2 / m.b <= B2_MISMATCH):
-            raise InputError("controller.type", (
-                f"backstepping_a inverts the design model with an ideal gear, and this ship's rudder efficiency "
-                f"b2 = {m.b2:.3g} 1/s^2 differs from K/T = {m.b:.3g} by a factor {m.b2 / m.b:.3g} (outside "
-                f"[{1 / B2_MISMATCH:.3g}, {B2_MISMATCH:g}]: a second-order or 3-DOF ship), so the inversion "
-                "over- or under-compensates and the loop limit-cycles; use backstepping_b (gear and rudder "
-                "feedback in the design) or nonlinear_adrc"))
+            k[n] = tu / ctx.gear.T_sg if n == "k4" else kd[n]
     c = Backstepping(k["k1"], k["k2"], k["k3"], k.get("k4", 1.0), ctx.gear.T_sg, mu, i_rdot,
                      ctx.u_max(cfg.u_max_deg), tuple(float(v) for v in s), tu, 0.0)
     if cfg.k_i is not None or not paper:
@@ -316,6 +395,8 @@ CONTROLLER = ControllerSpec(
     update=backstepping_a_update, n_state=N_STATE, config=BacksteppingAConfig, build=build,
     source="Witkowska & Smierzchalski, Table 2 eqs (18)-(20), (25), (27)-(28)",
     params=PARAMS,
-    design_rule=("k1 = k2 = k3 = zeta sqrt(2/(1 - zeta^2)) in the time unit sqrt(k^2 + 2)/omega_n: error "
-                 "poles -zeta omega_n +- j omega_n sqrt(1 - zeta^2) and -zeta omega_n at the shared bandwidth "
-                 "(Krstic et al. 1995 error system); cancels f for T of either sign"))
+    design_rule=("error-system poles -zeta omega_n +- j omega_n sqrt(1 - zeta^2) at the shared bandwidth and "
+                 "-p3, p3 = 1/T1 + 1/T2 - 2 zeta omega_n (the poles sum to the design model's: the order reads "
+                 "no r'), gains by matching det(sI - M) in the time unit 1.8/omega_n (Krstic et al. 1995 error "
+                 "system; on a Nomoto model the pole-placement PD of Fossen 2011 Sec. 12.2.7 with the gear lag); "
+                 "cancels f for T of either sign"))

@@ -40,9 +40,10 @@ error ``w4 = c mu^3 z4`` (``V = (z1^2 + z2^2 + z3^2 + w4^2)/2``): then ``z3' = -
 ``(z3, z4)`` oscillates at ``c mu^3 t_u^2`` [rad/s] in real time, about 20 rad/s on a thesis
 ship with the design's time unit: above the 0.1 s sample's Nyquist rate, the order then
 alternated +-16 deg from sample to sample (measured). A differenced ``r'`` (ships without an
-``rdot`` state) is low-passed with the time constant ``0.1/omega_n``. ``k1..k3`` and the time unit as version A
-(:func:`steerlab.control.backstepping_a.design_gains`: error poles at the shared bandwidth
-``omega_n``), and ``k4 = t_u / T_R``: the gear error ``z4`` decays at the gear's own rate
+``rdot`` state) is low-passed with the time constant ``0.1/omega_n``. ``k1 = k2 = k3 = zeta sqrt(2/(1 - zeta^2))`` in
+the time unit ``sqrt(k^2 + 2)/omega_n`` (:func:`steerlab.control.backstepping_a.design_gains`:
+the three error poles at the shared bandwidth ``omega_n``; version A keeps its design model's
+fast pole instead, see its module doc), and ``k4 = t_u / T_R``: the gear error ``z4`` decays at the gear's own rate
 ``1/T_R`` (the order is then ``u_c = alpha3 + T_R (alpha3' - c mu^3 z3)``, the design's
 rudder plus the lead that undoes the gear's lag). ``V' = -sum k_i z_i^2 < 0`` for any positive
 gains and either sign of ``T``. Integral action with anti-windup as version A (design rule only).
@@ -120,6 +121,7 @@ CONTROLLER = ControllerSpec(
     update=backstepping_b_update, n_state=N_STATE, config=BacksteppingBConfig, build=build,
     source="Witkowska & Smierzchalski, Table 2 eqs (21)-(24), (26), (29)",
     params=A_PARAMS,
-    design_rule=("k1..k3 and time unit as backstepping_a (error poles at the shared bandwidth omega_n), "
+    design_rule=("k1 = k2 = k3 = zeta sqrt(2/(1 - zeta^2)) in the time unit sqrt(k^2 + 2)/omega_n (error poles "
+                 "at the shared bandwidth omega_n), "
                  "k4 = t_u/T_R: the gear error decays at the gear's rate (Witkowska & Smierzchalski Table 2 "
                  "error system); cancels f for T of either sign"))
