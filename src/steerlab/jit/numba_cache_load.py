@@ -34,8 +34,8 @@ fails for any reason is retried the numba way (full refresh).
 It reaches numba internals (``numba.core.dispatcher.FunctionCache``, a cache's ``_impl.locator``
 and ``Cache._load_overload``, written against numba 0.67-0.68), so it is installed only on the
 numba versions the tests cover (:mod:`steerlab.jit.numba_gate`); elsewhere, or if a name it
-needs is missing, steerlab's kernels load the numba way (slower, the same numbers). Set ``STEERLAB_LIGHT_CACHE_LOAD=0`` (before ``import steerlab``)
-to switch it off.
+needs is missing, steerlab's kernels load the numba way (slower, the same numbers). Set
+``STEERLAB_LIGHT_CACHE_LOAD=0`` (before ``import steerlab``) to switch it off.
 
 Measured with ``python benchmarks/bench_startup_ab.py`` (2026-11-29, ``benchmarks/RESULTS.md``,
 "Start-up after the light load of steerlab's own kernels"): a library user's first
