@@ -27,7 +27,9 @@ PROBE = Path(__file__).resolve().parent / "cache_faults" / "probe.py"
 def _env(cache: Path) -> dict:
     env = {**os.environ, "STEERLAB_CACHE_DIR": str(cache), "PYTHONPATH": str(SRC),
            "XDG_CACHE_HOME": str(cache / "xdg")}     # numba's user-wide fallback stays in the test folder
-    for name in ("STEERLAB_DRIVER_CACHE", "STEERLAB_NUMBA_INTERNALS", "STEERLAB_NUMBA_CACHE_STAMP"):
+    # NUMBA_CACHE_DIR (set by .ci/run-pins for the whole suite) would put the driver's numba files
+    # outside the test's folder, where the cases below look for them
+    for name in ("STEERLAB_DRIVER_CACHE", "STEERLAB_NUMBA_INTERNALS", "STEERLAB_NUMBA_CACHE_STAMP", "NUMBA_CACHE_DIR"):
         env.pop(name, None)
     return env
 

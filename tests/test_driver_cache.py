@@ -44,6 +44,8 @@ SCRIPT = textwrap.dedent("""
 def _run(cache: Path, src: Path = SRC, wait=True):
     env = {**os.environ, "STEERLAB_CACHE_DIR": str(cache), "PYTHONPATH": str(src)}
     env.pop("STEERLAB_DRIVER_CACHE", None)
+    # NUMBA_CACHE_DIR (.ci/run-pins sets it for the whole suite) would move numba's files out of the test's folder
+    env.pop("NUMBA_CACHE_DIR", None)
     p = subprocess.Popen([sys.executable, "-c", SCRIPT], env=env, stdout=subprocess.PIPE,
                          stderr=subprocess.PIPE, text=True)
     return _result(p) if wait else p

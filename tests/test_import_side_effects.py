@@ -38,7 +38,8 @@ atexit_names = {n: id(getattr(atexit, n)) for n in dir(atexit)}
 import numba
 from numba.core import caching, config
 before = {"layer": numba.config.THREADING_LAYER, "locators": os.environ.get("NUMBA_CACHE_LOCATOR_CLASSES", ""),
-          "load": caching.Cache.load_overload, "meta_path": list(sys.meta_path), "hooks": list(sys.path_hooks)}
+          "load": caching.Cache.load_overload, "meta_path": list(sys.meta_path), "hooks": list(sys.path_hooks),
+          "function_cache": caching.FunctionCache, "function_cache_load": caching.FunctionCache.load_overload}
 stamp = None
 light = {}
 if mode != "plain":
@@ -68,7 +69,10 @@ print(json.dumps({
     "atexit_same": atexit_names == {n: id(getattr(atexit, n)) for n in dir(atexit)},
     "environ_same": environ == dict(os.environ),
     "layer_same": numba.config.THREADING_LAYER == before["layer"],
-    "load_same": caching.Cache.load_overload is before["load"],
+    "load_same": caching.Cache.load_overload is before["load"]
+                 and caching.FunctionCache is before["function_cache"]
+                 and caching.FunctionCache.load_overload is before["function_cache_load"]
+                 and type(usermod.user_kernel._cache) is caching.FunctionCache,
     "meta_path_same": [type(f) for f in sys.meta_path] == [type(f) for f in before["meta_path"]],
     "hooks_same": sys.path_hooks == before["hooks"],
     "light": light, "user_cache_plain": "load_overload" not in vars(usermod.user_kernel._cache),

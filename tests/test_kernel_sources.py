@@ -57,6 +57,8 @@ def _step(folder: Path, cache: Path) -> dict:
     env = {**os.environ, "STEERLAB_CACHE_DIR": str(cache),
            "PYTHONPATH": os.pathsep.join([str(folder), str(SRC)])}
     env.pop("STEERLAB_DRIVER_CACHE", None)
+    # NUMBA_CACHE_DIR (.ci/run-pins sets it for the whole suite) would move numba's files out of the test's folder
+    env.pop("NUMBA_CACHE_DIR", None)
     p = subprocess.run([sys.executable, "-c", STEP], cwd=folder, env=env, capture_output=True, text=True,
                        timeout=600)
     assert p.returncode == 0, p.stderr

@@ -1,7 +1,8 @@
 """steerlab's own cached kernels load without numba's compile-time registries
 (steerlab.jit.numba_cache_load), in any process that imports steerlab, and give the same numbers;
 a user's own cached kernel loads the numba way beside them, and a later compilation in the same
-process still gets the registries. numba's ``Cache`` class is not touched."""
+process still gets the registries. numba's ``Cache`` and ``FunctionCache`` classes are not touched:
+the light load is an attribute of each steerlab cache instance, given as numba makes it."""
 
 from __future__ import annotations
 
@@ -58,6 +59,8 @@ print(json.dumps({"value": value, "y": y.tolist(), "hits": sum(kmod.everything.s
                   "registries_after_user": "numba.np.arraymath" in sys.modules,
                   "user_cache_plain": "load_overload" not in vars(kmod.everything._cache),
                   "class_same": caching.Cache.load_overload is numba_load,
+                  "caches_numbas": type(_transposed_df2._cache) is type(kmod.everything._cache) is caching.FunctionCache,
+                  "steerlab_given": "load_overload" in vars(_transposed_df2._cache),
                   "compiled": compiled, "enabled": numba_cache_load.enabled()}))
 '''
 
@@ -83,6 +86,8 @@ def test_steerlabs_kernels_load_light_a_users_the_numba_way_and_compiling_still_
     assert numba_way["registries_after_steerlab"]
     assert light["registries_after_user"]                          # the user's load: numba's full refresh
     assert light["user_cache_plain"] and light["class_same"]
+    assert light["caches_numbas"] and numba_way["caches_numbas"]   # numba's own class, made by numba
+    assert light["steerlab_given"] and not numba_way["steerlab_given"]  # the light load: an attribute of that instance
     for key in ("value", "y"):
         assert light[key] == numba_way[key] == compiled[key], key
     assert light["compiled"] == 2.0 + 1.0                          # norm([1, 1, 1, 1]) + len({"x": 1.0})

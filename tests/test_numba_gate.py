@@ -36,7 +36,9 @@ with warnings.catch_warnings(record=True) as caught:
     allowed = numba_gate.internals_allowed()
     fused = dispatch.supported_options({"forceinline": True, "_nrt": False})
     pays = threading_layer.threads_pay()
+from numba.core import caching, dispatcher as numba_dispatcher
 print(json.dumps({"hash": h.hexdigest(), "allowed": allowed, "settings": settings,
+                  "cache_hook": numba_dispatcher.FunctionCache is not caching.FunctionCache,
                   "stamp": numba_cache.INSTALLED, "light": numba_cache_load.STATS["light"], "fused": fused,
                   "pays": pays, "layer": numba.config.THREADING_LAYER,
                   "warnings": [str(w.message) for w in caught if w.category is numba_gate.NumbaVersionWarning]}))
@@ -80,6 +82,7 @@ def test_another_numba_warns_once_uses_no_internals_and_gives_the_same_numbers(t
     assert real["layer"] == "forksafe"
     assert other["hash"] == real["hash"]                                   # the same numbers
     assert len(other["warnings"]) == 1 and "numba 0.70.0" in other["warnings"][0]
+    assert real["cache_hook"] and not other["cache_hook"]                    # numba's dispatcher as numba made it
     assert not other["allowed"] and not other["stamp"] and not other["light"] and other["fused"] == {}
     assert other["settings"] == {"numba_blas_probe": False, "threading_layer": True}
     assert other["pays"] is False                                          # no threaded step (call_at)

@@ -148,7 +148,7 @@ def _make_locator(base):
             for locator_class in _INNER:
                 inner = locator_class.from_function(py_func, py_file)
                 if inner is not None:
-                    return cls._claimed(py_func, cls(inner, name))
+                    return cls(inner, name)
             if driver and p.exists():
                 # no writable folder anywhere (a read-only cache, no user cache): the driver's
                 # own folder still serves its checked machine code; a save there warns once
@@ -161,17 +161,8 @@ def _make_locator(base):
                         locator = cls(locator_class(py_func, py_file), name)
                     except Exception:  # noqa: BLE001 - a locator of another shape: try the next
                         continue
-                    return cls._claimed(py_func, locator)
+                    return locator
             return None
-
-        @staticmethod
-        def _claimed(py_func, locator):
-            """The locator of a steerlab function, after giving the cache numba is making for
-            it the light load (:mod:`steerlab.jit.numba_cache_load`)."""
-            from steerlab.jit import numba_cache_load
-
-            numba_cache_load.give_to_cache_being_made(py_func)
-            return locator
 
     _PackageStampLocator.__name__ = _PackageStampLocator.__qualname__ = "PackageStampLocator"
     _PackageStampLocator.__module__ = __name__
@@ -207,9 +198,10 @@ def install() -> bool:
             return False        # a class numba cannot find either: numba says so at first use
         _INNER[:] = inner
         config.CACHE_LOCATOR_CLASSES = f"{CONFIG_NAME},{user}"
-    from steerlab.jit import cache_check
+    from steerlab.jit import cache_check, numba_cache_load
 
     cache_check.install()          # the files the locator claims are checked before use
+    numba_cache_load.install()     # and their caches, made by numba, load light
     INSTALLED = True
     return True
 

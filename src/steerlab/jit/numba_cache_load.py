@@ -14,23 +14,28 @@ Loading machine code needs none of it: only the symbols that code links against.
   imported;
 * third-party numba extensions (``numba.core.entrypoints.init_all``).
 
-Only steerlab's own dispatchers load that way. numba's ``Cache`` class is not touched: while
-numba makes the cache of a function in a steerlab file (a package kernel or a generated driver,
-the files :class:`steerlab.jit.numba_cache.PackageStampLocator` claims), the locator calls
-:func:`give_to_cache_being_made`, which finds that cache instance (the ``Cache.__init__`` that
-asked the locator, a few frames up) and gives it, as an attribute of that one instance, a
-``load_overload`` that prepares exactly the symbols above and then loads (:func:`give`). A
-user's own ``@numba.njit(cache=True)`` functions, and any code that is not steerlab's, load as
-numba loads them (``tests/test_import_side_effects.py``). Compiling is unchanged: numba's
-compiler refreshes the context itself before every compilation, so a process that compiles
-later (a user's function, a cache miss) gets the registries then. A light load that fails for
-any reason is retried the numba way (full refresh).
+Only steerlab's own dispatchers load that way, and the hook sits where their caches are made.
+numba makes a dispatcher's cache in ``Dispatcher.enable_caching`` (``@numba.njit(cache=True)``)
+as ``FunctionCache(py_func)``, the name ``FunctionCache`` looked up in ``numba.core.dispatcher``.
+:func:`install` (called by :func:`steerlab.jit.numba_cache.install`, right after it puts steerlab's
+cache locator in place) binds that name to :class:`StampedFunctionCache`, a ``FunctionCache``
+subclass that makes numba's own ``FunctionCache`` and returns it: unchanged when its locator is
+not steerlab's (a user's function, any code that is not steerlab's: the same object, of numba's
+class, numba's load), and, when it is (a package kernel or a generated driver, the files
+:class:`steerlab.jit.numba_cache.PackageStampLocator` claims), after giving that one instance a
+``load_overload`` attribute that prepares exactly the symbols above and then loads
+(:func:`give`). numba's classes (``Cache``, ``FunctionCache``) are not touched
+(``tests/test_import_side_effects.py``, ``tests/test_numba_cache_load.py``), nor are
+``numba.core.caching``'s names, ``@cfunc`` or ``@vectorize`` caches (numba's load). Compiling is
+unchanged: numba's compiler refreshes the context itself before every compilation, so a process
+that compiles later (a user's function, a cache miss) gets the registries then. A light load that
+fails for any reason is retried the numba way (full refresh).
 
-It reaches numba internals (the shape of ``Cache.__init__`` and ``Cache._load_overload``,
-written against numba 0.68), so it acts only on the numba versions the tests cover
-(:mod:`steerlab.jit.numba_gate`); elsewhere, or if the names it needs are missing, steerlab's
-kernels load the numba way. Set ``STEERLAB_LIGHT_CACHE_LOAD=0`` (before ``import steerlab``)
-to switch it off.
+It reaches numba internals (``numba.core.dispatcher.FunctionCache``, a cache's ``_impl.locator``
+and ``Cache._load_overload``, written against numba 0.67-0.68), so it is installed only on the
+numba versions the tests cover (:mod:`steerlab.jit.numba_gate`); elsewhere, or if a name it
+needs is missing, steerlab's kernels load the numba way (slower, the same numbers). Set
+``STEERLAB_LIGHT_CACHE_LOAD=0`` (before ``import steerlab``) to switch it off.
 
 Measured with ``python benchmarks/bench_startup_ab.py`` (2026-11-29, ``benchmarks/RESULTS.md``,
 "Start-up after the light load of steerlab's own kernels"): a library user's first
@@ -41,7 +46,6 @@ boundary (``a91f3ce``) did, where it was 1.55x that tree's CPU without it.
 from __future__ import annotations
 
 import os
-import sys
 
 ENV = "STEERLAB_LIGHT_CACHE_LOAD"
 STATS = {"given": 0, "light": 0, "fallback": 0}
@@ -98,28 +102,66 @@ def give(cache) -> bool:
     return True
 
 
-def give_to_cache_being_made(py_func) -> bool:
-    """Called by :class:`steerlab.jit.numba_cache.PackageStampLocator` when it claims
-    ``py_func``'s file: give the light load to the cache numba is making for ``py_func`` (the
-    ``self`` of the ``Cache.__init__`` frame that asked the locator, identified by its code
-    object and its ``_py_func``). Returns whether it did; anything unexpected (another call
-    shape, another numba) leaves that cache as numba made it."""
+def give_if_ours(cache) -> bool:
+    """Give ``cache`` (a numba ``Cache`` numba has just made) the light load if its locator is
+    steerlab's (:class:`steerlab.jit.numba_cache.PackageStampLocator`); returns whether it has it.
+    Any other cache, or one of another shape, is left as numba made it."""
+    impl = getattr(cache, "_impl", None)
+    if not getattr(getattr(impl, "locator", None), "_steerlab", False):
+        return False
+    return give(cache)
+
+
+StampedFunctionCache = None
+"""The subclass of numba's ``FunctionCache`` that :func:`install` binds in
+``numba.core.dispatcher`` (made there, on the ``FunctionCache`` of the numba in use)."""
+
+INSTALLED = False
+"""Whether steerlab's dispatchers get the light load in this process (:func:`install`)."""
+
+
+def _make_stamped(function_cache):
+    class _StampedFunctionCache(function_cache):
+        __doc__ = ("numba's FunctionCache, made by numba; steerlab's own files' caches get the "
+                   "light load (steerlab.jit.numba_cache_load).")
+        _steerlab = True
+
+        def __new__(cls, py_func, *args, **kwargs):
+            cache = function_cache(py_func, *args, **kwargs)   # numba's own class and instance
+            try:
+                give_if_ours(cache)
+            except Exception:  # noqa: BLE001 - anything unexpected: the cache as numba made it
+                pass
+            return cache       # not an instance of cls: Python does not call __init__ again
+
+    _StampedFunctionCache.__name__ = _StampedFunctionCache.__qualname__ = "StampedFunctionCache"
+    _StampedFunctionCache.__module__ = __name__
+    return _StampedFunctionCache
+
+
+def install() -> bool:
+    """Make numba give the caches of steerlab's own dispatchers the light load as it makes them
+    (module docstring); idempotent. Called by :func:`steerlab.jit.numba_cache.install` once its
+    locator is in place, so before any steerlab kernel is defined. Returns whether it is
+    installed: ``False`` when switched off (``STEERLAB_LIGHT_CACHE_LOAD=0``), outside the tested
+    numba versions, or if numba no longer makes caches the way described (numba's load then)."""
+    global StampedFunctionCache, INSTALLED
     if not enabled():
         return False
     try:
-        from numba.core import caching
+        from numba.core import caching, dispatcher
 
-        init = caching.Cache.__init__.__code__
-        frame = sys._getframe(1)
-    except (ImportError, AttributeError, ValueError):  # pragma: no cover - another numba/Python
+        current = dispatcher.FunctionCache
+        caching.Cache._load_overload  # noqa: B018 - the names the light load needs
+        caching.Cache._guard_against_spurious_io_errors  # noqa: B018
+    except (ImportError, AttributeError):  # pragma: no cover - depends on the numba version
         return False
-    for _ in range(6):                     # locator <- CacheImpl.__init__ <- Cache.__init__
-        if frame is None:
-            return False
-        if frame.f_code is init:
-            cache = frame.f_locals.get("self")
-            if isinstance(cache, caching.Cache) and getattr(cache, "_py_func", None) is py_func:
-                return give(cache)
-            return False
-        frame = frame.f_back
-    return False
+    if getattr(current, "_steerlab", False):
+        INSTALLED = True
+        return True
+    if current is not caching.FunctionCache:  # pragma: no cover - someone else's: leave it
+        return False
+    StampedFunctionCache = _make_stamped(current)
+    dispatcher.FunctionCache = StampedFunctionCache
+    INSTALLED = True
+    return True
