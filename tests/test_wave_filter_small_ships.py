@@ -42,7 +42,7 @@ def test_gain_scale_designed_only_where_the_filter_is_designed():
 
 def _leak(pf: "WF.WaveFilterParams", h: float, seconds: float = 1800.0) -> float:
     """Std [rad] over the last 600 s of the heading estimate's error on a ship the filter's model
-    knows (K 0.173 1/s, T 14.7 s: the Zeefakkel at 4.1 kn), steered by a slow rudder (5 deg at
+    knows (K 0.173 1/s, T 14.7 s: the Zeefakkel at 8 kn), steered by a slow rudder (5 deg at
     0.05 rad/s), in a wave yaw of 5 deg at 0.84 rad/s (its encounter frequency in sea state 5)."""
     K, T = 0.173, 14.7
     p = pf.pack()
