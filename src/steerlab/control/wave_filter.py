@@ -53,10 +53,13 @@ error: wind, wrong K or tau) and a high-frequency part ``eps_H = eps - eps_L`` (
 powers ``P_L``, ``P_H`` are averaged with time constant ``T_pow``::
 
     xi     = (P_L + P0) / (P_L + P_H + P0),   xi_min <= xi <= 1        (0 < xi <= 1: 4.69)
-    k_psi  = min(gain_scale xi, 1),   k_r = k_psi^2 / (2 - k_psi)       (Benedict-Bordner)
+    k_psi  = g xi / (1 - xi + g xi),   k_r = k_psi^2 / (2 - k_psi)      (Benedict-Bordner)
 
-(``gain_scale`` = 1 in the thesis' filter, ``k_psi = xi``; the designed filter's is ``h / h_d``,
-:func:`designed_gain_scale`, so that its bandwidth in 1/s does not grow as the sample shrinks.)
+(``g`` = ``gain_scale``: 1 in the thesis' filter, ``k_psi = xi``; the designed filter's is
+``h / h_d``, :func:`designed_gain_scale`: the power ratio ``k_psi / (1 - k_psi) = g (P_L + P0) / P_H``
+is scaled, so ``k_psi ~ g xi`` in a sea, where ``xi`` is small and the filter's bandwidth in 1/s
+then does not grow as the sample shrinks, while with no noise seen, ``xi = 1``, the filter still
+passes the measurement through, ``k_psi = 1``, at any sample time.)
 
 ``P0`` [rad^2] is the noise floor: when the absolute noise level is low, ``xi -> 1`` and the
 filter passes the measurement through (``psi^ = psi``, ``r^`` = the heading difference); in
@@ -115,8 +118,9 @@ PARAMS = Layout("controller.wave_filter", "WF_", [
                 default=0.02),
     RecordField("KB", "bias_gain", "-", "gain of the yaw-bias estimate b, in units of the alpha-beta-gamma "
                 "tracker's gamma (0: no bias state, the thesis' filter)", 0.0, 10.0, default=0.0),
-    RecordField("GS", "gain_scale", "-", "the filter gain is k_psi = min(gain_scale xi, 1): h / h_d keeps the "
-                "filter's bandwidth in 1/s that of its tuning at the sample time h_d (1: the thesis' filter)",
+    RecordField("GS", "gain_scale", "-", "scale g of the filter gain k_psi = g xi / (1 - xi + g xi): h / h_d keeps "
+                "the filter's bandwidth in 1/s in a sea that of its tuning at the sample time h_d (1: the thesis' "
+                "filter)",
                 0.0, 1.0, lo_open=True, default=1.0),
 ], size_name="N_WF_PARAMS")
 PARAMS.export(globals())         # WF_TLF = 0, WF_TPOW = 1, WF_P0 = 2, WF_XIMIN = 3, WF_KB = 4, WF_GS = 5, N_WF_PARAMS = 6
@@ -165,8 +169,12 @@ def designed_gain_scale(sample_time: float) -> float:
     estimate as about ``A (k_psi / h) / w_e``. On a small ship that is the whole story: the
     Zeefakkel at 8 kn in JONSWAP sea state 5 yaws 4.7 deg (std) at a 7.5 s encounter period;
     at ``h = 0.1 s`` with ``xi`` = 0.004 the estimate kept 0.22 deg of it and a PID behind the
-    filter reversed its rudder 9 times a minute (issue 30's sea leg). With ``k_psi = xi h / h_d``
-    the correction rate is the tuning's at any step, and so are the rate gain
+    filter reversed its rudder 9 times a minute (issue 30's sea leg). With ``k_psi ~ xi h / h_d``
+    (the exact form in the module docstring keeps ``k_psi = 1`` at ``xi = 1``: with no noise seen
+    the filter passes the measurement through at any step, as the thesis' does; a plain
+    ``xi h / h_d`` made the filter trust its model from the first sample, and backstepping A
+    behind it put the B-481's rudder to port for a starboard change)
+    the correction rate in a sea is the tuning's at any step, and so are the rate gain
     ``k_r / h^2 ~ k_psi^2 / (2 h^2)`` and the bias gain ``~ k_psi^3 / (8 h^3)`` of the tracker
     (1/s^2, 1/s^3): the whole filter keeps its bandwidth in 1/s. Above ``h_d`` the gain is not
     raised (``k_psi <= xi``).
@@ -256,7 +264,8 @@ def wave_filter_step(zf, pf, K, tau, psi_meas, delta, h):
     p0 = pf[WF_P0]
     xi = (pl + p0) / (pl + ph + p0)
     xi = min(max(xi, pf[WF_XIMIN]), 1.0)
-    k_psi = min(pf[WF_GS] * xi, 1.0)
+    gs = pf[WF_GS]
+    k_psi = xi if gs == 1.0 else gs * xi / (1.0 - xi + gs * xi)     # the thesis' gain bit for bit at g = 1
     k_r = k_psi * k_psi / (2.0 - k_psi)
     zf[F_PSI] = wrap_to_pi(psi_pred + k_psi * eps)
     zf[F_R] = r_pred + k_r * eps / h
