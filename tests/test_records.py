@@ -203,9 +203,9 @@ def test_wrapper_records_compose_with_the_inner_layout():
     assert (wrapper.Z_CALLS, wrapper.Z_PSI, wrapper.Z_R, wrapper.OFF_X) == (0, 1, 2, 3)
     assert (wrapper.P_HI, wrapper.P_SPSI, wrapper.P_DROP, wrapper.P_M, wrapper.OFF_P) == (0, 2, 6, 7, 8)
     assert (wave_filter.F_PSI, wave_filter.F_R, wave_filter.F_XI, wave_filter.F_BIAS, wave_filter.N_WF) == (0, 1, 6, 7, 8)
-    assert (wave_filter.WF_TLF, wave_filter.WF_XIMIN, wave_filter.WF_KB, wave_filter.N_WF_PARAMS) == (0, 3, 4, 5)
+    assert (wave_filter.WF_TLF, wave_filter.WF_XIMIN, wave_filter.WF_KB, wave_filter.WF_GS, wave_filter.N_WF_PARAMS) == (0, 3, 4, 5, 6)
     wf = wave_filtered
-    assert (wf.P_K, wf.P_T, wf.OFF_P, wf.OFF_X, wf.OFF_Z) == (5, 6, 7, 8, 8 + wf.NX_MAX)
+    assert (wf.P_K, wf.P_T, wf.OFF_P, wf.OFF_X, wf.OFF_Z) == (6, 7, 8, 8, 8 + wf.NX_MAX)
 
     inner = pid.PID(Kp=2.5, Ki=0.01, Kd=30.0, u_max=0.5)
     sensed = wrapper.sensed_layout(pid.PARAMS)

@@ -47,7 +47,8 @@ for the instability is refused as by every law
 refuses a course-unstable ship in one line naming ``controller.type`` and laws that design it.
 Its wave filter (``wave_filter = {...}``, every setting unset) is the one designed for the
 sample time (:func:`steerlab.control.wave_filter.design_filter`: the noise floor scaled as
-``h^4`` and the yaw-bias state, as for every ``"<law>+wf"``); with ``gains = "paper"`` the
+``h^4`` and the yaw-bias state, as for every ``"<law>+wf"``, but its gain not scaled to the
+sample time: the filter's model is ASA's identified one, ``identified=True``); with ``gains = "paper"`` the
 thesis' per-sample defaults, which at a 0.1 s step pass the waves (issue 30's sea-state-5 leg:
 ASA held the course in 1 of 79 cases with them). Designed from ``(K, T)`` alone (no speed), the cruising speed is :func:`nomoto_only_speed`
 (``K* = 1``). Anti-windup: the integral ``Ki`` of
@@ -426,7 +427,8 @@ def build(cfg: ASAConfig, ctx):
             K_star_bounds=(ks_lo, ks_hi), tau_star_bounds=(ts_lo, ts_hi),
             n_ti=cfg.integral_time_constants, rho_acc=cfg.accel_margin, f_delta=cfg.rudder_limit_factor,
             use_estimator=cfg.use_estimator,
-            wave_filter=filter_params(cfg.wave_filter, ctx.sample_time, cfg.gains == "paper"))
+            wave_filter=filter_params(cfg.wave_filter, ctx.sample_time, cfg.gains == "paper",
+                                      identified=True))
     return c, c.pack()
 
 
