@@ -49,12 +49,7 @@ REFUSAL_FIELDS = {"controller.c0", "controller.K_star0", "controller.type"}
 """Fields a design rule may refuse a course-stable ship with (c0: no c_B, B; K*: ASA's range;
 type: a law that cannot design the ship and names one that can, e.g. asa, gain_shaping_pid)."""
 
-KNOWN_STALLS: dict = {
-    ("backstepping_a+wf", "b481"): "behind the designed wave filter (gain scaled to the sample time, issue 30 "
-                                   "'wave filter on small ships') its first minute orders port for a starboard "
-                                   "change (max +0.27 deg); the conformance matrix has it 'never turns' in sea "
-                                   "state 5 before that change too",
-}
+KNOWN_STALLS: dict = {}
 """Pairs whose default settings are known not to turn the ship (the run is still checked); the
 published backstepping B gains that stalled the B-481's turn are now the ``gains = "paper"`` preset."""
 
