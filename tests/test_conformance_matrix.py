@@ -44,18 +44,21 @@ HOLD_TARGET = 0.95
 N_RANDOM_PLANTS = 256
 """Random plants drawn (issue 30: at least 200)."""
 MATRIX_TARGET_NOT_MET_YET = pytest.mark.xfail(
-    strict=True, reason="issue 30's 95 % is not met yet (docs/conformance.md): in calm water 772 of 869 cases "
-                        "steer (89 %; 85 refused in one line, 12 fail); in JONSWAP sea state 5, each law behind "
-                        "the designed wave filter (yaw-bias state; an observer at 2x its loop), 466 of 869 hold "
-                        "the 1 deg band on the 60 s mean heading with at most six rudder reversals a minute "
-                        "(54 %; 342 before the bias state and the slower observer, 15 of 836 without the "
-                        "filter). Strict: an XPASS fails the run, so delete this mark when it is met.")
-CALM_STEER_FLOOR = 0.88
-"""Measured floor (after issue 30's design rules): fraction of calm-water cases that steer."""
-SEA_HOLD_FLOOR = 0.50
-"""Measured floor (the laws behind the designed wave filter with its yaw-bias state): fraction of
-the sea-state-5 cases that hold the change with bounded rudder reversals (measured 0.536 on
-2026-11-29 before the container ship joined the catalogue; issue 30's target is 0.95)."""
+    strict=True, reason="issue 30's 95 % is not met yet (docs/conformance.md, 2026-11-29): 1644 of 1804 cases "
+                        "steer (91.1 %); calm water 881 of 902 (97.7 %; 11 refused in one line, 10 fail); "
+                        "JONSWAP sea state 5, each law behind the designed wave filter, 763 of 902 hold the "
+                        "1 deg band on the 60 s mean heading with at most six rudder reversals a minute "
+                        "(84.6 %; the Kosoko model, the small Zeefakkel's Norrbin entries, the B-481 and the "
+                        "container ship at their lowest speeds fail most). Strict: an XPASS fails the run, "
+                        "so delete this mark when it is met.")
+CALM_STEER_FLOOR = 0.95
+"""Measured floor (after issue 30's design rules): fraction of calm-water cases that steer
+(measured 0.977 on 2026-11-29; a margin for another machine's floating-point path)."""
+SEA_HOLD_FLOOR = 0.80
+"""Measured floor (the laws behind the designed wave filter with its yaw-bias state and its gain
+scaled to the sample time; Norrbin ships taking the waves superposed): fraction of the
+sea-state-5 cases that hold the change with bounded rudder reversals (measured 0.846 on
+2026-11-29; issue 30's target is 0.95)."""
 DESIGNED_HOLD_FLOOR = 0.95
 """Of the random-plant lanes a law designed (not refused), the fraction that must hold the change."""
 KINDS = {"diverged", "spins", "never turns", "limit cycle", "steady offset", "not settled", "rudder reversals"}
