@@ -18,20 +18,18 @@ multiplexer on TCP are read exactly like a UDP talker.
 from __future__ import annotations
 
 import asyncio
-import sys
 from collections import Counter
 
 from steerlab.errors import InputError
 from steerlab.runtime.line_splitter import LineSplitter, nmea_chunks
 from steerlab.runtime.reconnecting_input import ReconnectingInput
+from steerlab.runtime.reconnecting_input import stderr_line as _stderr
 
 NMEA_TCP_PORT = 10110
 """The conventional TCP port of NMEA 0183 over IP (IANA "nmea-0183", used by plotters and
 multiplexers such as OpenCPN, Signal K server and kplex)."""
 
 
-def _stderr(line: str) -> None:
-    print(line, file=sys.stderr, flush=True)
 
 
 class _Lines:

@@ -13,8 +13,9 @@ import sys
 from collections import Counter
 
 
-def _stderr(msg: str) -> None:
-    print(msg, file=sys.stderr, flush=True)
+def stderr_line(line: str) -> None:
+    """The inputs' default ``log``: one line to standard error, flushed."""
+    print(line, file=sys.stderr, flush=True)
 
 
 class ReconnectingInput:
@@ -30,7 +31,7 @@ class ReconnectingInput:
         One-line messages (default: standard error).
     """
 
-    def __init__(self, host: str, port: int, reconnect_period: float = 1.0, log=_stderr):
+    def __init__(self, host: str, port: int, reconnect_period: float = 1.0, log=stderr_line):
         self.host, self.port = host, int(port)
         self.reconnect_period = float(reconnect_period)
         self.log = log

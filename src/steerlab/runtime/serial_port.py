@@ -15,10 +15,10 @@ loop's callbacks; ``connected`` tells the state.
 from __future__ import annotations
 
 import asyncio
-import sys
 from collections import Counter
 
 from steerlab.errors import InputError
+from steerlab.runtime.reconnecting_input import stderr_line as _stderr
 
 DEFAULT_BAUD = 4800
 BAUD_RATES = (1200, 2400, 4800, 9600, 19200, 38400, 57600, 115200, 230400)
@@ -38,8 +38,6 @@ def parse_serial_spec(text: str, field: str, default_baud: int = DEFAULT_BAUD) -
     return path, b
 
 
-def _stderr(line: str) -> None:
-    print(line, file=sys.stderr, flush=True)
 
 
 class SerialLink:

@@ -17,19 +17,17 @@ from __future__ import annotations
 import asyncio
 import json
 import math
-import sys
 from collections import Counter
 
 from steerlab.runtime.nmea_magnetic import MAX_VARIATION_DEG
 from steerlab.runtime.reconnecting_input import ReconnectingInput
+from steerlab.runtime.reconnecting_input import stderr_line as _stderr
 
 INPUT_PATHS = ("navigation.headingTrue", "navigation.headingMagnetic", "navigation.magneticVariation",
                "navigation.position", "navigation.rateOfTurn", "navigation.speedOverGround",
                "steering.rudderAngle")
 
 
-def _stderr(line: str) -> None:
-    print(line, file=sys.stderr, flush=True)
 
 
 def _finite(x) -> bool:
