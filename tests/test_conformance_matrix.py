@@ -109,6 +109,28 @@ def test_judge_in_waves_holds_the_mean_heading():
     assert _judge(drift, waves=True).verdict == J.FAILS       # the mean drifts off course
 
 
+def test_course_made_good_removes_the_wave_yaw_and_keeps_a_slow_swing():
+    """The triangular window's gains: sinc(L / 2P)^2 (judge.course_made_good)."""
+    t = np.arange(0.0, 3000.0, 0.1)
+    late = t > 1000.0
+
+    def left(period):
+        e = np.sin(2 * np.pi * t / period)
+        return np.max(np.abs(J.course_made_good(t, e)[late]))
+
+    def boxcar_left(period):
+        return np.max(np.abs(J.trailing_mean(t, np.sin(2 * np.pi * t / period), J.WAVE_WINDOW)[late]))
+
+    for period in (7.0, 9.0, 9.7, 13.0):                 # the wave yaw of sea state 5
+        assert left(period) <= (period / (np.pi * J.WAVE_WINDOW / 2)) ** 2 + 1e-3
+        assert left(period) < 0.25 * boxcar_left(period)
+    # a 9-s yaw of 5.8 deg std (the Zeefakkel at 3.9 kn) leaves under 0.06 deg, not +-0.55
+    assert np.degrees(np.radians(5.8 * math.sqrt(2)) * left(9.0)) < 0.06
+    assert 0.8 < left(120.0) < 0.82                      # a real slow swing is kept ...
+    assert left(120.0) > boxcar_left(120.0) + 0.15       # ... better than by one 60-s mean
+    assert J.course_made_good(t, np.full_like(t, 0.3))[-1] == pytest.approx(0.3)   # unit gain
+
+
 def test_reversal_counts_and_the_vector_counter_agree():
     t = np.arange(0.0, 60.0, 0.1)
     assert J.count_reversals(np.radians(2.0) * np.sin(2 * np.pi * t / 10.0), math.radians(0.5)) == 12   # 6 periods: 12 extremes

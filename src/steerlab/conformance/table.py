@@ -83,7 +83,7 @@ def markdown(m: Matrix) -> str:
            "and stays there for the whole hold window at the end of the run, and the rudder reverses at most "
            f"{J.MAX_REVERSALS_PER_MIN:g} times a minute after the change (a reversal counts once the rudder "
            f"came back {J.REVERSAL_HYST_DEG:g} deg from its last extreme). In waves the heading judged is "
-           f"its trailing mean over {J.WAVE_WINDOW:g} s (the course made good; the heading itself swings "
+           f"its mean over a triangular window of {J.WAVE_WINDOW:g} s (the course made good; the heading itself swings "
            "at the encounter frequency whatever the autopilot does).",
            "* **refused** (R): the design raised `InputError`, one line naming the field to give "
            "(listed below).",
