@@ -13,7 +13,8 @@ import numpy as np
 import pytest
 
 from steerlab.control.adrc import HERBST, NO_CLAMP
-from steerlab.control.design_context import OBSERVER_MULTIPLE, OBSERVER_MULTIPLE_FILTERED
+from steerlab.control.design_context import (OBSERVER_MULTIPLE, OBSERVER_MULTIPLE_FILTERED,
+                                             OBSERVER_MULTIPLE_FILTERED_UNSTABLE)
 from steerlab.control.backstepping_a import (A_TIME_UNIT, PAPER_GAINS, design_gains, design_gains_a, stiffness,
                                             third_pole)
 from steerlab.control.design_model import ZETA, bandwidth, design_model
@@ -118,7 +119,7 @@ def test_an_observer_behind_the_wave_filter_is_slower_than_on_a_direct_measureme
     ship = "capella-nomoto-10deg"
     direct, filtered = obj(ship, {"type": law}), obj(ship, {"type": law + "+wf"}).inner
     w = bandwidth(design_model(ctx_of(ship)))
-    assert OBSERVER_MULTIPLE_FILTERED < OBSERVER_MULTIPLE
+    assert OBSERVER_MULTIPLE_FILTERED < OBSERVER_MULTIPLE_FILTERED_UNSTABLE < OBSERVER_MULTIPLE
     if law == "adrc":
         np.testing.assert_allclose(np.sort(eso_poles(direct.L).real), [-OBSERVER_MULTIPLE * w] * 3, rtol=1e-4)
         np.testing.assert_allclose(np.sort(eso_poles(filtered.L).real), [-OBSERVER_MULTIPLE_FILTERED * w] * 3,
@@ -127,6 +128,22 @@ def test_an_observer_behind_the_wave_filter_is_slower_than_on_a_direct_measureme
     else:
         assert filtered.beta[0] == pytest.approx(direct.beta[0] * OBSERVER_MULTIPLE_FILTERED / OBSERVER_MULTIPLE)
         assert (filtered.k1, filtered.k2, filtered.b) == (direct.k1, direct.k2, direct.b)
+
+
+@pytest.mark.parametrize("law", ["adrc", "nonlinear_adrc"])
+def test_behind_the_filter_a_course_unstable_ship_keeps_a_faster_observer(law):
+    """A course-unstable design model (the Esso, T < 0) gets OBSERVER_MULTIPLE_FILTERED_UNSTABLE:
+    the observer estimates the hull's own divergence and must not lag it."""
+    m = design_model(ctx_of("esso", 16.0))
+    assert m.T < 0
+    direct = obj("esso", {"type": law}, speed_kn=16.0)
+    filtered = obj("esso", {"type": law + "+wf"}, speed_kn=16.0).inner
+    if law == "adrc":
+        w = -np.sort(eso_poles(direct.L).real)[0] / OBSERVER_MULTIPLE
+        np.testing.assert_allclose(np.sort(eso_poles(filtered.L).real),
+                                   [-OBSERVER_MULTIPLE_FILTERED_UNSTABLE * w] * 3, rtol=1e-4)
+    else:
+        assert filtered.beta[0] == pytest.approx(direct.beta[0] * OBSERVER_MULTIPLE_FILTERED_UNSTABLE / OBSERVER_MULTIPLE)
 
 
 def test_adrc_design_of_a_course_unstable_ship_uses_the_exact_b2_and_a_loop_above_its_pole():

@@ -229,7 +229,7 @@ def build(cfg: ADRCConfig, ctx):
     elif observer == "bandwidth":
         L = eso_gains_bandwidth(cfg.observer_bandwidth)
     elif observer == "design":
-        L = eso_gains_bandwidth(observer_multiple(ctx) * HERBST / T_settle)
+        L = eso_gains_bandwidth(observer_multiple(ctx, law_bandwidth(ctx, "adrc")[0].T < 0) * HERBST / T_settle)
     else:
         L = eso_gains_lqr(cfg.lqr_q, cfg.lqr_r)
     field = "controller.L" if cfg.L is not None else (

@@ -44,18 +44,30 @@ class DesignContext:
 OBSERVER_MULTIPLE = 5.0
 """Bandwidth of a law's extended-state observer in multiples of its loop's, on a direct
 measurement [-] (Gao 2003 advises 3-10)."""
-OBSERVER_MULTIPLE_FILTERED = 2.0
-"""The same behind the wave filter [-]. The filter's low-frequency heading still carries a
-residual of the wave motion; a third-order observer turns a ripple ``e`` at the encounter
-frequency ``w_e`` into a disturbance estimate of about ``w_o^3 e / w_e`` and a rudder order
-of that over ``b2``, so the ripple reaches the rudder as ``(w_o / w_n)^3``: 5x the loop's
-bandwidth gave 10-16 rudder reversals a minute in sea state 5 on the conformance matrix's
-ships, 2x gives 2-5 while the course is held (docs/conformance.md). Below Gao's range, which
+OBSERVER_MULTIPLE_FILTERED = 1.0
+"""The same behind the wave filter, for a course-stable design model [-]. The filter's
+low-frequency heading still carries a residual of the wave motion; a third-order observer
+turns a ripple ``e`` at the encounter frequency ``w_e`` into a disturbance estimate of about
+``w_o^3 e / w_e`` and a rudder order of that over ``b2``, so the ripple reaches the rudder as
+``(w_o / w_n)^3``: 5x the loop's bandwidth gave 10-16 rudder reversals a minute in sea state 5
+on the conformance matrix's ships, 2x gives 2-5 on most, but 9-12 on the small Zeefakkel,
+which yaws 5-6 deg (std) at a 9-s encounter period only 11 times faster than its loop; 1x
+gives 3-6 there (issue 30). On the design model the linear ADRC's closed loop is then
+``(s + w_n)^2 (s + w_o)^3`` as at any multiple (its poles separate exactly), only the
+disturbance is estimated no faster than the loop acts on it. Below Gao's range, which
 assumes a clean measurement."""
+OBSERVER_MULTIPLE_FILTERED_UNSTABLE = 2.0
+"""The same for a course-unstable design model (``T < 0``) [-]: the observer estimates the
+hull's own divergence ``-r / T`` as part of the disturbance, and at 1x it lags it: the Esso,
+the MSS tanker and the KVLCC2 (unstable) then wander +-1.5-5 deg in sea state 5 where 2x holds
+them (issue 30's matrix)."""
 
 
-def observer_multiple(ctx) -> float:
+def observer_multiple(ctx, course_unstable: bool = False) -> float:
     """The observer's bandwidth over the loop's [-] for the measurement of ``ctx``
-    (:data:`OBSERVER_MULTIPLE` direct, :data:`OBSERVER_MULTIPLE_FILTERED` behind the wave filter)."""
-    return OBSERVER_MULTIPLE_FILTERED if getattr(ctx, "measurement", "direct") == "wave-filtered" \
-        else OBSERVER_MULTIPLE
+    (:data:`OBSERVER_MULTIPLE` direct; behind the wave filter
+    :data:`OBSERVER_MULTIPLE_FILTERED`, or :data:`OBSERVER_MULTIPLE_FILTERED_UNSTABLE` when the
+    design model is ``course_unstable``)."""
+    if getattr(ctx, "measurement", "direct") != "wave-filtered":
+        return OBSERVER_MULTIPLE
+    return OBSERVER_MULTIPLE_FILTERED_UNSTABLE if course_unstable else OBSERVER_MULTIPLE_FILTERED

@@ -269,7 +269,7 @@ def build(cfg: NonlinearADRCConfig, ctx):
         if omega_o is None and cfg.beta is None and cfg.reference_b is None:
             if omega_c is None:
                 omega_c = law_bandwidth(ctx, "nonlinear_adrc")[1]
-            omega_o = observer_multiple(ctx) * omega_c
+            omega_o = observer_multiple(ctx, law_bandwidth(ctx, "nonlinear_adrc")[0].T < 0) * omega_c
     if cfg.reference_b is not None:
         if cfg.k1 is None or cfg.k2 is None or cfg.beta is None:
             raise InputError("controller.reference_b", "needs k1, k2 and beta (the reference ship's setting)")
