@@ -120,6 +120,34 @@ def test_gain_shaping_designs_an_unstable_model_by_pole_placement_and_its_paper_
     assert '"pid"' in str(ei.value) and '"lq_pd"' in str(ei.value)
 
 
+def test_gain_shaping_does_not_cancel_a_pole_slower_than_its_integral(control):
+    """A nearly neutral ship (Bech's small tanker at 8.25 m/s as a second-order Nomoto model:
+    T1 = 1667 s, T2 = 10 s, T3 = 22 s; first-order K = 2 1/s, T = 1655 s): cancelling -1/T
+    with the gain-shaping zero leaves a closed-loop mode of thousands of seconds on the real
+    ship (the heading crept 8.7 deg past the new course); T > 10 T01, so the design rule places
+    the poles as pid does, and every closed-loop pole is faster than 1/(10 T01)."""
+    from steerlab.control.gain_shaping_pid import INTEGRAL_DIVISOR, design_T01
+    from steerlab.components.design import design_context
+
+    K, T1, T2, T3 = 2.0, 1667.0, 10.0, 22.0
+    T = T1 + T2 - T3
+    ship = control.tf([K * T3, K], np.polymul([T1, 1.0], [T2, 1.0, 0.0]))
+    T01 = design_T01(design_model(design_context(nomoto=(K, T), gear=GEAR)))
+    assert T > INTEGRAL_DIVISOR * T01
+
+    def slowest(c):
+        return min(abs(np.real(control.poles(control.feedback(transfer_function(c) * ship, 1)))))
+
+    gsp = controller("gain_shaping_pid", nomoto=(K, T), gear=GEAR)
+    np.testing.assert_array_equal(gsp.params, controller("pid", nomoto=(K, T), gear=GEAR).params)
+    assert slowest(gsp) > 1.0 / (INTEGRAL_DIVISOR * T01)
+    cancelling = controller("gain_shaping_pid", nomoto=(K, T), gear=GEAR, T01=T01)   # the paper's rule
+    assert slowest(cancelling) < 1.0 / 1000.0
+    # a course-stable ship with T within 10 T01 keeps the gain-shaping rule
+    assert not np.array_equal(controller("gain_shaping_pid", nomoto=(0.1, 56.0), gear=GEAR).params,
+                              controller("pid", nomoto=(0.1, 56.0), gear=GEAR).params)
+
+
 def _step(law, K, T, gear, dmax, rate, t_end=4000.0, dt=0.1):
     """A first-order Nomoto ship in plain Python (Euler), the gear as a rate-limited saturation;
     a 20 deg course change at t = 100 s. Returns (time, heading) [s, rad]."""

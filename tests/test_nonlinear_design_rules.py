@@ -7,6 +7,7 @@ that names the field and a law that can. The catalogue-wide runs are the conform
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -18,6 +19,7 @@ from steerlab.control.design_context import (OBSERVER_MULTIPLE, OBSERVER_MULTIPL
 from steerlab.control.backstepping_a import (A_TIME_UNIT, PAPER_GAINS, design_gains, design_gains_a, stiffness,
                                             third_pole)
 from steerlab.control.design_model import ZETA, bandwidth, design_model
+from steerlab.control.law_design import BAND_MARGIN, band_gain
 from steerlab.control.estimators import PAPER_L, eso_poles
 from steerlab.control.heading_integral import integral_step
 from steerlab.control.nonlinear_adrc import time_scale_factor, time_scale_retune
@@ -146,12 +148,21 @@ def test_behind_the_filter_a_course_unstable_ship_keeps_a_faster_observer(law):
         assert filtered.beta[0] == pytest.approx(direct.beta[0] * OBSERVER_MULTIPLE_FILTERED_UNSTABLE / OBSERVER_MULTIPLE)
 
 
-def test_adrc_design_of_a_course_unstable_ship_uses_the_exact_b2_and_a_loop_above_its_pole():
+def test_adrc_design_of_a_course_unstable_ship_uses_its_gain_over_the_band_and_a_loop_above_its_pole():
+    """band_gain: K/T where the loop is at least twice as fast as the ship's pole (esso: the
+    exact b2 is 2.5 times larger), the exact b2 for a loop at the ship's own pole (kosoko)."""
     c = obj("esso", {"type": "adrc"}, speed_kn=16.0)
     m = design_model(ctx_of("esso", 16.0))
-    assert c.c0 == m.b2 and "exact" in c.c0_source
     w = HERBST / (HERBST / math.sqrt(c.Kp))
-    assert w >= 2.0 * abs(m.a)
+    assert w >= 2.0 * abs(m.a) and w * abs(m.T) >= BAND_MARGIN
+    assert c.c0 == m.b == pytest.approx(m.K / m.T) and "K/T" in c.c0_source
+    assert m.b2 > 2.0 * m.b
+    nl = obj("esso", {"type": "nonlinear_adrc"}, speed_kn=16.0)
+    assert nl.b == m.b
+    # a loop at the ship's own pole (kosoko at 0.972 kn: T = -3.87 s, omega_n = 0.31 rad/s) keeps b2
+    fast = dataclasses.replace(m, T=-3.87, K=-3.87 * m.b)
+    assert band_gain(fast, 0.31) == (fast.b2, band_gain(fast, 0.31)[1]) and "exact" in band_gain(fast, 0.31)[1]
+    assert band_gain(fast, 2.0 * BAND_MARGIN / 3.87)[0] == fast.b
 
 
 def test_eso_disturbance_clamp_is_conditional_integration():

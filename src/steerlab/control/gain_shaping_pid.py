@@ -48,6 +48,20 @@ every closed-loop pole at the shared bandwidth and cancels nothing; ``describe()
 rule that was used. ``gains = "paper"`` (or a given ``T01``) keeps the paper's rule and
 refuses a course-unstable model in one line naming ``controller.type`` and the laws that
 design it (``pid``, ``lq_pd``).
+
+A course-stable model whose pole is **slower than the loop's integral action**, ``T >
+INTEGRAL_DIVISOR T01`` (:func:`cancels_too_slow_a_pole`), is not cancelled either. The
+cancelled pole ``-1/T`` stays a closed-loop pole (above); only an exact first-order Nomoto
+ship leaves it unexcited. Every difference between the ship and its design model (the ship's
+second time constant and its zero, a nonlinear yaw damping, the integral, a sea) excites it,
+and the heading then settles with the ship's own ``T`` rather than the designed ``T01``: the
+slowest mode the design accepts is its integral's, ``1/(INTEGRAL_DIVISOR T01)``
+(Fossen 2011, Sec. 12.2.7: ``omega/10``). This is the known weakness of pole-cancelling PID
+rules on lag-dominant plants; Skogestad's SIMC rule (J. Process Control 13 (2003) 291-309,
+eq (15)) bounds the cancelled time constant for the same reason (``tau_I = min(tau_1,
+4 (tau_c + theta))``). Such a model (a nearly neutrally stable ship, e.g. Bech's small
+tanker at 8.25 m/s: ``T = 1645 s`` against ``T01 = 26 s``; its heading crept 8.7 deg past the
+new course in 1400 s) is designed by the same PID pole placement as a course-unstable one.
 """
 
 from __future__ import annotations
@@ -71,8 +85,9 @@ PAPER_T01 = 20.0
 DESIGN_RULE = ("first-order closed-loop gain shaping on the Nomoto heading model (berthing paper 2019, eqs 17-19): "
                "kp = 1/(K T01), kd = T/(K T01); T01 = max(1/omega_n, 20 deg/(0.7 delta_max K)) from the shared "
                "bandwidth rule, ki = kp/(10 T01) with clamping anti-windup (gains = 'paper': T01 = 20 s, ki = 0); "
-               "a course-unstable model (T < 0) is not cancelled: PID pole placement on the Nomoto model instead "
-               "(Fossen 2011, 12.2.7, as pid)")
+               "a course-unstable model (T < 0) or one whose pole is slower than the integral (T > 10 T01: the "
+               "cancelled pole would set the settling, cf. Skogestad 2003 SIMC) is not cancelled: PID pole placement on "
+               "the Nomoto model instead (Fossen 2011, 12.2.7, as pid)")
 
 
 def gain_shaping_gains(T01: float, a2: float, a1: float, a0: float, b0: float) -> tuple[float, float, float]:
@@ -108,12 +123,19 @@ def design_T01(m) -> float:
     return max(1.0 / bandwidth(m, law="gain_shaping_pid"), DESIGN_TURN / (GEAR_USE * m.delta_max * m.K))
 
 
+def cancels_too_slow_a_pole(m, T01: float) -> bool:
+    """True when the ship pole ``-1/T`` the rule cancels is slower than the integral action of
+    the designed loop: ``T > INTEGRAL_DIVISOR T01`` (module doc; ``T = inf``, a neutrally
+    stable model, included)."""
+    return m.T > INTEGRAL_DIVISOR * T01
+
+
 def build(cfg: GainShapingPIDConfig, ctx):
     m = design_model(ctx, cfg.K, cfg.T)
     paper = cfg.gains == "paper"
-    if m.T < 0.0 and not paper and cfg.T01 is None:
-        # course-unstable: the gain-shaping zero would cancel the unstable pole -1/T > 0 (module doc);
-        # pole placement on the same model instead
+    if not paper and cfg.T01 is None and (m.T < 0.0 or cancels_too_slow_a_pole(m, design_T01(m))):
+        # course-unstable: the gain-shaping zero would cancel the unstable pole -1/T > 0; nearly neutral:
+        # the cancelled pole would be the loop's slowest (module doc); pole placement on the same model instead
         d = pid_pole_placement(m, law="gain_shaping_pid")
         c = PID(Kp=d.Kp, Ki=d.Ki if cfg.Ki is None else cfg.Ki, Kd=d.Kd, u_max=ctx.u_max(cfg.u_max_deg))
         return c, c.pack()

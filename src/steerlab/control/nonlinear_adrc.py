@@ -44,8 +44,9 @@ shared bandwidth rule of :func:`steerlab.control.design_model.bandwidth` where t
 binds (``omega_n = sqrt(0.7 delta_max b / 20 deg)``), and the rule also keeps the loop within
 the gear's rate and lag and above a course-unstable ship's pole. So by default
 
-* ``b``: the design model's ``b2`` (exact linearisation, else ``K/T``; a neutral ship with
-  infinite ``K``, ``T``: its ``b2``);
+* ``b``: the rudder gain over the loop's band (:func:`steerlab.control.law_design.band_gain`:
+  ``K/T`` where ``omega_n |T| >= 2``, else the exact linearisation's ``b2``; a neutral ship
+  with infinite ``K``, ``T``: its ``b2``);
 * ``omega_c = omega_n`` (NLSEF linear zone ``s^2 + 2 omega_c s + omega_c^2``, above);
 * ``omega_o = m omega_c``, ``m = 5`` (Gao 2003: 3-10); ``m = 2`` behind the wave filter
   (:func:`steerlab.control.design_context.observer_multiple`).
@@ -77,7 +78,7 @@ from pydantic import Field, create_model, field_validator
 from steerlab.angles import wrap_to_pi
 from steerlab.config_base import FrozenConfig
 from steerlab.control.design_context import observer_multiple
-from steerlab.control.law_design import GAINS, law_bandwidth, law_model
+from steerlab.control.law_design import GAINS, band_gain, law_bandwidth
 from steerlab.control.nonlinear_eso import NLESO, fal, nleso_gains_bandwidth, nleso_step
 from steerlab.control.registry import ControllerSpec
 from steerlab.control.tracking_differentiator import TD, td_step
@@ -256,7 +257,7 @@ def build(cfg: NonlinearADRCConfig, ctx):
     elif cfg.b is not None or paper:
         b = ctx.b2(cfg.b or "exact")
     else:
-        b = law_model(ctx).b2
+        b = band_gain(*law_bandwidth(ctx, "nonlinear_adrc"))[0]
     if not (b > 0.0):
         raise InputError("controller.b", f"the ship's rudder gain must be > 0, got {b}")
     omega_c, omega_o = cfg.omega_c, cfg.omega_o
