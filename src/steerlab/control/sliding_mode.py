@@ -93,7 +93,7 @@ PARAMS = Layout("controller", "S_", [
     RecordField("UMAX", "u_max", "rad", "output limit (scenario default: the gear's limit)", lo=0.0, lo_open=True),
     RecordField("KI", "k_i", "1/s", "integral gain on the heading error (heading_integral; 0: none, the paper)",
                 lo=0.0, default=0.0),
-    RecordField("RBAND", "r_band", "rad/s", "integral off in turns: beyond 5 deg only while |r - r_ref| < r_band",
+    RecordField("RBAND", "r_band", "rad/s", "integral off in turns: it runs only while |r - r_ref| < r_band",
                 lo=0.0, default=0.0),
 ], size_name="N_PARAMS")
 PARAMS.export(globals())   # S_K1..S_K4 = 0..3, S_H1..S_H4 = 4..7, S_ETA = 8, ..., S_UMAX = 12, N_PARAMS = 13
