@@ -60,31 +60,46 @@ def test_the_paper_presets_start_and_run_the_integral_as_before(law):
     s = _setup({"type": law, "gains": "paper"})
     assert not np.any(s.z0[[pid.Z_INT] if "sliding" not in law else [sm.Z_XI]])
     if law in ("pid", "lq_pd", "gain_shaping_pid"):
-        assert s.pc[pid.C_ECC] == 0.0 and s.pc[pid.C_HELM0] == 0.0
+        assert s.pc[pid.C_RBAND] == 0.0 and s.pc[pid.C_HELM0] == 0.0
 
 
-def _pid_params(ecc: float) -> np.ndarray:
-    return pid.PID(Kp=1.0, Ki=0.01, Kd=10.0, u_max=math.radians(35.0), course_change=ecc).pack()
+def _pid_params(r_band: float) -> np.ndarray:
+    return pid.PID(Kp=1.0, Ki=0.01, Kd=10.0, u_max=math.radians(35.0), r_band=r_band).pack()
 
 
-@pytest.mark.parametrize("e_deg,r_ref,ecc_deg,charges", [
-    (10.0, 0.0, 5.0, False),     # a course change: frozen
-    (2.0, 0.0, 5.0, True),       # near the course: integrates
-    (2.0, 0.01, 5.0, False),     # the reference turns: frozen
-    (10.0, 0.0, 0.0, True),      # course_change = 0 (the paper): never frozen
+@pytest.mark.parametrize("e_deg,r,r_band,charges", [
+    (10.0, -0.002, 0.001, False),    # a course change (the error closing faster than r_band): frozen
+    (2.0, -0.002, 0.001, False),     # its final approach, near the course: frozen too
+    (10.0, 0.0, 0.001, True),        # held 10 deg off by a yaw moment: integrates
+    (10.0, -0.002, 0.0, True),       # r_band = 0 (the paper): never frozen
 ])
-def test_the_pid_integral_is_frozen_in_course_changes(e_deg, r_ref, ecc_deg, charges):
-    from steerlab.guidance.reference_vector import initial_reference, REF_PSI, REF_R
+def test_the_pid_integral_is_frozen_in_course_changes(e_deg, r, r_band, charges):
+    from steerlab.guidance.reference_vector import initial_reference, REF_PSI
+    from steerlab.ships.state import IR
 
     x = np.zeros(7)
+    x[IR] = r
     ref = initial_reference()
     ref[REF_PSI] = math.radians(e_deg)
-    ref[REF_R] = r_ref
     z = np.zeros(pid.N_STATE)
-    pid.pid_update(z, _pid_params(math.radians(ecc_deg)), 0.0, x, ref, 0.1)
+    pid.pid_update(z, _pid_params(r_band), 0.0, x, ref, 0.1)
     assert (z[pid.Z_INT] != 0.0) == charges
     if charges:
         assert z[pid.Z_INT] == pytest.approx(math.radians(e_deg) * 0.1)
+
+
+def test_the_pid_family_design_sets_the_turn_detector_from_its_own_gains():
+    """``r_band = omega_n 5 deg / 4`` with ``omega_n = 10 Ki / Kp`` (the family's ``Ki = Kp omega_n / 10``)."""
+    from steerlab.control.law_design import law_bandwidth
+    from steerlab.units import knots_to_ms
+
+    s = _setup({"type": "pid"}, "nomoto1", 10.0)
+    w = 10.0 * s.pc[pid.C_KI] / s.pc[pid.C_KP]
+    spec = get_ship("nomoto1")
+    ctx = DesignContext(spec, knots_to_ms(10.0), make_gear(None), 0.1, 0.1, spec.options(None))
+    assert w == pytest.approx(law_bandwidth(ctx, "pid")[1])          # the shared bandwidth rule's
+    assert s.pc[pid.C_RBAND] == pytest.approx(w * INTEGRAL_BAND / 4.0)
+    assert s.pc[pid.C_HELM0] == 0.0
 
 
 def test_the_heading_integral_waits_for_the_approach_to_end_near_the_course_too():

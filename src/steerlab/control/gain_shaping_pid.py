@@ -70,7 +70,7 @@ from steerlab.errors import InputError, require_finite_range
 PAPER_T01 = 20.0
 DESIGN_RULE = ("first-order closed-loop gain shaping on the Nomoto heading model (berthing paper 2019, eqs 17-19): "
                "kp = 1/(K T01), kd = T/(K T01); T01 = max(1/omega_n, 20 deg/(0.7 delta_max K)) from the shared "
-               "bandwidth rule, ki = kp/(10 T01) with clamping anti-windup, frozen in course changes beyond 5 deg and "
+               "bandwidth rule, ki = kp/(10 T01) with clamping anti-windup, frozen in course changes and "
                "started at the ship model's straight-course rudder, as pid (gains = 'paper': T01 = 20 s, ki = 0); "
                "a course-unstable model (T < 0) is not cancelled: PID pole placement on the Nomoto model instead "
                "(Fossen 2011, 12.2.7, as pid)")
@@ -117,7 +117,7 @@ def build(cfg: GainShapingPIDConfig, ctx):
         # pole placement on the same model instead
         d = pid_pole_placement(m, law="gain_shaping_pid")
         ki = d.Ki if cfg.Ki is None else cfg.Ki
-        c = PID(Kp=d.Kp, Ki=ki, Kd=d.Kd, u_max=ctx.u_max(cfg.u_max_deg), **design_integral(ctx, ki))
+        c = PID(Kp=d.Kp, Ki=ki, Kd=d.Kd, u_max=ctx.u_max(cfg.u_max_deg), **design_integral(ctx, d.Kp, ki))
         return c, c.pack()
     if not (m.T > 0.0 and math.isfinite(m.T)):
         raise InputError("controller.type", f"gain_shaping_pid cancels the ship pole -1/T, which stays a closed-loop "
@@ -129,7 +129,7 @@ def build(cfg: GainShapingPIDConfig, ctx):
         ki = cfg.Ki
     elif not paper:
         ki = kp / (INTEGRAL_DIVISOR * T01)
-    extra = {} if paper else design_integral(ctx, ki)
+    extra = {} if paper else design_integral(ctx, kp, ki)
     c = PID(Kp=kp, Ki=ki, Kd=kd, u_max=ctx.u_max(cfg.u_max_deg), **extra)
     return c, c.pack()
 

@@ -72,7 +72,7 @@ PAPER_LAM = 1.0
 DESIGN_RULE = ("LQ state feedback for Koyama's criterion J = mean(eps^2 + lam delta^2) on the first-order Nomoto "
                "model (van Amerongen 1982, Sec. 3.2.2, eqs 3.5-3.6, extended to T < 0): Kp = 1/sqrt(lam), "
                "Kd = (sqrt(a^2 + 2 b Kp) - a)/b; lam = (b/omega_n^2)^2 from the shared bandwidth rule, a slow "
-               "integral Ki = Kp omega_n/10 with clamping anti-windup, frozen in course changes beyond 5 deg and "
+               "integral Ki = Kp omega_n/10 with clamping anti-windup, frozen in course changes and "
                "started at the ship model's straight-course rudder, as pid (gains = 'paper': lam = 1, Ki = 0)")
 
 
@@ -126,7 +126,7 @@ def build(cfg: LQPDConfig, ctx):
     lam = cfg.lam if cfg.lam is not None else (PAPER_LAM if paper else design_lam(m))
     kp, kd = lq_pd_gains(lam, m.K, m.T) if math.isfinite(m.T) else lq_pd_gains_ab(lam, m.a, m.b)
     ki = cfg.Ki if cfg.Ki is not None else (0.0 if paper else kp * math.sqrt(m.b * kp) / INTEGRAL_DIVISOR)
-    extra = {} if paper else design_integral(ctx, ki)
+    extra = {} if paper else design_integral(ctx, kp, ki)
     c = PID(Kp=kp, Ki=ki, Kd=kd, u_max=ctx.u_max(cfg.u_max_deg), **extra)
     return c, c.pack()
 
