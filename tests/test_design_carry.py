@@ -63,6 +63,18 @@ def test_the_paper_presets_start_and_run_the_integral_as_before(law):
         assert s.pc[pid.C_RBAND] == 0.0 and s.pc[pid.C_HELM0] == 0.0
 
 
+@pytest.mark.parametrize("controller", [{"type": "pid", "Kp": 0.84, "Ki": 0.001, "Kd": 1.56},
+                                        {"type": "lq_pd", "lam": 1.0, "Ki": 0.001},
+                                        {"type": "classic_autopilot", "Ki": 0.001}])
+def test_a_given_integral_gain_is_used_as_given(controller):
+    """The integral's start and freeze belong to the designed integral: a PID whose Ki the user
+    gives (the berthing and Zwierzewicz reproductions give all three gains) runs as before."""
+    s = _setup(controller)
+    assert not np.any(s.z0)
+    if controller["type"] != "classic_autopilot":
+        assert s.pc[pid.C_RBAND] == 0.0 and s.pc[pid.C_HELM0] == 0.0
+
+
 def _pid_params(r_band: float) -> np.ndarray:
     return pid.PID(Kp=1.0, Ki=0.01, Kd=10.0, u_max=math.radians(35.0), r_band=r_band).pack()
 

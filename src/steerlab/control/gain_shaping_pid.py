@@ -117,7 +117,8 @@ def build(cfg: GainShapingPIDConfig, ctx):
         # pole placement on the same model instead
         d = pid_pole_placement(m, law="gain_shaping_pid")
         ki = d.Ki if cfg.Ki is None else cfg.Ki
-        c = PID(Kp=d.Kp, Ki=ki, Kd=d.Kd, u_max=ctx.u_max(cfg.u_max_deg), **design_integral(ctx, d.Kp, ki))
+        extra = {} if cfg.Ki is not None else design_integral(ctx, d.Kp, ki)
+        c = PID(Kp=d.Kp, Ki=ki, Kd=d.Kd, u_max=ctx.u_max(cfg.u_max_deg), **extra)
         return c, c.pack()
     if not (m.T > 0.0 and math.isfinite(m.T)):
         raise InputError("controller.type", f"gain_shaping_pid cancels the ship pole -1/T, which stays a closed-loop "
@@ -129,7 +130,7 @@ def build(cfg: GainShapingPIDConfig, ctx):
         ki = cfg.Ki
     elif not paper:
         ki = kp / (INTEGRAL_DIVISOR * T01)
-    extra = {} if paper else design_integral(ctx, kp, ki)
+    extra = {} if paper or cfg.Ki is not None else design_integral(ctx, kp, ki)
     c = PID(Kp=kp, Ki=ki, Kd=kd, u_max=ctx.u_max(cfg.u_max_deg), **extra)
     return c, c.pack()
 

@@ -126,7 +126,7 @@ def build(cfg: LQPDConfig, ctx):
     lam = cfg.lam if cfg.lam is not None else (PAPER_LAM if paper else design_lam(m))
     kp, kd = lq_pd_gains(lam, m.K, m.T) if math.isfinite(m.T) else lq_pd_gains_ab(lam, m.a, m.b)
     ki = cfg.Ki if cfg.Ki is not None else (0.0 if paper else kp * math.sqrt(m.b * kp) / INTEGRAL_DIVISOR)
-    extra = {} if paper else design_integral(ctx, kp, ki)
+    extra = {} if paper or cfg.Ki is not None else design_integral(ctx, kp, ki)
     c = PID(Kp=kp, Ki=ki, Kd=kd, u_max=ctx.u_max(cfg.u_max_deg), **extra)
     return c, c.pack()
 

@@ -153,7 +153,8 @@ def designed_gains(ctx, law: str = "pid") -> dict:
 def build(cfg: PIDConfig, ctx):
     g = fill_gains({"Kp": cfg.Kp, "Ki": cfg.Ki, "Kd": cfg.Kd}, cfg.gains, PAPER_GAINS,
                    lambda: designed_gains(ctx))
-    extra = design_integral(ctx, g["Kp"], g["Ki"]) if cfg.gains == "design" else {}
+    # the design's integral rules go with the designed integral (a Ki the user gives is used as given)
+    extra = design_integral(ctx, g["Kp"], g["Ki"]) if cfg.gains == "design" and cfg.Ki is None else {}
     c = PID(Kp=g["Kp"], Ki=g["Ki"], Kd=g["Kd"], u_max=ctx.u_max(cfg.u_max_deg), **extra)
     return c, c.pack()
 
