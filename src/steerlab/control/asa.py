@@ -25,9 +25,10 @@ thesis' flow diagram (Fig. 5.7: FILTER, CTLSET, DELLIM, PAREST):
    with speed and noise level (4.90)-(4.91); Kd LQ-optimal (3.6) or constant damping (4.2)
    from the identified K*, tau*; integral action (4.104) *[reconstructed]*
    ``dKi/dt = Kp e / (n_Ti tau)`` (clamping anti-windup), ``e = wrap_to_pi(psi_set - psi^)``;
-   with ``gains = "design"`` ``Ki`` (and its mean, the next change's ``Ki0``) starts at the
-   ship model's straight-course rudder (:data:`steerlab.control.design_context.HELM_RULE`),
-   the thesis' ASA at 0.
+   with ``gains = "design"`` the mean of ``Ki`` (the next change's ``Ki0``) starts at the ship
+   model's straight-course rudder (:data:`steerlab.control.design_context.HELM_RULE`; ``Ki``
+   itself at 0: started there too, the MRAS of the change adapted it away on the mariner, whose
+   calm change then settled 1 deg short), the thesis' ASA at 0.
 5. **Parameter estimation** (Fig. 4.12, eqs 4.93-4.99; :func:`~steerlab.control.asa_mras.
    mras_identify_step`): MRAS identification of K*, tau* (non-dimensional, bounded) with a
    parallel adjustable model driven by the actual rudder and compared with the measured yaw
@@ -142,7 +143,7 @@ class ASA(NamedTuple):
     sigma2: float = 1e-6
     T_pow_id: float = 300.0
     wave_filter: WaveFilterParams = WaveFilterParams()
-    helm0: float = 0.0   #: [rad] the offset Ki at the start (design_context.HELM_RULE; 0: the thesis)
+    helm0: float = 0.0   #: [rad] the mean Ki (Ki0) at the start (design_context.HELM_RULE; 0: the thesis)
 
     def pack(self) -> np.ndarray:
         f = "controller"
@@ -205,7 +206,7 @@ class ASA(NamedTuple):
         U = float(x0[IU]) if float(x0[IU]) > 0.0 else self.U0
         z[Z_RM_ID] = float(x0[IR]) * self.L / U
         z[Z_DELTA_LIM] = self.u_max
-        z[Z_KI] = z[Z_KI_MEAN] = self.helm0      # the permanent helm the model knows (HELM_RULE)
+        z[Z_KI_MEAN] = self.helm0      # the permanent helm the model knows (HELM_RULE)
         return z
 
 
