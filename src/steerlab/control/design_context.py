@@ -79,11 +79,13 @@ HELM_RULE = ("the integral starts at the ship model's straight-course rudder (De
 learns a constant yaw moment in about ``10 / omega_n``; where the ship model states the rudder
 that holds her straight (an asymmetry ``delta_0``), the design starts the integral holding it
 (``xi_0 = delta_0 / K_i``), as a helmsman hands the ship over with the helm that keeps her on
-course and the autopilot takes it over bumplessly ("automatic permanent helm", van Amerongen
-1982, Sec. 3.1; bumpless transfer, Astrom & Hagglund 2006, Sec. 3.5). The integral then learns
-only what the model does not know (wind, current, a model error). A PD loop with ``Kp =
-omega_n^2 / b`` leaves ``delta_0 / Kp`` of heading error until the integral has learned it: on
-the B-481 (``delta_0`` = -2.1 deg, ``Kp`` = 1.2) 1.7 deg, which at 0.97 kn (``omega_n`` =
-0.0024 rad/s) took longer than the conformance run's 8 000 s to run out. 0 for a symmetric
-ship: nothing changes there."""
+course and the autopilot takes it over bumplessly (the integral is the "automatic permanent
+helm", van Amerongen 1982, Sec. 3.1, Fig. 3.3; a PID switched from manual to automatic starts
+its integral at the order in force, the bumpless transfer of Astrom & Hagglund 2006, *Advanced
+PID Control*). The integral then learns only what the model does not know (wind, current, a
+model error). A PD loop with ``Kp = omega_n^2 / b`` leaves ``delta_0 / Kp`` of heading error
+until the integral has learned it: on the B-481 (``delta_0`` = -2.1 deg, ``Kp`` = 1.2) 1.7 deg,
+which at 0.97 kn (``omega_n`` = 0.0024 rad/s) took longer than the conformance run's 8 000 s to
+run out. 0 for a symmetric ship: nothing changes there. Only a designed integral starts there:
+a ``Ki`` the user gives runs as given, from 0."""
 
