@@ -45,7 +45,7 @@ def test_sample_time_and_reset(scenario):
     assert np.array_equal(first, res.delta_cmd[::5])
     c.reset()                                               # reset gives the same run again
     assert np.array_equal(_replay(c, res, nc=5), first)
-    assert c.state.shape == (1,) and c.params.shape == (4,)
+    assert c.state.shape == (1,) and c.params.shape == (6,)              # Kp Ki Kd u_max r_band helm0
 
 
 def test_vector_steps_n_controllers_like_n_single_ones(scenario):

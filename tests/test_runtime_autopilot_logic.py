@@ -50,7 +50,7 @@ def test_controller_runtime_is_the_registry_kernel(ctrl):
     from steerlab.control.pid import pid_update
 
     assert ctrl.kernel is pid_update and ctrl.h == H
-    assert ctrl.setup.pc.tolist() == [2.0, 0.0, 8.0, math.radians(35.0)]
+    assert ctrl.setup.pc.tolist() == [2.0, 0.0, 8.0, math.radians(35.0), 0.0, 0.0]
     x = ctrl.measured_state(1.0, 2.0, 0.1, 5.0, 0.0, 0.01, 0.02)
     assert x.shape == (7,) and x[2] == 0.1 and x[-1] == 0.02
     # same number as the law written out: Kp e - Kd (r - r_ref)

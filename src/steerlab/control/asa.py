@@ -24,7 +24,11 @@ thesis' flow diagram (Fig. 5.7: FILTER, CTLSET, DELLIM, PAREST):
    ``mu`` (1 economy ... 5 accuracy), ``Kp = mu/2`` at cruising speed (4.88), scheduled
    with speed and noise level (4.90)-(4.91); Kd LQ-optimal (3.6) or constant damping (4.2)
    from the identified K*, tau*; integral action (4.104) *[reconstructed]*
-   ``dKi/dt = Kp e / (n_Ti tau)`` (clamping anti-windup), ``e = wrap_to_pi(psi_set - psi^)``.
+   ``dKi/dt = Kp e / (n_Ti tau)`` (clamping anti-windup), ``e = wrap_to_pi(psi_set - psi^)``;
+   with ``gains = "design"`` the mean of ``Ki`` (the next change's ``Ki0``) starts at the ship
+   model's straight-course rudder (:data:`steerlab.control.design_context.HELM_RULE`; ``Ki``
+   itself at 0: started there too, the MRAS of the change adapted it away on the mariner, whose
+   calm change then settled 1 deg short), the thesis' ASA at 0.
 5. **Parameter estimation** (Fig. 4.12, eqs 4.93-4.99; :func:`~steerlab.control.asa_mras.
    mras_identify_step`): MRAS identification of K*, tau* (non-dimensional, bounded) with a
    parallel adjustable model driven by the actual rudder and compared with the measured yaw
@@ -139,6 +143,7 @@ class ASA(NamedTuple):
     sigma2: float = 1e-6
     T_pow_id: float = 300.0
     wave_filter: WaveFilterParams = WaveFilterParams()
+    helm0: float = 0.0   #: [rad] the mean Ki (Ki0) at the start (design_context.HELM_RULE; 0: the thesis)
 
     def pack(self) -> np.ndarray:
         f = "controller"
@@ -201,6 +206,7 @@ class ASA(NamedTuple):
         U = float(x0[IU]) if float(x0[IU]) > 0.0 else self.U0
         z[Z_RM_ID] = float(x0[IR]) * self.L / U
         z[Z_DELTA_LIM] = self.u_max
+        z[Z_KI_MEAN] = self.helm0      # the permanent helm the model knows (HELM_RULE)
         return z
 
 
@@ -428,7 +434,8 @@ def build(cfg: ASAConfig, ctx):
             n_ti=cfg.integral_time_constants, rho_acc=cfg.accel_margin, f_delta=cfg.rudder_limit_factor,
             use_estimator=cfg.use_estimator,
             wave_filter=filter_params(cfg.wave_filter, ctx.sample_time, cfg.gains == "paper",
-                                      identified=True))
+                                      identified=True),
+            helm0=ctx.straight_rudder() if cfg.gains == "design" else 0.0)
     return c, c.pack()
 
 

@@ -138,7 +138,7 @@ PARAMS = Layout("controller", "B_", [
                 lo=0.0, lo_open=True),
     RecordField("KI", "k_i", "1/s", "integral gain on the heading error (heading_integral; 0: none, the paper)",
                 lo=0.0, default=0.0),
-    RecordField("RBAND", "r_band", "rad/s", "integral off in turns: beyond 5 deg only while |r - r_ref| < r_band",
+    RecordField("RBAND", "r_band", "rad/s", "integral off in turns: it runs only while |r - r_ref| < r_band",
                 lo=0.0, default=0.0),
     RecordField("TF", "T_f", "s", "version B: time constant of the r' low-pass (0: none, the paper)", lo=0.0,
                 default=0.0),

@@ -50,7 +50,8 @@ Gains (``gains`` in the config; a gain the user gives always wins):
       Kp = omega_n^2 / b,   Kd = (2 zeta omega_n - a) / b,   Ki = Kp omega_n / 10
 
   (``a = 1/T``, ``b = K/T``, ``zeta = 0.9``, ``omega_n`` the shared gear-capped bandwidth;
-  course-unstable ships included);
+  course-unstable ships included), the integral started at the ship model's straight-course
+  rudder (``I_0 = delta_0 / Ki``; :data:`steerlab.control.design_context.HELM_RULE`);
 * ``"paper"``: steerlab's settings up to now, ``Kp = 1``, ``Ki = 0.002 1/s``, ``Kd = 20 s``
   (the thesis prints no gains for Fig. 3.3: on board they are set by hand;
   :mod:`steerlab.control.lq_pd` gives ``Kp``, ``Kd`` from the speed-loss criterion (3.1) of
@@ -119,6 +120,7 @@ class ClassicAutopilot(NamedTuple):
     weather_on: str = "error"                         #: "error" or "order"
     lowpass_T: float = _default("lowpass_T")          #: low-pass time constant [s] (0 = none)
     course_change: float = _default("course_change")  #: heading error beyond which the integrator is frozen [rad]
+    helm0: float = 0.0                                #: the integral's share of the order at the start [rad]
 
     def pack(self) -> np.ndarray:
         if self.weather_on not in WEATHER_ON:
@@ -128,7 +130,10 @@ class ClassicAutopilot(NamedTuple):
                            course_change=self.course_change)
 
     def init_state(self, x0, ref0) -> np.ndarray:
-        return np.zeros(N_STATE)
+        z = np.zeros(N_STATE)
+        if self.Ki > 0.0:
+            z[Z_INT] = self.helm0 / self.Ki     # design_context.HELM_RULE
+        return z
 
 
 @numba.njit(cache=True)
@@ -185,7 +190,8 @@ ClassicAutopilotConfig.__module__ = __name__
 PAPER_GAINS = {n: _default(n) for n in ("Kp", "Ki", "Kd")}
 DESIGN_RULE = ("pole placement on the first-order Nomoto model (Fossen 2011, Sec. 12.2.7), as pid: "
                "Kp = omega_n^2/b, Kd = (2 zeta omega_n - a)/b, Ki = Kp omega_n/10, zeta = 0.9, omega_n from the "
-               "shared bandwidth rule; integral frozen in turns (van Amerongen 1982, Fig. 3.3)")
+               "shared bandwidth rule; integral frozen in turns (van Amerongen 1982, Fig. 3.3) and started at the "
+               "ship model's straight-course rudder")
 
 
 def build(cfg: ClassicAutopilotConfig, ctx):
@@ -195,7 +201,9 @@ def build(cfg: ClassicAutopilotConfig, ctx):
                    lambda: designed_gains(ctx, "classic_autopilot"))
     c = ClassicAutopilot(Kp=g["Kp"], Ki=g["Ki"], Kd=g["Kd"], u_max=ctx.u_max(cfg.u_max_deg),
                          weather=rad(cfg.weather_deg), weather_on=cfg.weather_on,
-                         lowpass_T=cfg.lowpass_T, course_change=rad(cfg.course_change_deg))
+                         lowpass_T=cfg.lowpass_T, course_change=rad(cfg.course_change_deg),
+                         helm0=ctx.straight_rudder() if cfg.gains == "design" and cfg.Ki is None and g["Ki"] > 0.0
+                         else 0.0)
     return c, c.pack()
 
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Any
 
@@ -35,6 +36,17 @@ class DesignContext:
     def nomoto(self) -> tuple[float, float]:
         """First-order Nomoto ``(K [1/s], T [s])`` of the ship at the design speed."""
         return self.ship.nomoto(self.speed, self.ship_options)
+
+    def straight_rudder(self) -> float:
+        """The rudder [rad] that holds the ship on a straight course at the design speed, as its
+        model states it (``ShipSpec.equilibrium_rudder``: a propeller's or hull's asymmetry, the
+        B-481's ``a0* / K*``, a Norrbin ship's ``c0``); 0 for a symmetric ship or a ship whose
+        model does not say. A design rule starts its integral there (:data:`HELM_RULE`)."""
+        f = getattr(self.ship, "equilibrium_rudder", None)
+        if f is None:
+            return 0.0
+        d0 = float(f(self.speed, self.ship_options))
+        return d0 if math.isfinite(d0) else 0.0
 
     def u_max(self, u_max_deg: float | None) -> float:
         """The controller's output limit [rad]: the configured one, or the gear's limit."""
@@ -71,3 +83,21 @@ def observer_multiple(ctx, course_unstable: bool = False) -> float:
     if getattr(ctx, "measurement", "direct") != "wave-filtered":
         return OBSERVER_MULTIPLE
     return OBSERVER_MULTIPLE_FILTERED_UNSTABLE if course_unstable else OBSERVER_MULTIPLE_FILTERED
+
+
+HELM_RULE = ("the integral starts at the ship model's straight-course rudder (DesignContext.straight_rudder): "
+             "the permanent helm is known, not learned")
+"""The designed integral's initial state. An integral at Fossen's ``omega_n / 10`` (Sec. 12.2.7)
+learns a constant yaw moment in about ``10 / omega_n``; where the ship model states the rudder
+that holds her straight (an asymmetry ``delta_0``), the design starts the integral holding it
+(``xi_0 = delta_0 / K_i``), as a helmsman hands the ship over with the helm that keeps her on
+course and the autopilot takes it over bumplessly (the integral is the "automatic permanent
+helm", van Amerongen 1982, Sec. 3.1, Fig. 3.3; a PID switched from manual to automatic starts
+its integral at the order in force, the bumpless transfer of Astrom & Hagglund 2006, *Advanced
+PID Control*). The integral then learns only what the model does not know (wind, current, a
+model error). A PD loop with ``Kp = omega_n^2 / b`` leaves ``delta_0 / Kp`` of heading error
+until the integral has learned it: on the B-481 (``delta_0`` = -2.1 deg, ``Kp`` = 1.2) 1.7 deg,
+which at 0.97 kn (``omega_n`` = 0.0024 rad/s) took longer than the conformance run's 8 000 s to
+run out. 0 for a symmetric ship: nothing changes there. Only a designed integral starts there:
+a ``Ki`` the user gives runs as given, from 0."""
+

@@ -74,7 +74,7 @@ from steerlab.config_base import FrozenConfig
 import math
 
 from steerlab.control.design_model import DESIGN_TURN, GEAR_USE, bandwidth, design_model
-from steerlab.control.pid import N_STATE, PID, pid_update
+from steerlab.control.pid import N_STATE, PID, design_integral, pid_update
 from steerlab.control.pole_placement import INTEGRAL_DIVISOR, pid_pole_placement
 from steerlab.control.registry import ControllerSpec
 from steerlab.control.pid import PARAMS as PID_PARAMS
@@ -84,7 +84,8 @@ from steerlab.errors import InputError, require_finite_range
 PAPER_T01 = 20.0
 DESIGN_RULE = ("first-order closed-loop gain shaping on the Nomoto heading model (berthing paper 2019, eqs 17-19): "
                "kp = 1/(K T01), kd = T/(K T01); T01 = max(1/omega_n, 20 deg/(0.7 delta_max K)) from the shared "
-               "bandwidth rule, ki = kp/(10 T01) with clamping anti-windup (gains = 'paper': T01 = 20 s, ki = 0); "
+               "bandwidth rule, ki = kp/(10 T01) with clamping anti-windup, frozen in course changes and "
+               "started at the ship model's straight-course rudder, as pid (gains = 'paper': T01 = 20 s, ki = 0); "
                "a course-unstable model (T < 0) or one whose pole is slower than the integral (T > 10 T01: the "
                "cancelled pole would set the settling, cf. Skogestad 2003 SIMC) is not cancelled: PID pole placement on "
                "the Nomoto model instead (Fossen 2011, 12.2.7, as pid)")
@@ -137,7 +138,9 @@ def build(cfg: GainShapingPIDConfig, ctx):
         # course-unstable: the gain-shaping zero would cancel the unstable pole -1/T > 0; nearly neutral:
         # the cancelled pole would be the loop's slowest (module doc); pole placement on the same model instead
         d = pid_pole_placement(m, law="gain_shaping_pid")
-        c = PID(Kp=d.Kp, Ki=d.Ki if cfg.Ki is None else cfg.Ki, Kd=d.Kd, u_max=ctx.u_max(cfg.u_max_deg))
+        ki = d.Ki if cfg.Ki is None else cfg.Ki
+        extra = {} if cfg.Ki is not None else design_integral(ctx, d.Kp, ki)
+        c = PID(Kp=d.Kp, Ki=ki, Kd=d.Kd, u_max=ctx.u_max(cfg.u_max_deg), **extra)
         return c, c.pack()
     if not (m.T > 0.0 and math.isfinite(m.T)):
         raise InputError("controller.type", f"gain_shaping_pid cancels the ship pole -1/T, which stays a closed-loop "
@@ -149,7 +152,8 @@ def build(cfg: GainShapingPIDConfig, ctx):
         ki = cfg.Ki
     elif not paper:
         ki = kp / (INTEGRAL_DIVISOR * T01)
-    c = PID(Kp=kp, Ki=ki, Kd=kd, u_max=ctx.u_max(cfg.u_max_deg))
+    extra = {} if paper or cfg.Ki is not None else design_integral(ctx, kp, ki)
+    c = PID(Kp=kp, Ki=ki, Kd=kd, u_max=ctx.u_max(cfg.u_max_deg), **extra)
     return c, c.pack()
 
 

@@ -61,7 +61,7 @@ from pydantic import Field
 
 from steerlab.config_base import FrozenConfig
 from steerlab.control.design_model import DesignModel, bandwidth, design_model
-from steerlab.control.pid import N_STATE, PID, pid_update
+from steerlab.control.pid import N_STATE, PID, design_integral, pid_update
 from steerlab.control.pole_placement import INTEGRAL_DIVISOR
 from steerlab.control.registry import ControllerSpec
 from steerlab.control.pid import PARAMS as PID_PARAMS
@@ -72,7 +72,8 @@ PAPER_LAM = 1.0
 DESIGN_RULE = ("LQ state feedback for Koyama's criterion J = mean(eps^2 + lam delta^2) on the first-order Nomoto "
                "model (van Amerongen 1982, Sec. 3.2.2, eqs 3.5-3.6, extended to T < 0): Kp = 1/sqrt(lam), "
                "Kd = (sqrt(a^2 + 2 b Kp) - a)/b; lam = (b/omega_n^2)^2 from the shared bandwidth rule, a slow "
-               "integral Ki = Kp omega_n/10 with clamping anti-windup (gains = 'paper': lam = 1, Ki = 0)")
+               "integral Ki = Kp omega_n/10 with clamping anti-windup, frozen in course changes and "
+               "started at the ship model's straight-course rudder, as pid (gains = 'paper': lam = 1, Ki = 0)")
 
 
 def lq_pd_gains(lam: float, K: float, tau: float) -> tuple[float, float]:
@@ -125,7 +126,8 @@ def build(cfg: LQPDConfig, ctx):
     lam = cfg.lam if cfg.lam is not None else (PAPER_LAM if paper else design_lam(m))
     kp, kd = lq_pd_gains(lam, m.K, m.T) if math.isfinite(m.T) else lq_pd_gains_ab(lam, m.a, m.b)
     ki = cfg.Ki if cfg.Ki is not None else (0.0 if paper else kp * math.sqrt(m.b * kp) / INTEGRAL_DIVISOR)
-    c = PID(Kp=kp, Ki=ki, Kd=kd, u_max=ctx.u_max(cfg.u_max_deg))
+    extra = {} if paper or cfg.Ki is not None else design_integral(ctx, kp, ki)
+    c = PID(Kp=kp, Ki=ki, Kd=kd, u_max=ctx.u_max(cfg.u_max_deg), **extra)
     return c, c.pack()
 
 

@@ -48,7 +48,9 @@ well (the linearised chain is controllable for any ``K/T > 0``). ``gains = "pape
 Integral action (design rule): the law does not cancel a constant yaw moment (the B-481's
 asymmetry ``a0*``, the thesis ships' spiral offset ``c0``), so the design adds
 :mod:`steerlab.control.heading_integral` (``k_i = (omega_n/10) omega_n^2 / b``, Fossen's
-``Ki = omega_n Kp / 10``) with conditional-integration anti-windup.
+``Ki = omega_n Kp / 10``) with conditional-integration anti-windup, started at the ship
+model's straight-course rudder (``xi_0 = delta_0 / k_i``;
+:data:`steerlab.control.design_context.HELM_RULE`).
 """
 
 from __future__ import annotations
@@ -91,7 +93,7 @@ PARAMS = Layout("controller", "S_", [
     RecordField("UMAX", "u_max", "rad", "output limit (scenario default: the gear's limit)", lo=0.0, lo_open=True),
     RecordField("KI", "k_i", "1/s", "integral gain on the heading error (heading_integral; 0: none, the paper)",
                 lo=0.0, default=0.0),
-    RecordField("RBAND", "r_band", "rad/s", "integral off in turns: beyond 5 deg only while |r - r_ref| < r_band",
+    RecordField("RBAND", "r_band", "rad/s", "integral off in turns: it runs only while |r - r_ref| < r_band",
                 lo=0.0, default=0.0),
 ], size_name="N_PARAMS")
 PARAMS.export(globals())   # S_K1..S_K4 = 0..3, S_H1..S_H4 = 4..7, S_ETA = 8, ..., S_UMAX = 12, N_PARAMS = 13
@@ -140,6 +142,7 @@ class SlidingMode(NamedTuple):
     u_max: float
     k_i: float = 0.0  #: integral gain [1/s] (heading_integral)
     r_band: float = 0.0  #: [rad/s] heading_integral's turn detector: omega_n x 5 deg
+    helm0: float = 0.0  #: [rad] the integral's share of the order at the start (design_context.HELM_RULE)
 
     def pack(self) -> np.ndarray:
         for name, v in (("k", self.k), ("h", self.h)):
@@ -151,7 +154,7 @@ class SlidingMode(NamedTuple):
                            k_i=self.k_i, r_band=self.r_band)
 
     def init_state(self, x0, ref0) -> np.ndarray:
-        return STATE.pack(r_prev=x0[IR], xi=0.0)
+        return STATE.pack(r_prev=x0[IR], xi=self.helm0 / self.k_i if self.k_i > 0.0 else 0.0)
 
 
 @numba.njit(cache=True)
@@ -223,7 +226,8 @@ def build(cfg: SlidingModeConfig, ctx):
     wi = w if w is not None or (paper and cfg.k_i is None) else law_bandwidth(ctx, "sliding_mode")[1]
     ki = cfg.k_i if cfg.k_i is not None else (0.0 if paper else integral_gain(wi, law_model(ctx).b))
     c = SlidingMode(tuple(k), tuple(h), eta, phi, hb, i_rdot, ctx.u_max(cfg.u_max_deg), ki,
-                    0.0 if wi is None else wi * INTEGRAL_BAND * TURN_RATE_FRACTION)
+                    0.0 if wi is None else wi * INTEGRAL_BAND * TURN_RATE_FRACTION,
+                    0.0 if paper or cfg.k_i is not None or ki <= 0.0 else ctx.straight_rudder())
     return c, c.pack()
 
 

@@ -22,7 +22,13 @@ from (:func:`design_model`):
 
 ``rd = r'`` is read from the ship's state when it has one named ``rdot`` (Van Leeuwen ships);
 otherwise the controller estimates it by the backward difference of the measured yaw rate
-over one sample (:func:`yaw_accel`), which it keeps in its own state.
+over one sample (:func:`yaw_accel`), which it keeps in its own state. Behind the wave filter
+(``ctx.measurement == "wave-filtered"``, :mod:`steerlab.control.wave_filtered`) it is always
+estimated: the filter replaces the heading and the yaw rate by their low-frequency estimates
+but passes the rest of the plant state as it is, so the ``rdot`` state still carries the whole
+wave-frequency yaw acceleration (on the B-481 at 15 kn in sea state 5 the sliding-mode order
+then reversed 17 times a minute and backstepping B spun); the difference of the filtered yaw
+rate is the low-frequency ``r'`` the filter is there to give.
 """
 
 from __future__ import annotations
@@ -41,12 +47,14 @@ from steerlab.ships.state import IR
 def design_model(ctx, design_loading: str | None, T2: float | None, match_b2: bool = False):
     """``(set7 packed (radian form), L [m], i_rdot)`` for a controller built in ``ctx``.
 
-    ``i_rdot`` is the index of ``rdot`` in the plant state, or ``-1`` (estimate it; also when the
-    ship has no ``state_names``, e.g. a duck-typed ship given by a user).
+    ``i_rdot`` is the index of ``rdot`` in the plant state, or ``-1`` (estimate it: also when the
+    ship has no ``state_names``, e.g. a duck-typed ship given by a user, and behind the wave
+    filter, whose estimates do not include ``rdot``; module doc).
     """
     ship = ctx.ship
     names = tuple(getattr(ship, "state_names", ()))   # a duck-typed ship may have no names: estimate rdot
-    i_rdot = float(names.index("rdot")) if "rdot" in names else -1.0
+    filtered = getattr(ctx, "measurement", "direct") == "wave-filtered"
+    i_rdot = float(names.index("rdot")) if "rdot" in names and not filtered else -1.0
     known = vl.ships()
     if ship.name in known:
         loadings = tuple(known[ship.name].loadings)
