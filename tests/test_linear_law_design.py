@@ -94,9 +94,16 @@ def test_a_given_gain_always_wins():
 
 
 def test_designed_itae_pid_has_anti_windup_and_a_gear_settling_time():
+    """omega_0 = omega_n / sqrt(c2): the ITAE loop's proportional gain H1 is the PD's omega_n^2 / b
+    for which the shared rule caps omega_n by the gear (itae_pid.design_t_r)."""
     c = controller("itae_pid", nomoto=(0.1, 50.0), speed_kn=10.0)
     assert c.design.anti_windup is True
-    assert c.design.t_r == pytest.approx(5.0 / _omega(0.1, 50.0), rel=1e-12)
+    w = _omega(0.1, 50.0)
+    assert c.design.t_r == pytest.approx(5.0 * math.sqrt(2.15) / w, rel=1e-12)
+    h1, _, _ = itae_gains(c.design.t_r, 0.1, 50.0)
+    assert h1 == pytest.approx(w * w / (0.1 / 50.0), rel=1e-12)          # Kp of the PD pole placement
+    eq6 = controller("itae_pid", nomoto=(0.1, 50.0), speed_kn=10.0, polynomial="eq6")
+    assert eq6.design.t_r == pytest.approx(5.0 / w, rel=1e-12)            # c2 = 1: omega_0 = omega_n
 
 
 def test_a_design_without_a_model_names_nomoto():

@@ -61,9 +61,10 @@ not duplicated here. The controller ignores ``r_ref`` (the pre-filter makes its 
 
 Settings (``gains`` in the config; a value the user gives always wins):
 
-* ``"design"`` (default): ``omega_0`` is the shared bandwidth rule
-  (:func:`steerlab.control.design_model.bandwidth`, capped by the gear's limit, rate and servo
-  lag), i.e. ``t_r = 5 / omega_n``, raised where needed to ``omega_0 >= 1.2 / (1.75 T)`` so
+* ``"design"`` (default): ``omega_0 = omega_n / sqrt(c2)``, ``omega_n`` the shared bandwidth
+  rule (:func:`steerlab.control.design_model.bandwidth`, capped by the gear's limit, rate and
+  servo lag, stated for a PD's ``Kp = omega_n^2 / b``, which ``H1`` then equals:
+  :func:`design_t_r`), i.e. ``t_r = 5 sqrt(c2) / omega_n``, raised where needed to ``omega_0 >= 1.2 / (1.75 T)`` so
   that ``H3 > 0``; anti-windup on. The paper's fixed settling time ignores the gear: a fast
   ``t_r`` on a ship that answers its rudder slowly asks for more rudder and rate than the gear
   has, and without anti-windup the integral then winds up until the ship spins (before this
@@ -247,13 +248,25 @@ PAPER_T_R = 53.0
 #: ``omega_0 >= H3_MARGIN / (1.75 T)`` for a course-stable model (``H3 > 0`` with a margin)
 H3_MARGIN = 1.2
 DESIGN_RULE = ("ITAE pole placement on the first-order Nomoto model with a set-point pre-filter (Morawski & "
-               "Pomirski, eqs 6-11): H1 = 2.15 w0^2 T/k, H2 = w0^3 T/k, H3 = (1.75 w0 T - 1)/k; w0 = 5/t_r from the "
-               "shared bandwidth rule (>= 1.2/(1.75 T)), clamping anti-windup (gains = 'paper': t_r = 53 s, none)")
+               "Pomirski, eqs 6-11): H1 = 2.15 w0^2 T/k, H2 = w0^3 T/k, H3 = (1.75 w0 T - 1)/k; w0 = 5/t_r = "
+               "omega_n/sqrt(c2) from the shared bandwidth rule (H1 = the PD's omega_n^2/b; >= 1.2/(1.75 T)), clamping anti-windup (gains = 'paper': t_r = 53 s, none)")
 
 
-def design_t_r(m) -> float:
-    """``t_r = 5 / omega_0`` [s], ``omega_0`` the shared bandwidth (>= ``H3_MARGIN / (1.75 T)`` for ``T > 0``)."""
-    w = bandwidth(m, law="itae_pid")
+def design_t_r(m, c2: float = POLYNOMIALS["dorf"]) -> float:
+    r"""``t_r = 5 / omega_0`` [s] with ``omega_0 = omega_n / sqrt(c2)``, ``omega_n`` the shared
+    bandwidth (>= ``H3_MARGIN / (1.75 T)`` for ``T > 0``).
+
+    The shared rule's gear caps (:func:`steerlab.control.design_model.bandwidth_caps`) are
+    stated for the proportional gain ``Kp = omega_n^2 / b`` of a PD loop: the rudder per radian
+    of heading error. The ITAE polynomial's ``H1 = c2 omega_0^2 T / k = c2 omega_0^2 / b`` is
+    ``c2`` times that at ``omega_0 = omega_n`` (2.15 with Dorf's coefficient), so the gear's
+    rule would be broken by that factor, and behind the wave filter the residual wave yaw reached
+    the rudder 2.15 times as strongly as through ``pid`` (the small Zeefakkel in sea state 5:
+    8-12 rudder reversals a minute against pid's 3-6, issue 30's matrix). ``omega_0 = omega_n /
+    sqrt(c2)`` gives ``H1`` the PD's ``omega_n^2 / b``; the ITAE loop's dominant poles are then
+    at ``1.19 omega_0 = 0.81 omega_n``.
+    """
+    w = bandwidth(m, law="itae_pid") / math.sqrt(c2)
     if m.T > 0.0:
         w = max(w, H3_MARGIN / (ITAE_C1 * m.T))
     return 5.0 / w
@@ -266,7 +279,7 @@ def build(cfg: ItaePIDConfig, ctx):
         raise InputError("controller.T", f"the ITAE design needs a finite Nomoto T; the ship gives K = {m.K:.4g}, "
                          f"T = {m.T:.4g} (neutrally stable): give K and T, or use type = \"pid\" or \"lq_pd\"")
     paper = cfg.gains == "paper"
-    t_r = cfg.t_r if cfg.t_r is not None else (PAPER_T_R if paper else design_t_r(m))
+    t_r = cfg.t_r if cfg.t_r is not None else (PAPER_T_R if paper else design_t_r(m, POLYNOMIALS[cfg.polynomial]))
     aw = cfg.anti_windup if cfg.anti_windup is not None else not paper
     Vm = knots_to_ms(cfg.design_speed_kn) if cfg.design_speed_kn is not None else ctx.speed
     schedule = cfg.schedule
