@@ -197,7 +197,12 @@ def test_359_to_1_turns_2_deg_to_starboard(scenario, ctrl):
     final = psi[-1] % 360.0
     assert abs(((final - 1.0 + 180.0) % 360.0) - 180.0) < 0.1
     assert np.max(np.degrees(np.abs(res.heading_error))) <= 2.0 + 1e-6
-    assert np.all(res.delta_cmd[100:400] >= 0.0) and res.delta_cmd[101] > 0.0   # starboard order first
+    # starboard order first, and no port order before the ship turns to starboard (a designed
+    # loop may check the swing with counter-rudder once she turns: adrc at 30 s, pid at 69 s)
+    turning = 100 + int(np.argmax(res.r[100:] >= 1e-4))
+    assert turning > 101 and res.r[turning] >= 1e-4
+    assert res.delta_cmd[101] > 0.0 and np.all(res.delta_cmd[100:turning] >= 0.0)
+    assert res.r.min() > -1e-4                        # and never turns to port
 
 
 def test_1_to_359_turns_2_deg_to_port(scenario):

@@ -57,7 +57,8 @@ def test_kernel_reading_past_its_record_is_named():
     with pytest.raises(InputError) as err:
         check_controller(_spec("long_reader_t", _long_reader))
     _one_line_naming(err, "record size", "long_reader_t")
-    assert "parameter record of 4 values" in str(err.value)
+    from steerlab.control.pid import N_PARAMS
+    assert f"parameter record of {N_PARAMS} values" in str(err.value)
 
 
 def test_wrong_state_size_is_named():
@@ -72,7 +73,8 @@ def test_a_good_controller_passes_with_parity():
     assert out["parity_max_abs_diff"] <= 1e-12 and "no allocation" in out["rules"]
     # a controller runs one run at a time in the batch loop: the ship's stages stay vectorised
     assert out["warnings"] == [] and out["vectorised_stages"] in (None, 4) and "vectorises" in out["rules"]
-    assert check_controller(get_controller("pid"), vectorisation=False)["n_params"] == 4
+    from steerlab.control.pid import PARAMS
+    assert check_controller(get_controller("pid"), vectorisation=False)["n_params"] == len(PARAMS.names) == 6
 
 
 def test_ship_checks():

@@ -151,10 +151,18 @@ def designed_gains(ctx, law: str = "pid") -> dict:
 
 
 def build(cfg: PIDConfig, ctx):
-    g = fill_gains({"Kp": cfg.Kp, "Ki": cfg.Ki, "Kd": cfg.Kd}, cfg.gains, PAPER_GAINS,
-                   lambda: designed_gains(ctx))
-    # the design's integral rules go with the designed integral (a Ki the user gives is used as given)
-    extra = design_integral(ctx, g["Kp"], g["Ki"]) if cfg.gains == "design" and cfg.Ki is None else {}
+    designed = {}
+
+    def design() -> dict:
+        designed.update(designed_gains(ctx))
+        return designed
+
+    g = fill_gains({"Kp": cfg.Kp, "Ki": cfg.Ki, "Kd": cfg.Kd}, cfg.gains, PAPER_GAINS, design)
+    # the design's integral rules go with the designed integral (a Ki the user gives is used as given);
+    # its turn detector is the design's (its Kp, Ki), so a Kp the user gives or a tuner varies maps
+    # to its own record slot alone (tuning/params.py: a "direct" parameter)
+    extra = design_integral(ctx, designed["Kp"], designed["Ki"]) \
+        if cfg.gains == "design" and cfg.Ki is None and designed else {}
     c = PID(Kp=g["Kp"], Ki=g["Ki"], Kd=g["Kd"], u_max=ctx.u_max(cfg.u_max_deg), **extra)
     return c, c.pack()
 
