@@ -20,7 +20,7 @@ threshold tests were marked ``xfail(strict=True)``. The plants meet it now (2701
 95.9 %: asa designed from (K, T) of either sign, gain_shaping_pid's pole placement for T < 0,
 and the bandwidth rule designing course-unstable plants past the gear caps while the rudder can
 hold the turn), so their mark is gone. The matrix met it on 2026-11-29 (1716 of 1804 cases,
-95.0 %: docs/conformance.md), and its mark is gone too.
+95.1 %: docs/conformance.md), and its mark is gone too.
 """
 
 from __future__ import annotations
