@@ -185,12 +185,31 @@ def is_realtime(nodeid: str) -> bool:
     return any(fnmatch(module, pattern) for pattern in REALTIME_MODULES)
 
 
+def shared_result_group(item) -> str:
+    """The ``xdist_group`` of a test that uses a fixture computed by :func:`once_per_session`
+    (a fixture whose function calls it), named after that fixture; ``""`` for any other test.
+
+    Such tests share one pytest-xdist worker: without the group, both workers could reach the
+    fixture at once and one would wait on :func:`once_per_session`'s lock, a core idle for as
+    long as the fixture takes (the random plants: about 170 s of one core on a cold cache,
+    measured 2026-11-29), while with it the other worker runs other tests meanwhile."""
+    infos = getattr(getattr(item, "_fixtureinfo", None), "name2fixturedefs", {})
+    for name in getattr(item, "fixturenames", ()):
+        for fixturedef in infos.get(name, ()):
+            code = getattr(getattr(fixturedef, "func", None), "__code__", None)
+            if code is not None and "once_per_session" in code.co_names:
+                return f"{fixturedef.func.__module__}.{name}"
+    return ""
+
+
 @pytest.hookimpl(tryfirst=True)      # before pytest-xdist's worker reads the xdist_group marks
 def pytest_collection_modifyitems(config, items):
     for item in items:
         if is_realtime(item.nodeid):
             item.add_marker(pytest.mark.realtime)
             item.add_marker(pytest.mark.xdist_group("realtime"))
+        elif group := shared_result_group(item):
+            item.add_marker(pytest.mark.xdist_group(group))
 
 
 # ------------------------------------------------- one expensive result for every worker

@@ -40,8 +40,12 @@ def test_registered():
     assert isinstance(zw.DESCRIPTION, str) and "\n" not in zw.DESCRIPTION
 
 
-def test_comparison_json_matches_return_value(quick_run):
+def test_comparison_json_matches_return_value(quick_run, request):
     out, rows, messages = quick_run
+    # a test of a fixture made once per session shares that fixture's pytest-xdist worker (conftest)
+    group = request.node.get_closest_marker("xdist_group")
+    assert group is not None and group.args == ("test_experiment_zwierzewicz2021.quick_run",)
+    assert request.node.get_closest_marker("realtime") is None
     with open(out / "comparison.json", encoding="utf-8") as fh:
         data = json.load(fh)
     assert data == rows
