@@ -64,6 +64,15 @@ def test_vector_steps_n_controllers_like_n_single_ones(scenario):
     same = controller("pid", nomoto=(0.05, 80.0)).vector(4).reset()
     u = same.step(0.0, np.zeros(4), 0.0, rad(10.0))
     assert u.shape == (4,) and np.all(u == u[0]) and u[0] > 0.0
+    # a Python number, a NumPy scalar and an (N,) array give the same column; bad ones one line
+    again = controller("pid", nomoto=(0.05, 80.0)).vector(4).reset()
+    assert np.array_equal(again.step(0.0, np.zeros(4), np.float64(0.0), np.full(4, rad(10.0))), u)
+    good = dict(t=0.0, heading=0.0, yaw_rate=0.0, heading_ref=0.1)
+    for field, value in (("heading", np.zeros(3)), ("yaw_rate", math.nan), ("yaw_rate_ref", math.inf),
+                         ("heading_ref", np.array([0.1, math.inf, 0.1, 0.1]))):
+        with pytest.raises(InputError) as ei:
+            same.step(**{**good, field: value})
+        assert str(ei.value).startswith(field + ": ") and "\n" not in str(ei.value)
 
 
 # ------------------------------------------------- a plant outside steerlab, designs from K, T only
