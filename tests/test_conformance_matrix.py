@@ -214,6 +214,30 @@ def test_reused_sea_is_the_full_build():
     matrix._SEAS.clear()
 
 
+@pytest.mark.parametrize("ship,law", [("esso", "pid"), ("esso", "adrc"), ("mss-container", "sliding_mode"),
+                                      ("nomoto2", "classic_autopilot")])
+def test_calm_water_runs_in_the_sea_legs_loop_bit_for_bit(ship, law):
+    """The matrix runs a calm case by its law's "+wf" loop with the filter off (matrix.one_loop,
+    one compiled loop per ship and law): the same design and every recorded state, rudder and
+    order the same bits as the plain law's own loop, at every operating point. (esso + pid and
+    esso + adrc are the suite's usual loops; the container ship has 4 DOF and an rpm state;
+    classic_autopilot's integral starts at the straight-course rudder.)"""
+    from steerlab.conformance.matrix import one_loop
+    from steerlab.sim.engine import simulate
+
+    spec = get_ship(ship)
+    for point in operating_points(spec):
+        setup = build_case(Case(ship, law, point, CALM), run_length(time_scale(spec, point))[0])
+        through = one_loop(setup)
+        assert through.controller.name == law + "+wf" and setup.controller.name == law
+        plain, filtered = simulate(setup), simulate(through)
+        for name in ("time", "states", "delta_cmd", "psi_ref", "r_ref"):
+            a, b = getattr(plain, name), getattr(filtered, name)
+            assert a.shape == b.shape and np.array_equal(a, b, equal_nan=True), (point.label, name)
+    asa = build_case(Case("nomoto1", "asa", operating_points(get_ship("nomoto1"))[0], CALM), 200.0)
+    assert one_loop(asa) is asa                       # its own filter: run as it is
+
+
 @pytest.mark.parametrize("ship,sea", [("nomoto1", SEA5), ("small-tanker-nomoto-10deg", SEA5), ("esso", CALM),
                                       ("nomoto2", CALM)])
 def test_backstepping_a_cases_issue_30_named_now_steer(ship, sea):

@@ -205,7 +205,7 @@ def test_wrapper_records_compose_with_the_inner_layout():
     assert (wave_filter.F_PSI, wave_filter.F_R, wave_filter.F_XI, wave_filter.F_BIAS, wave_filter.N_WF) == (0, 1, 6, 7, 8)
     assert (wave_filter.WF_TLF, wave_filter.WF_XIMIN, wave_filter.WF_KB, wave_filter.WF_GS, wave_filter.N_WF_PARAMS) == (0, 3, 4, 5, 6)
     wf = wave_filtered
-    assert (wf.P_K, wf.P_T, wf.OFF_P, wf.OFF_X, wf.OFF_Z) == (6, 7, 8, 8, 8 + wf.NX_MAX)
+    assert (wf.P_K, wf.P_T, wf.P_ON, wf.OFF_P, wf.OFF_X, wf.OFF_Z) == (6, 7, 8, 9, 8, 8 + wf.NX_MAX)
 
     inner = pid.PID(Kp=2.5, Ki=0.01, Kd=30.0, u_max=0.5)
     sensed = wrapper.sensed_layout(pid.PARAMS)
@@ -215,7 +215,7 @@ def test_wrapper_records_compose_with_the_inner_layout():
     filtered = wf.wave_filtered_layout(pid.PARAMS)
     p = wf.WaveFiltered(inner, K=0.05, T=40.0).pack(inner.pack())
     assert filtered.size == p.size and p[filtered.index("inner.Kp")] == 2.5 and p[filtered.index("filter_T")] == 40.0
-    assert filtered.unpack(p)["wave_filter.T_lf"] == 20.0
+    assert filtered.unpack(p)["wave_filter.T_lf"] == 20.0 and filtered.unpack(p)["filter_on"] == 1.0
     assert wf.wave_filtered_state_layout(pid.STATE).index("inner.integral") == wf.OFF_Z + pid.Z_INT
     with pytest.raises(InputError, match=r"controller\.filter_K: must be non-zero"):
         wf.WaveFiltered(inner, K=0.0, T=40.0).pack(inner.pack())

@@ -75,8 +75,11 @@ PARAMS = Layout("controller", "P_", [
                 "design speed)", -100.0, 100.0),
     RecordField("T", "filter_T", "s", "Nomoto time constant of the filter's model, non-zero (a ship near "
                 "the edge of course stability has |T| of 1e4 s and more: KVLCC2 at 8 kn, -1.5e4 s)", -1e6, 1e6),
+    RecordField("ON", "filter_on", "-", "1: the inner law sees the filter's estimates; 0: the filter is off and the "
+                "measured heading and yaw rate pass through, so the inner law gives the orders it gives without "
+                "the wrapper, bit for bit (filter_off; the conformance matrix's calm water)", 0.0, 1.0),
 ], size_name="OFF_P")
-PARAMS.export(globals())         # P_WF_TLF = 0, ..., P_K = 4, P_T = 5, OFF_P = 6 (the inner record from here)
+PARAMS.export(globals())         # P_WF_TLF = 0, ..., P_K = 4, P_T = 5, P_ON = 6, OFF_P = 7 (the inner record from here)
 STATE = Layout("controller state", "Z_", [
     *(RecordField("WF_" + f.const, "wave_filter." + f.name, f.unit, f.doc) for f in WF_STATE.fields),
     *(RecordField(f"X{i}", f"x_copy.{i}", "-", "scratch: the plant state with filtered heading and yaw rate")
@@ -106,14 +109,17 @@ def _inner(z, p, t, x, ref, h):  # pragma: no cover - replaced per wrapper
 
 
 def _wf_update_template(z, p, t, x, ref, h):
-    """Wave filter, then the inner controller on the filtered copy of ``x`` (module doc)."""
+    """Wave filter, then the inner controller on the filtered copy of ``x`` (module doc); with
+    ``filter_on`` = 0 the inner controller gets the unfiltered copy (one call site, so the
+    inner kernel is inlined once)."""
     nx = x.shape[0]
-    wave_filter_step(z, p, p[P_K], p[P_T], x[IPSI], x[nx - 1], h)
     xf = z[OFF_X:OFF_X + nx]
     for i in range(nx):
         xf[i] = x[i]
-    xf[IPSI] = z[F_PSI]
-    xf[IR] = z[F_R]
+    if p[P_ON] != 0.0:
+        wave_filter_step(z, p, p[P_K], p[P_T], x[IPSI], x[nx - 1], h)
+        xf[IPSI] = z[F_PSI]
+        xf[IR] = z[F_R]
     return _inner(z[OFF_Z:], p[OFF_P:], t, xf, ref, h)
 
 
@@ -127,7 +133,7 @@ class WaveFiltered(NamedTuple):
 
     def pack(self, inner_p) -> np.ndarray:
         values = {"wave_filter." + k: v for k, v in self.filt._asdict().items()}
-        head = PARAMS.pack(values, filter_K=self.K, filter_T=self.T)
+        head = PARAMS.pack(values, filter_K=self.K, filter_T=self.T, filter_on=1.0)
         if abs(self.T) < 1e-6:
             raise InputError("controller.filter_T", "must be non-zero (|T| >= 1e-6 s)")
         if abs(self.K) < 1e-9:
@@ -202,6 +208,25 @@ def wave_filtered(spec: ControllerSpec) -> ControllerSpec:
         source=f"{spec.source}; wave filter: van Amerongen (1982) Fig. 4.13-4.14", design_rule=spec.design_rule,
         params=None if spec.params is None else wave_filtered_layout(spec.params),
         recipe=(wave_filtered, (spec,)))
+
+
+def filter_off(spec: ControllerSpec, p, z0, nx: int) -> Optional[tuple[ControllerSpec, np.ndarray, np.ndarray]]:
+    """``(spec + "+wf", p', z0')``: the law ``spec`` as designed (``p``, ``z0``: its own record and
+    initial state, not a design behind the filter) run by the ``"+wf"`` kernel with the filter
+    off (``filter_on`` = 0) on a plant of ``nx`` states (rudder included).
+
+    Its orders are the plain law's bit for bit (the inner kernel reads an exact copy of the plant
+    state; tests/test_conformance_matrix.py compares whole runs), so one compiled loop per
+    (ship, law) serves calm water and a sea. ``None`` for a law that is not wrapped (``asa``, a
+    ``"+wf"`` law) or a plant of more than :data:`NX_MAX` states.
+    """
+    if spec.name in NOT_WRAPPED or spec.name.endswith(SUFFIX) or nx > NX_MAX:
+        return None
+    head = PARAMS.pack({"wave_filter." + k: v for k, v in WaveFilterParams()._asdict().items()},
+                       filter_K=1.0, filter_T=1.0, filter_on=0.0)
+    z = np.zeros(OFF_Z + len(z0))
+    z[OFF_Z:] = z0
+    return wave_filtered(spec), np.concatenate([head, np.asarray(p, dtype=np.float64)]), z
 
 
 def _behind_filter(ctx):
