@@ -9,15 +9,16 @@ other exception, at design or run time, is a failure whose reason starts ``crash
 design must refuse bad input in one line, never raise something else.
 
 Which engine. Each (ship kernel, control-law kernel) combination compiles one loop, kept in
-the on-disk driver cache (docs/compile-cache.md); the catalogue's 26 ships share 10 ship
-kernels and the 11 laws 9 law kernels (``pid``, ``gain_shaping_pid`` and ``lq_pd`` are one
-kernel with other gains), so a cold cache compiles about 90 loops, and that, not the runs,
-is the matrix's cost. The matrix uses the compiled single-run loop (``sl.simulate``), whose
-compile took 1.7-3.7 s of CPU per combination where the batch engine's vectorised group loop
-took 4.3-6.7 s (four combinations measured); a combination has 6-18 runs of 1-8 thousand
-simulated seconds, too few for the vectorised loop to pay its compile back. The whole matrix
-(1 672 cases) took 148 s of CPU from an empty driver cache (the kernels' own numba cache
-warm, as after CI's ``.ci/warm-cache``): about 75 s on two idle cores. The numbers are the same either way (the
+the on-disk driver cache (docs/compile-cache.md), and that, not the runs, is the matrix's cost.
+The sea leg runs each law behind the wave filter (``"<law>+wf"``); calm water runs the same
+``"+wf"`` loop with the filter switched off (:func:`one_loop`: the law's own design, its orders
+bit for bit those of its plain loop, tests/test_conformance_matrix.py), so the two legs share
+one compiled loop: 132 loops from a cold cache instead of 228, 478 s of CPU instead of 573 for
+the 1 804 cases, every outcome identical (2026-11-29, two processes, benchmarks/RESULTS.md).
+The matrix uses the compiled single-run loop (``sl.simulate``), whose compile took 1.7-3.7 s of
+CPU per combination where the batch engine's vectorised group loop took 4.3-6.7 s (four
+combinations measured); a combination has 6-18 runs of 1-8 thousand simulated seconds, too few
+for the vectorised loop to pay its compile back. The numbers are the same either way (the
 engines are bit-identical, tests/test_engine.py). Combinations are spread over ``workers``
 processes (default: 2, or the machine's cores if fewer), one combination per task, so no two
 processes compile the same loop.
