@@ -39,6 +39,9 @@ def test_the_design_context_knows_the_straight_course_rudder():
     spec = get_ship("b481")
     ctx = DesignContext(spec, 0.5, make_gear(None), 0.1, 0.1, spec.options(None))
     assert ctx.straight_rudder() == pytest.approx(B481_DELTA0, rel=1e-4)
+    # HELM_RULE in one place: only a designed integral that exists starts there
+    assert ctx.integral_start(True, 1e-3) == ctx.straight_rudder()
+    assert ctx.integral_start(False, 1e-3) == 0.0 and ctx.integral_start(True, 0.0) == 0.0
     nomoto1 = get_ship("nomoto1")
     assert DesignContext(nomoto1, 5.0, make_gear(None), 0.1, 0.1, None).straight_rudder() == 0.0
 

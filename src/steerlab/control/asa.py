@@ -435,7 +435,7 @@ def build(cfg: ASAConfig, ctx):
             use_estimator=cfg.use_estimator,
             wave_filter=filter_params(cfg.wave_filter, ctx.sample_time, cfg.gains == "paper",
                                       identified=True),
-            helm0=ctx.straight_rudder() if cfg.gains == "design" else 0.0)
+            helm0=ctx.integral_start(cfg.gains == "design", 1.0 / cfg.integral_time_constants))
     return c, c.pack()
 
 

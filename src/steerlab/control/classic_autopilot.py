@@ -202,8 +202,7 @@ def build(cfg: ClassicAutopilotConfig, ctx):
     c = ClassicAutopilot(Kp=g["Kp"], Ki=g["Ki"], Kd=g["Kd"], u_max=ctx.u_max(cfg.u_max_deg),
                          weather=rad(cfg.weather_deg), weather_on=cfg.weather_on,
                          lowpass_T=cfg.lowpass_T, course_change=rad(cfg.course_change_deg),
-                         helm0=ctx.straight_rudder() if cfg.gains == "design" and cfg.Ki is None and g["Ki"] > 0.0
-                         else 0.0)
+                         helm0=ctx.integral_start(cfg.gains == "design" and cfg.Ki is None, g["Ki"]))
     return c, c.pack()
 
 

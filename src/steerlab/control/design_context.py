@@ -48,6 +48,13 @@ class DesignContext:
         d0 = float(f(self.speed, self.ship_options))
         return d0 if math.isfinite(d0) else 0.0
 
+    def integral_start(self, designed: bool, ki: float) -> float:
+        """A law's integral's initial output [rad] (:data:`HELM_RULE`): the straight-course
+        rudder when the integral is the design rule's (``designed``: no preset and no integral
+        gain given) and there is one (``ki > 0``), else 0 (a given or the paper's integral
+        starts at 0, as published)."""
+        return self.straight_rudder() if designed and ki > 0.0 else 0.0
+
     def u_max(self, u_max_deg: float | None) -> float:
         """The controller's output limit [rad]: the configured one, or the gear's limit."""
         return rad(u_max_deg) if u_max_deg is not None else self.gear.delta_max

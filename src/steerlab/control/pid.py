@@ -139,7 +139,7 @@ def design_integral(ctx, kp: float, ki: float) -> dict:
     if not (ki > 0.0 and kp > 0.0):
         return {"r_band": 0.0, "helm0": 0.0}
     return {"r_band": INTEGRAL_DIVISOR * ki / kp * INTEGRAL_BAND * TURN_RATE_FRACTION,
-            "helm0": ctx.straight_rudder()}
+            "helm0": ctx.integral_start(True, ki)}
 
 
 def designed_gains(ctx, law: str = "pid") -> dict:

@@ -227,7 +227,7 @@ def build(cfg: SlidingModeConfig, ctx):
     ki = cfg.k_i if cfg.k_i is not None else (0.0 if paper else integral_gain(wi, law_model(ctx).b))
     c = SlidingMode(tuple(k), tuple(h), eta, phi, hb, i_rdot, ctx.u_max(cfg.u_max_deg), ki,
                     0.0 if wi is None else wi * INTEGRAL_BAND * TURN_RATE_FRACTION,
-                    0.0 if paper or cfg.k_i is not None or ki <= 0.0 else ctx.straight_rudder())
+                    ctx.integral_start(not paper and cfg.k_i is None, ki))
     return c, c.pack()
 
 
