@@ -32,12 +32,39 @@ SCENARIO_TOML = runtime_scenario_toml("cli-runtime", 60.0, waves=False)
     (["autopilot", "--connect", "127.0.0.1:47110", "--mode", "route"], "--mode"),
     (["autopilot", "--connect", "127.0.0.1:47110", "--profile", "storm"], "--profile"),
     (["autopilot", "--connect", "127.0.0.1:47110", "--profiles", "missing.toml"], "--profiles"),
+    (["autopilot", "--connect", "127.0.0.1:47110", "--operator-token-env", "STEERLAB_TEST_UNSET_VAR"],
+     "--operator-token-env"),
 ])
 def test_bad_input_one_line_exit_2(argv, field, capsys, monkeypatch):
     monkeypatch.delenv("STEERLAB_TEST_UNSET_VAR", raising=False)
     assert main(argv) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and err[0].startswith("steerlab: error: ") and field in err[0]
+
+
+def test_the_operator_token_from_the_environment(monkeypatch, capsys):
+    """``--operator-token-env NAME``: the run's operator token is that variable's value (stripped),
+    presented as ``?op=`` or ``Authorization: Bearer``; a wrong one is refused (``None``), a token
+    that is too short, too long or not URL-safe is one line, exit 2. Without it, a random token
+    per run."""
+    from types import SimpleNamespace
+
+    from steerlab.runtime.operator_session import MAX_TOKEN, MIN_TOKEN, OperatorSession
+
+    monkeypatch.setenv("STEERLAB_TEST_OP_TOKEN", "  boat-owner_token.2026~x  ")
+    op = OperatorSession.from_env("STEERLAB_TEST_OP_TOKEN")
+    assert op.token == "boat-owner_token.2026~x"
+    assert op.url("127.0.0.1", 8080) == "http://127.0.0.1:8080/#op=boat-owner_token.2026~x"
+    assert op.check(SimpleNamespace(path=f"/ws?op={op.token}", headers={})) is True
+    assert op.check(SimpleNamespace(path="/ws", headers={"Authorization": f"Bearer {op.token}"})) is True
+    assert op.check(SimpleNamespace(path="/ws?op=boat-owner_token.2026~y", headers={})) is None
+    assert op.check(SimpleNamespace(path="/ws", headers={})) is False
+    assert OperatorSession.from_env(None).token != OperatorSession.from_env(None).token
+    for bad in ("x" * (MIN_TOKEN - 1), "x" * (MAX_TOKEN + 1), "boat owner token 2026", "boat/owner/token/2026"):
+        monkeypatch.setenv("STEERLAB_TEST_OP_TOKEN", bad)
+        assert main(["autopilot", "--connect", "127.0.0.1:47110", "--operator-token-env", "STEERLAB_TEST_OP_TOKEN"]) == 2
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1 and err[0].startswith("steerlab: error: --operator-token-env") and "URL-safe" in err[0]
 
 
 def test_a_profile_out_of_range_is_one_line_naming_profile_and_field(tmp_path, capsys):
