@@ -48,7 +48,7 @@ def scenario(ship, ctrl, speed_kn=None, options=None):
                                "guidance": {"changes": [{"t": 1.0, "psi_deg": 20.0}]}})
 
 
-def setup(ship, ctrl, **kw):
+def _setup(ship, ctrl, **kw):
     return build(scenario(ship, ctrl, **kw))
 
 
@@ -89,8 +89,8 @@ def test_adrc_explicit_settings_are_the_paper_preset_bit_for_bit():
     only difference (it never binds on the default run: the guard's time series are unchanged)."""
     ctrl = {"type": "adrc", "T_settle": 150.0, "c0": "estimate", "observer": "paper"}
     a = obj("esso", ctrl, speed_kn=16.0)
-    b = setup("esso", {**ctrl, "gains": "paper"}, speed_kn=16.0)
-    c = setup("esso", {"type": "adrc", "gains": "paper"}, speed_kn=16.0)
+    b = _setup("esso", {**ctrl, "gains": "paper"}, speed_kn=16.0)
+    c = _setup("esso", {"type": "adrc", "gains": "paper"}, speed_kn=16.0)
     assert a.Kp == 36.0 / 150.0 ** 2 and a.Kd == 12.0 / 150.0 and a.L == PAPER_L
     np.testing.assert_array_equal(b.pc, c.pc)
     assert b.pc[-1] == NO_CLAMP

@@ -95,7 +95,7 @@ def test_bridge_page_in_headless_chromium(tmp_path):
                 _check_live_values(page)
                 _check_controls(page)
                 _check_link_cut(page, server)
-                page.screenshot(path=str(tmp_path / "bridge.png"))
+                page.screenshot(path=str(tmp_path / "bridge.png"), caret="initial")   # the page as it is: no injected style
             finally:
                 browser.close()
     finally:
@@ -113,6 +113,19 @@ def test_bridge_page_in_headless_chromium(tmp_path):
 
 def _texts(page, *ids):
     return page.evaluate("(ids) => ids.map((i) => document.getElementById(i).textContent)", list(ids))
+
+
+def _wait_until(page, predicate: str, arg) -> None:
+    """Poll ``predicate(arg)`` in the page until it is true (at most ``TIMEOUT_MS``). Not
+    ``page.wait_for_function``: Playwright 1.40 (the oldest pin) polls it through ``eval``, which the page's
+    Content Security Policy (``default-src 'self'``) refuses; ``page.evaluate`` is not subject
+    to it on any version (found on the oldest pins, docs/ci.md)."""
+    import time
+
+    end = time.monotonic() + TIMEOUT_MS / 1000.0
+    while not page.evaluate(predicate, arg):
+        assert time.monotonic() < end, f"the page did not reach {predicate!r} in {TIMEOUT_MS} ms"
+        page.wait_for_timeout(100)
 
 
 def _attr(page, id_, name):
@@ -141,14 +154,15 @@ def _check_live_values(page):
     assert re.fullmatch(r"(1|2|5)0* (m|km)", page.text_content("#scale-text")), page.text_content("#scale-text")
     assert float(_attr(page, "scale-bar", "x2")) > float(_attr(page, "scale-bar", "x1")) + 10
     # the values are live: the needle turns, the track moves on, rudder and yaw rate move (waves)
-    page.wait_for_function(
+    _wait_until(
+        page,
         """([needle, points, yaw, rudder, ctl]) => {
              const E = (i) => document.getElementById(i);
              return E("ship-needle").getAttribute("transform") !== needle
                && E("track-line").getAttribute("points") !== points
                && E("yaw-rate").textContent !== yaw && E("rudder-angle").textContent !== rudder
                && E("controller").textContent !== ctl && E("rudder-bar").getAttribute("width") !== null;
-           }""", arg=[needle0, points0, yaw0, rudder0, ctl0])
+           }""", [needle0, points0, yaw0, rudder0, ctl0])
     # what the page shows is what the autopilot reports (same-origin fetch, allowed by the CSP)
     st = page.evaluate("fetch('/status.json').then((r) => r.json())")
     shown = float(page.text_content("#heading").rstrip("\u00b0"))

@@ -80,7 +80,7 @@ def test_bridge_page_on_a_390_px_phone(tmp_path):
                 page.tap("#gain-set")
                 expect(page.locator("#reply")).to_contain_text("refused: controller.Kp")
                 expect(page.locator("#settings")).to_contain_text("Kp = 3.5")
-                page.screenshot(path=str(tmp_path / "phone.png"), full_page=True)
+                page.screenshot(path=str(tmp_path / "phone.png"), full_page=True, caret="initial")
             finally:
                 browser.close()
     finally:
