@@ -79,7 +79,7 @@ PARAMS = Layout("controller", "P_", [
                 "measured heading and yaw rate pass through, so the inner law gives the orders it gives without "
                 "the wrapper, bit for bit (filter_off; the conformance matrix's calm water)", 0.0, 1.0),
 ], size_name="OFF_P")
-PARAMS.export(globals())         # P_WF_TLF = 0, ..., P_K = 4, P_T = 5, P_ON = 6, OFF_P = 7 (the inner record from here)
+PARAMS.export(globals())         # P_WF_TLF = 0, ..., P_K = 6, P_T = 7, P_ON = 8, OFF_P = 9 (the inner record from here)
 STATE = Layout("controller state", "Z_", [
     *(RecordField("WF_" + f.const, "wave_filter." + f.name, f.unit, f.doc) for f in WF_STATE.fields),
     *(RecordField(f"X{i}", f"x_copy.{i}", "-", "scratch: the plant state with filtered heading and yaw rate")
@@ -130,10 +130,11 @@ class WaveFiltered(NamedTuple):
     K: float
     T: float
     filt: WaveFilterParams = WaveFilterParams()
+    on: float = 1.0            # filter_on: 0 passes the measurement through (filter_off)
 
     def pack(self, inner_p) -> np.ndarray:
         values = {"wave_filter." + k: v for k, v in self.filt._asdict().items()}
-        head = PARAMS.pack(values, filter_K=self.K, filter_T=self.T, filter_on=1.0)
+        head = PARAMS.pack(values, filter_K=self.K, filter_T=self.T, filter_on=self.on)
         if abs(self.T) < 1e-6:
             raise InputError("controller.filter_T", "must be non-zero (|T| >= 1e-6 s)")
         if abs(self.K) < 1e-9:
@@ -222,11 +223,9 @@ def filter_off(spec: ControllerSpec, p, z0, nx: int) -> Optional[tuple[Controlle
     """
     if spec.name in NOT_WRAPPED or spec.name.endswith(SUFFIX) or nx > NX_MAX:
         return None
-    head = PARAMS.pack({"wave_filter." + k: v for k, v in WaveFilterParams()._asdict().items()},
-                       filter_K=1.0, filter_T=1.0, filter_on=0.0)
     z = np.zeros(OFF_Z + len(z0))
     z[OFF_Z:] = z0
-    return wave_filtered(spec), np.concatenate([head, np.asarray(p, dtype=np.float64)]), z
+    return wave_filtered(spec), WaveFiltered(None, 1.0, 1.0, on=0.0).pack(p), z
 
 
 def _behind_filter(ctx):
