@@ -8,11 +8,13 @@ worker; each log is switched on by its variable)::
 
 * ``STEERLAB_TEST_TIMES=FILE``: ``seconds phase nodeid`` for every test phase (setup, call,
   teardown) of at least 0.05 s, as it finishes (written by the controller only).
-* ``STEERLAB_TEST_CPU=FILE``: ``cpu_s wall_s nodeid`` for every test (setup, call and teardown
-  together; CPU of the worker and the subprocesses it waited for, ``getrusage``): which tests
-  use the cores and which wait (sockets, sleeps, other processes' locks). POSIX only.
-* ``STEERLAB_TEST_COMPILES=FILE``: ``seconds worker nodeid function`` for every function numba
-  compiles (not a disk-cache load) while a test runs, so that a suite's compile time can be
+* ``STEERLAB_TEST_CPU=FILE``: ``cpu_s wall_s nodeid children_cpu_s`` for every test (setup, call
+  and teardown together; CPU of the worker and the subprocesses it waited for, ``getrusage``,
+  and of those subprocesses alone): which tests use the cores, which wait (sockets, sleeps,
+  other processes' locks) and which spend their CPU in the commands they start. POSIX only.
+* ``STEERLAB_TEST_COMPILES=FILE``: ``seconds worker nodeid function depth`` for every function
+  numba compiles (not a disk-cache load) while a test runs (``depth`` 0: a compile no other
+  compile started, whose seconds include those it started; sum depth 0 for the total), so that a suite's compile time can be
   traced to its tests and combinations compiled by both workers found (``sort -k4 FILE``);
   what ``.ci/warm-cache`` should warm.
 
@@ -35,12 +37,14 @@ def pytest_runtest_logreport(report):
             f.write(f"{report.duration:.2f} {report.when} {report.nodeid}\n")
 
 
-def _cpu_seconds() -> float:
-    """User + system CPU of this process and of its waited-for children [s]."""
+def _cpu_seconds() -> tuple[float, float]:
+    """User + system CPU of this process and of its waited-for children, and of those children
+    alone [s]."""
     import resource
 
     own, kids = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(resource.RUSAGE_CHILDREN)
-    return own.ru_utime + own.ru_stime + kids.ru_utime + kids.ru_stime
+    children = kids.ru_utime + kids.ru_stime
+    return own.ru_utime + own.ru_stime + children, children
 
 
 @pytest.hookimpl(hookwrapper=True)
@@ -49,12 +53,12 @@ def pytest_runtest_protocol(item, nextitem):
     if not path or os.name != "posix":
         yield
         return
-    c0, t0 = _cpu_seconds(), time.perf_counter()
+    (c0, k0), t0 = _cpu_seconds(), time.perf_counter()
     yield
-    cpu, wall = _cpu_seconds() - c0, time.perf_counter() - t0
+    (c1, k1), wall = _cpu_seconds(), time.perf_counter() - t0
     if wall >= 0.05:
         with open(path, "a", encoding="utf-8") as f:
-            f.write(f"{cpu:.2f} {wall:.2f} {item.nodeid}\n")
+            f.write(f"{c1 - c0:.2f} {wall:.2f} {item.nodeid} {k1 - k0:.2f}\n")
 
 
 def _listen_to_compiles(path: str) -> None:
@@ -62,16 +66,19 @@ def _listen_to_compiles(path: str) -> None:
     import numba.core.event as ev
 
     class Listener(ev.Listener):
+        starts: list = []
+
         def on_start(self, event):
-            self.t0 = time.perf_counter()
+            self.starts.append(time.perf_counter())
 
         def on_end(self, event):
             disp = event.data.get("dispatcher")
             func = getattr(disp, "py_func", None)
             name = f"{getattr(func, '__module__', '?')}.{getattr(func, '__qualname__', '?')}"
+            seconds = time.perf_counter() - self.starts.pop()
             with open(path, "a", encoding="utf-8") as f:
-                f.write(f"{time.perf_counter() - self.t0:.2f} {os.environ.get('PYTEST_XDIST_WORKER', '-')} "
-                        f"{os.environ.get('PYTEST_CURRENT_TEST', '-').split(' ')[0]} {name}\n")
+                f.write(f"{seconds:.2f} {os.environ.get('PYTEST_XDIST_WORKER', '-')} "
+                        f"{os.environ.get('PYTEST_CURRENT_TEST', '-').split(' ')[0]} {name} {len(self.starts)}\n")
 
     ev.register("numba:compile", Listener())
 
