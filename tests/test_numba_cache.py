@@ -54,6 +54,21 @@ def test_steerlab_kernels_carry_the_package_stamp_and_others_do_not(monkeypatch)
     assert not getattr(outside._cache._impl._locator, "_steerlab", False)
 
 
+def test_a_result_numba_cannot_cache_is_one_warning_naming_the_kernels_file():
+    """numba refuses to cache a compile result with dynamic globals (every driver under
+    NUMBA_OPT=0) and warns naming the source file through the locator: the stamped locator
+    must name it too (it raised AttributeError, so every run crashed under NUMBA_OPT=0)."""
+    from types import SimpleNamespace
+
+    impl = esso_rhs._cache._impl
+    assert impl._locator._py_file == esso_rhs.py_func.__code__.co_filename
+    cres = SimpleNamespace(lifted=(), library=SimpleNamespace(has_dynamic_globals=True),
+                           fndesc=SimpleNamespace(qualname="esso_rhs"))
+    with pytest.warns(numba.NumbaWarning, match="Cannot cache compiled function") as record:
+        assert impl.check_cachable(cres) is False
+    assert record[0].filename == esso_rhs.py_func.__code__.co_filename
+
+
 def test_a_change_elsewhere_in_steerlab_recompiles_the_cached_kernel(tmp_path):
     """In a fresh process: a cached kernel is loaded (hit); once another steerlab file's stamp
     changes (simulated by pointing the fingerprint at a changed tree), it is compiled again."""

@@ -138,6 +138,12 @@ def _make_locator(base):
         def get_disambiguator(self):
             return self._inner.get_disambiguator()
 
+        @property
+        def _py_file(self):
+            # numba names the source file when it warns that a result cannot be cached (e.g.
+            # under NUMBA_OPT=0, where a driver keeps dynamic globals): the inner locator's
+            return getattr(self._inner, "_py_file", "")
+
         @classmethod
         def from_function(cls, py_func, py_file):
             driver = _is_driver(py_file)
