@@ -57,7 +57,10 @@ CACHE = False         # numba disk cache for the entry points
 
 ENTRY_POINTS = {"run": "closed loop", "group": "batch loop", "rk4_step": "plant step",
                 "replay_rudder": "rudder replay", "step_lanes": "vectorised plant step"}
-"""The compiled entry points and what they are (for :data:`steerlab.jit.drivers.on_compile`)."""
+"""The compiled entry points and what they are (for :data:`steerlab.jit.drivers.on_compile`).
+Only these are called from Python; every other function here, and the fused kernels below,
+is compiled without a Python entry (:func:`steerlab.sim.kernels._fuse_options`) and is called
+from compiled code only."""
 
 ship = _fused(SHIP_RHS)
 rate = _fused(gear_rate)

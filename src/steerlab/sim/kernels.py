@@ -49,11 +49,17 @@ def _fuse_options() -> dict:
     ship models) is one instruction and not a branch to an exception, which would stop the
     batch engine from vectorising the kernel. The records the kernels divide by are validated
     (T != 0 etc.), so no valid scenario divides by zero and the numbers are those of the
-    plain kernels. The options are checked (without compiling anything: a compile per
+    plain kernels. ``no_cpython_wrapper`` and ``no_cfunc_wrapper``: a fused kernel is only
+    ever called from compiled code (a driver's entry points, which keep their wrappers), so
+    numba need not build, optimise and emit machine code for the two wrappers of each one
+    (their argument unboxing is much of the IR): a driver compiles in about two thirds of the
+    CPU (benchmarks/RESULTS.md), with the same machine code for the loop. Such a kernel cannot be
+    called from Python (it has no entry to call). The options are checked (without compiling anything: a compile per
     process would cost start-up time) against numba's target options; plain ``njit`` if
     this numba lacks one.
     """
-    return supported_options({"forceinline": True, "_nrt": False, "error_model": "numpy"})
+    return supported_options({"forceinline": True, "_nrt": False, "error_model": "numpy",
+                              "no_cpython_wrapper": True, "no_cfunc_wrapper": True})
 
 
 def _jit_fused(fn):
@@ -90,28 +96,23 @@ def rk4_stage(x, c, k):
 def rk4_update(x, s6, k1, k2, k3, k4):
     """Classic RK4: the step ``x + (h/6) (k1 + 2 k2 + 2 k3 + k4)``, ``s6 = h/6``.
 
-    These two helpers are the RK4 formula for every engine (the single run's :func:`_plant_kernels`
+    These two helpers are the RK4 formula for every engine (the single run's :func:`plant_step`
     and the batch's :mod:`steerlab.sim.lanes`), element by element, so both give the same bits.
     """
     return x + s6 * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
-
-
-def _plant_kernels(ship_rhs, nx: int = 0):
-    """``(rk4, rk4_step, plant_rhs, clamp)`` for a ship model (its plant-only driver);
-    ``nx > 0`` specialises on the plant state size."""
-    from steerlab.jit.drivers import driver
-
-    d = driver(ship_rhs, None, None, int(nx))
-    return d.rk4, d.rk4_step, d.plant_rhs, d.clamp
 
 
 def plant_step(ship_rhs):
     """RK4 step of the plant ``[ship states..., delta]`` with the rudder order held (ZOH).
 
     ``rk4_step(t, x, delta_cmd, w_row, ps, pg, dt, work)`` advances ``x`` in place;
-    ``work`` is a (5, nx) scratch array.
+    ``work`` is a (5, nx) scratch array. It is the ``rk4_step`` entry point of the ship's
+    plant-only driver (:mod:`steerlab.jit.driver_template`; its ``rk4`` and ``plant_rhs`` are
+    fused kernels, callable from compiled code only).
     """
-    return _plant_kernels(ship_rhs)[1]
+    from steerlab.jit.drivers import driver
+
+    return driver(ship_rhs, None, None, 0).rk4_step
 
 
 @lru_cache(maxsize=None)

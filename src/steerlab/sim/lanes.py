@@ -6,7 +6,7 @@ group of ``lanes`` independent runs together and lays the group out **structure 
 arrays**: one row per state, one column per run (``XL[q, g]`` is state ``q`` of run ``g``),
 in scratch arrays of a shape fixed at compile time. Each RK4 stage is then one loop over
 the runs of the group that calls the very same ship + gear kernel
-(:func:`steerlab.sim.kernels._plant_kernels`) on column views ``XL[:, g]``; after inlining,
+(``plant_rhs`` of :mod:`steerlab.jit.driver_template`) on column views ``XL[:, g]``; after inlining,
 the compiler vectorises that loop (8 runs per AVX-512 instruction, 4 with AVX2), because
 the kernels are straight-line arithmetic and selects: the kinematics take ``sin``/``cos``
 from :func:`steerlab.sincos.sincos` instead of the C library, the steering gear selects its
