@@ -414,3 +414,37 @@ def test_conformance_command(tmp_path, capsys):
     assert "| `nomoto1` |" in page
     assert main(["conformance", "--ships", "no-such-ship"]) == 2
     assert "ship.model" in capsys.readouterr().err
+
+
+# ------------------------------------------------------------- the evaluation is its own step
+EVALUATION_TESTS = {"test_matrix_runs_every_case_and_none_fails_silently",
+                    "test_matrix_fraction_that_steers_meets_the_target",
+                    "test_calm_water_cases_steer_or_are_refused",
+                    "test_sea_cases_hold_behind_the_designed_wave_filter",
+                    "test_random_plants_every_lane_is_judged",
+                    "test_random_plants_a_designed_law_holds_the_change",
+                    "test_random_plants_hold_the_change"}
+
+
+@pytest.mark.parametrize("marks,selected", [((), "others"), (("-m", "conformance"), "evaluation"),
+                                            (("-m", "not realtime"), "others")])
+def test_the_default_run_leaves_the_evaluation_to_its_own_step(marks, selected):
+    """The README's ``pytest`` run collects every test of this module but the seven of the
+    evaluation; ``-m conformance`` (what ``.ci/run`` runs second) collects exactly those seven;
+    another ``-m`` expression does not bring them back."""
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    repo = Path(__file__).resolve().parent.parent
+    proc = subprocess.run([sys.executable, "-m", "pytest", "--collect-only", "-q", "-n", "0",
+                           "-p", "no:cacheprovider", *marks, "tests/test_conformance_matrix.py"],
+                          cwd=repo, capture_output=True, text=True, timeout=600)
+    assert proc.returncode == 0, proc.stdout[-2000:] + proc.stderr[-2000:]
+    names = {line.split("::")[1].split("[")[0] for line in proc.stdout.splitlines() if "::" in line}
+    if selected == "evaluation":
+        assert names == EVALUATION_TESTS
+    else:
+        assert not names & EVALUATION_TESTS and "test_conformance_command" in names
+    ci = (repo / ".ci" / "run").read_text(encoding="utf-8").splitlines()
+    assert ci.index("python3 -m pytest -q") < ci.index("python3 -m pytest -q -m conformance")
