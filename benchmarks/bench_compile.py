@@ -1,0 +1,80 @@
+"""What a driver's compile costs, with the fused kernels' Python and C wrappers and without.
+
+The fused kernels (:func:`steerlab.sim.kernels._fuse_options`) are called from compiled code
+only, so steerlab compiles them with ``no_cpython_wrapper`` and ``no_cfunc_wrapper``. This
+benchmark measures what that saves: each round starts two fresh processes on empty caches, one
+with the wrappers put back (the options as they were before, patched in the child) and one as
+steerlab ships, in alternating order; each compiles the single-run loop of a few (ship, law)
+combinations and one batch group loop, and reports the CPU of each compile. Medians and the
+ratio (without / with) over the rounds are printed; no number of a run can differ (the loop's
+code is the same; the entry points keep their wrappers).
+
+Usage (the machine quiet; about a minute of CPU per round)::
+
+    PYTHONPATH=src python3 benchmarks/bench_compile.py --rounds 3
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+
+CHILD = r"""
+import json, sys, time
+if sys.argv[1] == "wrappers":
+    import steerlab.sim.kernels as K
+    from steerlab.jit.dispatch import supported_options
+    opts = supported_options({"forceinline": True, "_nrt": False, "error_model": "numpy"})
+    K._fuse_options = lambda: opts
+from steerlab.sim.batch import simulate_batch
+from steerlab.sim.engine import simulate
+from steerlab.sim.scenario import scenario_from_dict
+from steerlab.sim.setup import build
+
+def setup(ship, law):
+    return build(scenario_from_dict({"ship": {"model": ship}, "controller": {"type": law}, "duration": 20.0}))
+
+out = {}
+t = time.process_time(); simulate(setup("nomoto1", "sliding_mode")); out["first compile in the process"] = time.process_time() - t
+for ship, law in (("nomoto1", "pid"), ("esso", "adrc"), ("mss-mariner", "lq_pd+wf")):
+    s = setup(ship, law)
+    t = time.process_time(); simulate(s); out[f"run {ship} + {law}"] = time.process_time() - t
+s = setup("nomoto1", "pid")
+t = time.process_time(); simulate_batch([s, s, s]); out["group nomoto1 + pid"] = time.process_time() - t
+print(json.dumps(out))
+"""
+
+
+def one(variant: str) -> dict:
+    with tempfile.TemporaryDirectory() as cache:
+        env = dict(os.environ, XDG_CACHE_HOME=cache, STEERLAB_CACHE_DIR=os.path.join(cache, "steerlab"))
+        proc = subprocess.run([sys.executable, "-c", CHILD, variant], env=env, capture_output=True, text=True,
+                              check=True)
+    return json.loads(proc.stdout.strip().splitlines()[-1])
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--rounds", type=int, default=3)
+    args = ap.parse_args()
+    runs: dict[str, list[dict]] = {"wrappers": [], "shipped": []}
+    for k in range(args.rounds):
+        order = ("wrappers", "shipped") if k % 2 == 0 else ("shipped", "wrappers")
+        for variant in order:
+            runs[variant].append(one(variant))
+            print(f"round {k + 1} {variant}: " + ", ".join(f"{v:.2f}" for v in runs[variant][-1].values()),
+                  file=sys.stderr)
+    print(f"{'compile [s CPU, median of ' + str(args.rounds) + ']':44s} {'wrappers':>9s} {'without':>9s} {'ratio':>6s}")
+    for key in runs["shipped"][0]:
+        a = statistics.median(r[key] for r in runs["wrappers"])
+        b = statistics.median(r[key] for r in runs["shipped"])
+        print(f"{key:44s} {a:9.2f} {b:9.2f} {b / a:6.2f}")
+
+
+if __name__ == "__main__":
+    main()
