@@ -99,28 +99,45 @@ def test_the_annotation_check_finds_a_missing_annotation(tmp_path):
     assert [m.split(" ", 1)[1] for m in _unannotated(bad)] == ["f: return", "C.m: z"]
 
 
-def test_mypy_is_clean_on_the_public_api_and_a_typed_user_script(tmp_path):
+PROBE = ("from typing import assert_type\nimport steerlab as sl\nfrom steerlab.sim.batch import BatchResult\n"
+         "assert_type(sl.simulate(sl.default_scenario()), BatchResult)\n")
+"""A user's line that expects the wrong type from ``sl.simulate``: mypy must call it an error."""
+
+
+@pytest.fixture(scope="module")
+def mypy_run(tmp_path_factory) -> dict:
+    """One mypy run, with a cache of its own, over the configured files (``[tool.mypy] files``:
+    the public API and tests/typing_usage.py) and :data:`PROBE`: its exit code and output
+    (made once per session: the two tests below read it)."""
     pytest.importorskip("mypy")
-    # each mypy run its own cache: two runs sharing ROOT/.mypy_cache on two pytest-xdist workers
-    # once ended in "INTERNAL ERROR" on a clean clone
-    proc = subprocess.run([sys.executable, "-m", "mypy", "--no-error-summary", "--cache-dir",
-                           str(tmp_path / "mypy-cache")], cwd=ROOT,
-                          capture_output=True, text=True, timeout=900)
-    assert proc.returncode == 0, proc.stdout[-5000:] + proc.stderr[-2000:]
+    from conftest import once_per_session
+
+    def make(folder: Path) -> dict:
+        probe = folder / "probe.py"
+        probe.write_text(PROBE, encoding="utf-8")
+        # each mypy run its own cache: two runs sharing ROOT/.mypy_cache on two pytest-xdist
+        # workers once ended in "INTERNAL ERROR" on a clean clone
+        proc = subprocess.run([sys.executable, "-m", "mypy", "--no-error-summary", "--cache-dir",
+                               str(folder / "mypy-cache"), "--config-file", str(ROOT / "pyproject.toml"),
+                               *CONFIG["files"], str(probe)],
+                              cwd=ROOT, capture_output=True, text=True, timeout=900)
+        return {"returncode": proc.returncode, "stdout": proc.stdout, "stderr": proc.stderr, "probe": str(probe)}
+
+    return once_per_session(tmp_path_factory, "mypy-run", make)
 
 
-def test_mypy_catches_a_wrong_return_type(tmp_path):
+def test_mypy_is_clean_on_the_public_api_and_a_typed_user_script(mypy_run):
+    errors = [line for line in mypy_run["stdout"].splitlines()
+              if ": error:" in line and not line.startswith(mypy_run["probe"])]
+    assert mypy_run["returncode"] in (0, 1) and not errors, \
+        "\n".join(errors)[-5000:] + mypy_run["stderr"][-2000:]
+
+
+def test_mypy_catches_a_wrong_return_type(mypy_run):
     """A user's line that expects the wrong type from ``sl.simulate`` is an error."""
-    pytest.importorskip("mypy")
-    probe = tmp_path / "probe.py"
-    probe.write_text("from typing import assert_type\nimport steerlab as sl\nfrom steerlab.sim.batch import BatchResult\n"
-                     "assert_type(sl.simulate(sl.default_scenario()), BatchResult)\n", encoding="utf-8")
-    proc = subprocess.run([sys.executable, "-m", "mypy", "--no-error-summary", "--cache-dir", str(tmp_path / "mypy-cache"),
-                           "--config-file", str(ROOT / "pyproject.toml"), str(probe)], cwd=ROOT, capture_output=True,
-                          text=True,
-                          timeout=900)
-    assert proc.returncode == 1, proc.stdout + proc.stderr
-    assert 'Expression is of type "Result", not "BatchResult"' in proc.stdout
+    assert mypy_run["returncode"] == 1, mypy_run["stdout"] + mypy_run["stderr"]
+    probe_errors = [line for line in mypy_run["stdout"].splitlines() if line.startswith(mypy_run["probe"])]
+    assert len(probe_errors) == 1 and 'Expression is of type "Result", not "BatchResult"' in probe_errors[0]
 
 
 def test_the_typed_user_script_runs():
