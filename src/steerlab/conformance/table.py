@@ -75,7 +75,8 @@ def markdown(m: Matrix) -> str:
            "settings, x calm water and a JONSWAP sea of sea state 5: a "
            f"{J.CHANGE_DEG:g} deg course change. Written by `python3 tools/conformance_table.py` "
            "(`steerlab conformance --out DIR` writes the same page and a JSON file); "
-           "`tests/test_conformance_matrix.py` runs the same matrix in CI.", "",
+           "`tests/test_conformance_matrix.py` runs the same matrix in CI (`.ci/run`'s second step, "
+           "`pytest -m conformance`; the default `pytest` run leaves it out).", "",
            f"**{t[STEERS]} of {n} cases steer ({_pct(m.fraction_steers)}; the target is "
            f">= {_pct(TARGET)}), {t[REFUSED]} are refused, {t[FAILS]} fail.**", "",
            "## How a case is judged", "",
