@@ -204,10 +204,10 @@ def shared_result_group(item) -> str:
 
 EVALUATION_MARK = "conformance"
 """The marker of the conformance evaluation (issue 30's evidence: the 1 804-case catalogue
-matrix and the 256 random plants, about 7 minutes of CPU from a cold cache, most of it
+matrix and the 256 random plants, about 9 minutes of CPU from a cold cache, most of it
 compiling one loop per ship and law). The default run leaves these tests out; ``-m conformance``
 (or any ``-m`` expression naming the mark) runs them, and ``.ci/run`` runs them as its second
-step (docs/ci.md). So the README's test command stays a newcomer's few minutes, and CI still
+step (docs/ci.md). So the README's test command does not wait for the evaluation, and CI still
 holds the catalogue to its targets."""
 
 

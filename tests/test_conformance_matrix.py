@@ -15,7 +15,7 @@
   the 20 deg change is at least :data:`HOLD_TARGET`.
 
 The matrix's and the plants' tests are the conformance evaluation (marked ``conformance``, about
-7 minutes of CPU from a cold cache): the default ``pytest`` run leaves them out,
+9 minutes of CPU from a cold cache): the default ``pytest`` run leaves them out,
 ``pytest -m conformance`` runs them, and ``.ci/run`` runs them as its second step
 (tests/conftest.py: ``EVALUATION_MARK``). The judge, operating-point and reused-sea tests above
 them run in every run.

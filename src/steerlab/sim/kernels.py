@@ -52,11 +52,11 @@ def _fuse_options() -> dict:
     plain kernels. ``no_cpython_wrapper`` and ``no_cfunc_wrapper``: a fused kernel is only
     ever called from compiled code (a driver's entry points, which keep their wrappers), so
     numba need not build, optimise and emit machine code for the two wrappers of each one
-    (their argument unboxing is much of the IR): a driver compiles in about two thirds of the
-    CPU (benchmarks/RESULTS.md), with the same machine code for the loop. Such a kernel cannot be
-    called from Python (it has no entry to call). The options are checked (without compiling anything: a compile per
-    process would cost start-up time) against numba's target options; plain ``njit`` if
-    this numba lacks one.
+    (their argument unboxing is much of the IR): a driver compiles in 0.7-0.9 of the CPU
+    (benchmarks/bench_compile.py, benchmarks/RESULTS.md), with the same code for the loop. Such
+    a kernel cannot be called from Python (numba gives it no entry). The options are checked
+    (without compiling anything: a compile per process would cost start-up time) against
+    numba's target options; plain ``njit`` if this numba lacks one.
     """
     return supported_options({"forceinline": True, "_nrt": False, "error_model": "numpy",
                               "no_cpython_wrapper": True, "no_cfunc_wrapper": True})
