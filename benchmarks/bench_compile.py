@@ -1,17 +1,22 @@
-"""What a driver's compile costs, with the fused kernels' Python and C wrappers and without.
+"""What a driver's compile costs, as steerlab ships it against one of two earlier ways.
 
-The fused kernels (:func:`steerlab.sim.kernels._fuse_options`) are called from compiled code
-only, so steerlab compiles them with ``no_cpython_wrapper`` and ``no_cfunc_wrapper``. This
-benchmark measures what that saves: each round starts two fresh processes on empty caches, one
-with the wrappers put back (the options as they were before, patched in the child) and one as
-steerlab ships, in alternating order; each compiles the single-run loop of a few (ship, law)
-combinations and one batch group loop, and reports the CPU of each compile. Medians and the
-ratio (without / with) over the rounds are printed; no number of a run can differ (the loop's
-code is the same; the entry points keep their wrappers).
+``--against own-plant`` (the default): every law's driver compiled its own copy of the plant
+(``plant_rhs``, ``rk4``) and of the batch group's lane helpers, where steerlab now takes them
+from the ship's plant-only driver, typed and lowered once per process and ship
+(:data:`steerlab.jit.driver_template.PLANT_PARTS`). ``--against wrappers``: the fused kernels
+(:func:`steerlab.sim.kernels._fuse_options`) with their Python and C wrappers, which steerlab
+leaves out (``no_cpython_wrapper``, ``no_cfunc_wrapper``: they are called from compiled code
+only).
+
+Each round starts two fresh processes on empty caches, one with the earlier way put back
+(patched in the child) and one as steerlab ships, in alternating order; each compiles the
+single-run loop of a few (ship, law) combinations and two batch group loops on one ship, and
+reports the CPU of each compile. Medians and the ratio (shipped / earlier) over the rounds are
+printed; no number of a run can differ (the same operations are inlined into the same loops).
 
 Usage (the machine quiet; about a minute of CPU per round)::
 
-    PYTHONPATH=src python3 benchmarks/bench_compile.py --rounds 3
+    PYTHONPATH=src python3 benchmarks/bench_compile.py --rounds 3 [--against wrappers]
 """
 
 from __future__ import annotations
@@ -31,6 +36,10 @@ if sys.argv[1] == "wrappers":
     from steerlab.jit.dispatch import supported_options
     opts = supported_options({"forceinline": True, "_nrt": False, "error_model": "numpy"})
     K._fuse_options = lambda: opts
+if sys.argv[1] == "own-plant":
+    import steerlab.jit.drivers as D
+    _source = D._source
+    D._source = lambda *a, **k: _source(*a, **k).replace("    _share_the_plant()", "    pass")
 from steerlab.sim.batch import simulate_batch
 from steerlab.sim.engine import simulate
 from steerlab.sim.scenario import scenario_from_dict
@@ -44,8 +53,9 @@ t = time.process_time(); simulate(setup("nomoto1", "sliding_mode")); out["first 
 for ship, law in (("nomoto1", "pid"), ("esso", "adrc"), ("mss-mariner", "lq_pd+wf")):
     s = setup(ship, law)
     t = time.process_time(); simulate(s); out[f"run {ship} + {law}"] = time.process_time() - t
-s = setup("nomoto1", "pid")
-t = time.process_time(); simulate_batch([s, s, s]); out["group nomoto1 + pid"] = time.process_time() - t
+for law in ("pid", "adrc"):
+    s = setup("nomoto1", law)
+    t = time.process_time(); simulate_batch([s, s, s]); out[f"group nomoto1 + {law}"] = time.process_time() - t
 print(json.dumps(out))
 """
 
@@ -61,17 +71,18 @@ def one(variant: str) -> dict:
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--rounds", type=int, default=3)
+    ap.add_argument("--against", choices=("own-plant", "wrappers"), default="own-plant")
     args = ap.parse_args()
-    runs: dict[str, list[dict]] = {"wrappers": [], "shipped": []}
+    runs: dict[str, list[dict]] = {args.against: [], "shipped": []}
     for k in range(args.rounds):
-        order = ("wrappers", "shipped") if k % 2 == 0 else ("shipped", "wrappers")
+        order = (args.against, "shipped") if k % 2 == 0 else ("shipped", args.against)
         for variant in order:
             runs[variant].append(one(variant))
             print(f"round {k + 1} {variant}: " + ", ".join(f"{v:.2f}" for v in runs[variant][-1].values()),
                   file=sys.stderr)
-    print(f"{'compile [s CPU, median of ' + str(args.rounds) + ']':44s} {'wrappers':>9s} {'without':>9s} {'ratio':>6s}")
+    print(f"{'compile [s CPU, median of ' + str(args.rounds) + ']':44s} {args.against:>9s} {'shipped':>9s} {'ratio':>6s}")
     for key in runs["shipped"][0]:
-        a = statistics.median(r[key] for r in runs["wrappers"])
+        a = statistics.median(r[key] for r in runs[args.against])
         b = statistics.median(r[key] for r in runs["shipped"])
         print(f"{key:44s} {a:9.2f} {b:9.2f} {b / a:6.2f}")
 

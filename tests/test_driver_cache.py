@@ -162,6 +162,38 @@ def test_kernels_that_cannot_be_named_run_from_an_in_memory_driver(tmp_path, mon
     np.testing.assert_array_equal(a.states, b.states)
 
 
+
+def test_every_laws_loop_on_a_ship_calls_the_ships_one_plant_and_compiles_it_once():
+    """A law's driver takes the plant and the batch group's lane helpers from the ship's
+    plant-only driver (the same objects), so the loop of a second law on the ship compiles none
+    of them again, and its numbers are those of the readable engine (same plant, same bits)."""
+    from conftest import make_scenario, unnamed_ship
+    from numba.core import event
+
+    from steerlab.guidance.reference_models import course_guide
+    from steerlab.jit import driver_template, drivers
+    from steerlab.sim.engine import simulate, simulate_readable
+    from steerlab.sim.setup import build
+
+    rhs = None
+    loops = []
+    for law in ("pid", "adrc"):
+        setup = build(make_scenario(duration=20.0, ship={"model": "nomoto1", "speed_kn": 10.0},
+                                    controller={"type": law}))
+        rhs = rhs or unnamed_ship(setup.ship.rhs)      # a new kernel: its drivers are new, in memory
+        setup = replace(setup, ship=replace(setup.ship, rhs=rhs))
+        with event.install_recorder("numba:compile") as rec:
+            result = simulate(setup)
+        loops.append([e.data["dispatcher"].py_func.__name__ for _, e in rec.buffer if e.is_start])
+        np.testing.assert_array_equal(result.states, simulate_readable(setup).states)
+    plant = drivers.driver(rhs, None, None, setup.x0.shape[0])
+    law = drivers.driver(rhs, setup.controller.update, course_guide, setup.x0.shape[0])
+    for name in driver_template.PLANT_PARTS:
+        assert getattr(law, name) is getattr(plant, name), name
+    assert {"rk4", "plant_rhs"} <= set(loops[0])           # the first law's loop compiles the plant
+    assert "loop" in loops[1] and not set(loops[1]) & set(driver_template.PLANT_PARTS)
+
+
 UNPICKLE = textwrap.dedent("""
     import json, pickle, sys
     from steerlab.jit.kernel_refs import kernel_ref

@@ -22,6 +22,9 @@ What is in a driver (one definition of each loop, for every engine):
   disturbance rows, advanced by a few RK4 steps in groups of ``LANES``, structure of arrays,
   vectorised like ``group`` (the Gymnasium vector environment, :mod:`steerlab.gym.plant_batch`).
 
+A driver with a law or a guidance takes the plant and the group's lane helpers
+(:data:`PLANT_PARTS`) from the ship's plant-only driver rather than compiling its own copies.
+
 Per run, these loops perform the same operations in the same order, so a batch run is
 bit-identical to the same run alone, and a plant of ``step_lanes`` to the same plant stepped
 by ``rk4_step``; the readable engine calls the same ``rk4_step``.
@@ -134,6 +137,31 @@ def replay_rudder(x, delta, ps, pg, dt, w, psi_out, r_out, work):
                 psi_out[j] = np.nan
                 r_out[j] = np.nan
             return
+
+
+# ---------------------------------------------------------------- one plant per ship: shared
+
+PLANT_PARTS = ("plant_rhs", "rk4", "load_row", "store_row", "load", "store", "stage_flat",
+               "update_flat", "rk4_lanes", "record_lanes")
+"""The functions above and below that depend on the ship, ``NX`` and ``LANES`` only (not on
+the law or the guidance). A driver with a law or a guidance calls those of the ship's
+plant-only driver (the same template with neither, same ``NX`` and ``LANES``) instead of its
+own copies: numba types and lowers them once per process and ship for every law's loop,
+not once per loop (for a law after the first on a ship, the batch group's compile takes about
+half the CPU, the single run's about three quarters; the first law's about the same as
+before: benchmarks/bench_compile.py, benchmarks/RESULTS.md). Numba links their code into
+the caller's and LLVM inlines it as before (they are ``forceinline``): the same machine
+operations, the same numbers. The caller's text names the same ship kernel, ``NX``,
+``LANES`` and source digests, so the plant driver it calls is fixed by its own text (its
+disk cache cannot pair with another plant)."""
+
+
+def _share_the_plant() -> None:
+    from steerlab.jit.drivers import driver
+
+    plant = driver(SHIP_RHS, None, None, NX, LANES)
+    for name in PLANT_PARTS:
+        globals()[name] = getattr(plant, name)
 
 
 # ---------------------------------------------------------------- the single run
@@ -459,3 +487,7 @@ def step_lanes(X, K, CMD, W, w_index, PS, PG, idx, dt, n_sub, step_rows):
         store_plants(X, idx, i0, n_act, XL)
         for g in range(n_act):
             K[idx[i0 + g]] += n_sub
+
+
+if SHIP_RHS is not None and (CTRL_UPDATE is not None or GUIDE is not None):
+    _share_the_plant()      # after every definition: the loops' globals resolve when they compile
