@@ -156,6 +156,7 @@ def test_cache_clear_stale_drops_the_drivers_of_edited_code_and_keeps_the_rest(t
     import usership
 
     user = drivers.driver(usership.rhs, pid_update, None, 7)          # written, not compiled
+    plant = drivers.driver(usership.rhs, None, None, 7)               # the ship's plant, which it calls
     own = drivers.driver(nomoto1_rhs, pid_update, None, 7)
     here = drivers.drivers_dir()
     away = here / "d_0123456789abcdef0123.py"                         # another project's driver
@@ -168,9 +169,11 @@ def test_cache_clear_stale_drops_the_drivers_of_edited_code_and_keeps_the_rest(t
     assert drivers.cache_info()["outdated_drivers"] == 0
     (project / "helpers.py").write_text(HELPERS.format(gain="2.0"))
     info = drivers.cache_info()                                       # what `steerlab cache info` says
-    assert info["outdated_drivers"] == 1 and info["outdated_bytes"] > user_file.stat().st_size
+    plant_file = Path(plant.__file__)
+    assert info["outdated_drivers"] == 2
+    assert info["outdated_bytes"] > user_file.stat().st_size + plant_file.stat().st_size
     assert drivers.cache_clear(stale_only=True) == info["outdated_bytes"]
-    assert not user_file.exists() and not machine_code.exists()
+    assert not user_file.exists() and not plant_file.exists() and not machine_code.exists()
     assert Path(own.__file__).exists() and away.exists()
 
 
