@@ -178,7 +178,7 @@ sets of real-time processes at once, while the other worker runs the rest."""
 
 
 
-@pytest.hookimpl(hookwrapper=True)
+@pytest.hookimpl(hookwrapper=True, optionalhook=True)     # optional: a run without pytest-xdist
 def pytest_xdist_auto_num_workers(config):
     """``-n auto``: one pytest-xdist worker per core (pytest-xdist's count, which honours
     ``PYTEST_XDIST_AUTO_NUM_WORKERS``) and one more when the real-time tests may run: their
