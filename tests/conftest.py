@@ -177,17 +177,36 @@ bridge, the Signal K server): they wait on the wall clock. They are marked ``rea
 sets of real-time processes at once, while the other worker runs the rest."""
 
 
-
 @pytest.hookimpl(hookwrapper=True, optionalhook=True)     # optional: a run without pytest-xdist
 def pytest_xdist_auto_num_workers(config):
     """``-n auto``: one pytest-xdist worker per core (pytest-xdist's count, which honours
-    ``PYTEST_XDIST_AUTO_NUM_WORKERS``) and one more when the real-time tests may run: their
-    worker mostly waits on the wall clock (on two cores it used about 105 s of CPU in 234 s),
-    and the extra worker compiles and runs other tests on the core it leaves idle."""
+    ``PYTEST_XDIST_AUTO_NUM_WORKERS``) and one more when the real-time tests may run
+    (:func:`may_select_realtime`): their worker mostly waits on the wall clock (on two cores it
+    used about 105 s of CPU in 234 s), and the extra worker compiles and runs other tests on
+    the core it leaves idle."""
     outcome = yield
     count = outcome.get_result()
-    if not os.environ.get("PYTEST_XDIST_AUTO_NUM_WORKERS") and "realtime" not in (config.getoption("markexpr", "") or ""):
+    if not os.environ.get("PYTEST_XDIST_AUTO_NUM_WORKERS") and may_select_realtime(config.getoption("markexpr", "")):
         outcome.force_result(count + 1)
+
+
+def may_select_realtime(markexpr: str) -> bool:
+    """Whether the ``-m`` expression ``markexpr`` selects a test that carries the mark
+    ``realtime`` and no other of the suite's marks (a real-time test): ``""``, ``"not slow"``
+    yes; ``"not realtime"``, ``"conformance"`` no. An expression this cannot read counts as yes."""
+    import re
+
+    if not (markexpr or "").strip():
+        return True
+    words = re.sub(r"\b(?!(?:and|or|not)\b)[A-Za-z_][\w.]*\b",
+                   lambda m: "True" if m.group(0) == "realtime" else "False", markexpr)
+    if re.search(r"[^\w\s()]", words):
+        return True
+    try:
+        return bool(eval(words, {"__builtins__": {}}, {}))      # only True/False, and/or/not, ()
+    except SyntaxError:
+        return True
+
 
 def is_realtime(nodeid: str) -> bool:
     """True for a test of one of :data:`REALTIME_MODULES` (``nodeid`` relative to the repository)."""

@@ -1,6 +1,6 @@
 """How the README's ``pytest`` spreads the suite (``-n auto --dist loadgroup``, pyproject.toml):
-one pytest-xdist worker per core and one more while the real-time tests, which mostly wait on
-the wall clock on their own worker, may run (tests/conftest.py,
+one pytest-xdist worker per core and one more when the ``-m`` expression may select the
+real-time tests, which mostly wait on the wall clock on their own worker (tests/conftest.py,
 ``pytest_xdist_auto_num_workers``); the user's ``PYTEST_XDIST_AUTO_NUM_WORKERS`` wins."""
 
 from __future__ import annotations
@@ -38,6 +38,9 @@ def test_auto_gives_the_real_time_tests_a_worker_of_their_own_beside_one_per_cor
         return pytestconfig.hook.pytest_xdist_auto_num_workers(config=pytestconfig)
 
     assert auto("") == cores + 1
+    assert auto("not slow") == cores + 1
     assert auto("not realtime") == cores
+    assert auto("conformance") == cores                 # .ci/run's second step: no real-time test
+    assert auto("not (slow or realtime)") == cores
     monkeypatch.setenv("PYTEST_XDIST_AUTO_NUM_WORKERS", "5")
     assert auto("") == 5
