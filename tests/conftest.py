@@ -174,7 +174,8 @@ REALTIME_MODULES = ("tests/test_runtime_*.py", "tests/test_signalk_plugin.py")
 bridge, the Signal K server): they wait on the wall clock. They are marked ``realtime``
 (``-m "not realtime"`` leaves them out) and ``xdist_group("realtime")``: under pytest-xdist's
 ``--dist loadgroup`` (``pyproject.toml``) they run one after another on one worker, never two
-sets of real-time processes at once, while the other worker runs the rest."""
+sets of real-time processes at once, while the other workers (one per core:
+:func:`pytest_xdist_auto_num_workers`) run the rest."""
 
 
 @pytest.hookimpl(hookwrapper=True, optionalhook=True)     # optional: a run without pytest-xdist
