@@ -162,7 +162,6 @@ def test_kernels_that_cannot_be_named_run_from_an_in_memory_driver(tmp_path, mon
     np.testing.assert_array_equal(a.states, b.states)
 
 
-
 def test_every_laws_loop_on_a_ship_calls_the_ships_one_plant_and_compiles_it_once():
     """A law's driver takes the plant and the batch group's lane helpers from the ship's
     plant-only driver (the same objects), so the loop of a second law on the ship compiles none
