@@ -1,9 +1,9 @@
 """What a driver's compile costs, as steerlab ships it against one of two earlier ways.
 
-``--against own-plant`` (the default): every law's driver compiled its own copy of the plant
-(``plant_rhs``, ``rk4``) and of the batch group's lane helpers, where steerlab now takes them
-from the ship's plant-only driver, typed and lowered once per process and ship
-(:data:`steerlab.jit.driver_template.PLANT_PARTS`). ``--against wrappers``: the fused kernels
+``--against inlined`` (the default): every (ship, law, guidance) combination had a loop of its
+own with the law and the guidance inlined, where steerlab now compiles one loop per ship that
+calls the law and the guidance by address (:mod:`steerlab.jit.loop_calls`), and each law's
+and guidance's entry once for every ship. ``--against wrappers``: the fused kernels
 (:func:`steerlab.sim.kernels._fuse_options`) with their Python and C wrappers, which steerlab
 leaves out (``no_cpython_wrapper``, ``no_cfunc_wrapper``: they are called from compiled code
 only).
@@ -36,10 +36,9 @@ if sys.argv[1] == "wrappers":
     from steerlab.jit.dispatch import supported_options
     opts = supported_options({"forceinline": True, "_nrt": False, "error_model": "numpy"})
     K._fuse_options = lambda: opts
-if sys.argv[1] == "own-plant":
-    import steerlab.jit.drivers as D
-    _source = D._source
-    D._source = lambda *a, **k: _source(*a, **k).replace("    _share_the_plant()", "    pass")
+if sys.argv[1] == "inlined":
+    import steerlab.jit.loop_calls as L
+    L.by_address = lambda: False
 from steerlab.sim.batch import simulate_batch
 from steerlab.sim.engine import simulate
 from steerlab.sim.scenario import scenario_from_dict
@@ -56,6 +55,8 @@ for ship, law in (("nomoto1", "pid"), ("esso", "adrc"), ("mss-mariner", "lq_pd+w
 for law in ("pid", "adrc"):
     s = setup("nomoto1", law)
     t = time.process_time(); simulate_batch([s, s, s]); out[f"group nomoto1 + {law}"] = time.process_time() - t
+s = setup("esso", "pid")
+t = time.process_time(); simulate(s); out["run esso + pid (law and ship seen before)"] = time.process_time() - t
 print(json.dumps(out))
 """
 
@@ -71,7 +72,7 @@ def one(variant: str) -> dict:
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--rounds", type=int, default=3)
-    ap.add_argument("--against", choices=("own-plant", "wrappers"), default="own-plant")
+    ap.add_argument("--against", choices=("inlined", "wrappers"), default="inlined")
     args = ap.parse_args()
     runs: dict[str, list[dict]] = {args.against: [], "shipped": []}
     for k in range(args.rounds):

@@ -155,8 +155,8 @@ def test_cache_clear_stale_drops_the_drivers_of_edited_code_and_keeps_the_rest(t
     monkeypatch.syspath_prepend(str(project))
     import usership
 
-    user = drivers.driver(usership.rhs, pid_update, None, 7)          # written, not compiled
-    plant = drivers.driver(usership.rhs, None, None, 7)               # the ship's plant, which it calls
+    user = drivers.driver(usership.rhs, pid_update, None, 7)          # written, not compiled: the
+    plant = drivers.driver(usership.rhs, None, None, 7)               # law inlined, and the ship's loops
     own = drivers.driver(nomoto1_rhs, pid_update, None, 7)
     here = drivers.drivers_dir()
     away = here / "d_0123456789abcdef0123.py"                         # another project's driver

@@ -40,7 +40,8 @@ LAYERS = [
 ``steerlab`` (``"steerlab"`` itself: the package's ``__init__``). A module may import its own
 layer and the layers below it, never a layer above; docs/architecture.md describes them."""
 
-TEMPLATES = {"steerlab.jit.driver_template": "engine", "steerlab.jit.env_template": "front"}
+TEMPLATES = {"steerlab.jit.driver_template": "engine", "steerlab.jit.loop_call_template": "engine",
+             "steerlab.jit.env_template": "front"}
 """Source files of generated modules, never imported by the library: :mod:`steerlab.jit.drivers`
 reads them as text and writes one module per combination, which imports the kernels it binds.
 They sit at the layer of what they bind (the engine's kernels; the gym's plant batch)."""

@@ -12,6 +12,7 @@ from steerlab.guidance.reference_models import course_guide
 from steerlab.jit import vector_reports
 from steerlab.sim.batch import simulate_batch
 from steerlab.jit.drivers import cached_signatures, driver, in_memory_twin
+from steerlab.jit.loop_calls import bound
 from steerlab.sim.lanes import vectorisation_report
 from steerlab.sim.setup import build
 from steerlab.warm import warm_scenario
@@ -25,7 +26,7 @@ def nomoto1_pid():
     of the same group compiled in memory (the IR itself)."""
     s = build(warm_scenario("nomoto1", "pid"))
     simulate_batch([s, s])
-    key = (s.ship.rhs, s.controller.update, course_guide, s.x0.size)
+    key = (*bound(s.ship.rhs, s.controller.update, course_guide), s.x0.size)
     disp = driver(*key).group
     sigs = list(disp.signatures) or cached_signatures(disp)
     twin = in_memory_twin(*key).group
@@ -54,6 +55,7 @@ def test_an_unreadable_kept_report_falls_back_to_the_ir(nomoto1_pid, monkeypatch
 def test_only_cached_drivers_vectorised_entries_are_kept(nomoto1_pid):
     s, disp, sigs, _ = nomoto1_pid
     assert vector_reports._path(disp).name.endswith(".group.vec.json")
-    assert vector_reports._path(driver(s.ship.rhs, s.controller.update, course_guide, s.x0.size).run) is None
-    twin = in_memory_twin(s.ship.rhs, s.controller.update, course_guide, s.x0.size).group
+    key = (*bound(s.ship.rhs, s.controller.update, course_guide), s.x0.size)
+    assert vector_reports._path(driver(*key).run) is None
+    twin = in_memory_twin(*key).group
     assert vector_reports._path(twin) is None

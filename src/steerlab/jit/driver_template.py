@@ -22,8 +22,11 @@ What is in a driver (one definition of each loop, for every engine):
   disturbance rows, advanced by a few RK4 steps in groups of ``LANES``, structure of arrays,
   vectorised like ``group`` (the Gymnasium vector environment, :mod:`steerlab.gym.plant_batch`).
 
-A driver with a law or a guidance takes the plant and the group's lane helpers
-(:data:`PLANT_PARTS`) from the ship's plant-only driver rather than compiling its own copies.
+``run`` and ``group`` call the guidance and the law at each sample through one address (their
+last argument, :mod:`steerlab.jit.loop_calls`): the ship's one driver (no law, no guidance
+bound) serves every law. Where the loops cannot call by address (a numba outside the tested
+versions, ``NUMBA_DISABLE_JIT=1``) a driver is generated per combination with the law and the
+guidance bound below and inlined, and the argument is ignored.
 
 Per run, these loops perform the same operations in the same order, so a batch run is
 bit-identical to the same run alone, and a plant of ``step_lanes`` to the same plant stepped
@@ -44,6 +47,7 @@ import numpy as np
 from steerlab.angles import wrap_to_pi
 from steerlab.environment.channels import N_CHANNELS
 from steerlab.guidance.reference_vector import N_REF, REF_LEG, REF_PSI, REF_RPM, REF_XTE
+from steerlab.jit.loop_calls import call_sample, data_address, row_address
 from steerlab.metrics_online import accumulate
 from steerlab.sim.kernels import _fused, _jit_fused, rk4_stage, rk4_update
 from steerlab.steering_gear import gear_clamp, gear_rate
@@ -68,8 +72,6 @@ from compiled code only."""
 ship = _fused(SHIP_RHS)
 rate = _fused(gear_rate)
 clamp = _fused(gear_clamp)
-update = _fused(CTRL_UPDATE)
-reference = _fused(GUIDE)
 acc_step = _fused(accumulate)
 wrap = _fused(wrap_to_pi)
 NR = N_REF
@@ -139,36 +141,44 @@ def replay_rudder(x, delta, ps, pg, dt, w, psi_out, r_out, work):
             return
 
 
-# ---------------------------------------------------------------- one plant per ship: shared
+# ---------------------------------------------------------------- a sample: guidance, then law
 
-PLANT_PARTS = ("plant_rhs", "rk4", "load_row", "store_row", "load", "store", "stage_flat",
-               "update_flat", "rk4_lanes", "record_lanes")
-"""The functions above and below that depend on the ship, ``NX`` and ``LANES`` only (not on
-the law or the guidance). A driver with a law or a guidance calls those of the ship's
-plant-only driver (the same template with neither, same ``NX`` and ``LANES``) instead of its
-own copies: numba types and lowers them once per process and ship for every law's loop,
-not once per loop (for a law after the first on a ship, the batch group's compile takes about
-half the CPU, the single run's about three quarters; the first law's about the same as
-before: benchmarks/bench_compile.py, benchmarks/RESULTS.md). Numba links their code into
-the caller's and LLVM inlines it as before (they are ``forceinline``): the same machine
-operations, the same numbers. The caller's text names the same ship kernel, ``NX``,
-``LANES`` and source digests, so the plant driver it calls is fixed by its own text (its
-disk cache cannot pair with another plant)."""
+if CTRL_UPDATE is None:     # by address: arrays as (address of the first element, length)
+    @_jit_fused
+    def sample(at, t, x, gd, gz, z, p, ref, h):
+        """At a sample the guidance writes ``ref``, then the law returns its rudder order [rad]
+        (C-contiguous 1-D arrays): the (law, guidance) pair's sample entry at address ``at``."""
+        return call_sample(at, (t, data_address(x), x.shape[0], data_address(gd), gd.shape[0],
+                                data_address(gz), gz.shape[0], data_address(z), z.shape[0],
+                                data_address(p), p.shape[0], data_address(ref), ref.shape[0], h))
 
+    @_jit_fused
+    def sample_row(at, t, x, GD, GZ, Z, P, i, R, g, h):
+        """:func:`sample` of rows ``GD[i], GZ[i], Z[i], P[i], R[g]`` (C-contiguous 2-D arrays; no
+        view is made)."""
+        return call_sample(at, (t, data_address(x), x.shape[0], row_address(GD, i), GD.shape[1],
+                                row_address(GZ, i), GZ.shape[1], row_address(Z, i), Z.shape[1],
+                                row_address(P, i), P.shape[1], row_address(R, g), R.shape[1], h))
+else:                       # bound: the guidance and the law inlined (``at`` ignored)
+    _update = _fused(CTRL_UPDATE)
+    _reference = _fused(GUIDE)
 
-def _share_the_plant() -> None:
-    from steerlab.jit.drivers import driver
+    @_jit_fused
+    def sample(at, t, x, gd, gz, z, p, ref, h):
+        _reference(t, x, gd, gz, ref, h)
+        return _update(z, p, t, x, ref, h)
 
-    plant = driver(SHIP_RHS, None, None, NX, LANES)
-    for name in PLANT_PARTS:
-        globals()[name] = getattr(plant, name)
+    @_jit_fused
+    def sample_row(at, t, x, GD, GZ, Z, P, i, R, g, h):
+        _reference(t, x, GD[i], GZ[i], R[g], h)
+        return _update(Z[i], P[i], t, x, R[g], h)
 
 
 # ---------------------------------------------------------------- the single run
 
 @_jit_fused
 def loop(x, z, ps, pg, pc, gd, gz, w, dt, nc, n_steps, rec_every, out_x, out_cmd, out_ref,
-         acc, rpm_slot, k1, k2, k3, k4, xt, ref):
+         acc, rpm_slot, sample_at, k1, k2, k3, k4, xt, ref):
     nx = x.shape[0] if NX == 0 else NX
     nr = min(out_ref.shape[1], NR)
     cmd = 0.0
@@ -178,14 +188,12 @@ def loop(x, z, ps, pg, pc, gd, gz, w, dt, nc, n_steps, rec_every, out_x, out_cmd
     kr = 0
     for k in range(n_steps + 1):
         t = k * dt
-        sample = kc == 0
-        if sample:
-            reference(t, x, gd, gz, ref, h)
-            if rpm_slot >= 0 and ref[RPM] >= 0.0:
+        sampled = kc == 0
+        if sampled:
+            cmd = sample(sample_at, t, x, gd, gz, z, pc, ref, h)
+            if rpm_slot >= 0 and ref[RPM] >= 0.0:      # the guidance's propeller order
                 ps[rpm_slot] = ref[RPM]
         e = wrap(ref[REF_PSI] - x[IPSI])
-        if sample:
-            cmd = update(z, pc, t, x, ref, h)
         kc += 1
         if kc == nc:
             kc = 0
@@ -208,8 +216,9 @@ def loop(x, z, ps, pg, pc, gd, gz, w, dt, nc, n_steps, rec_every, out_x, out_cmd
 
 @numba.njit(cache=CACHE)
 def run(x, z, ps, pg, pc, gd, gz, w, dt, nc, n_steps, rec_every, out_x, out_cmd, out_ref, acc,
-        rpm_slot):
-    """The single run's closed loop (arguments: :func:`steerlab.sim.kernels.guided_closed_loop`)."""
+        rpm_slot, sample_at):
+    """The single run's closed loop (arguments: :func:`steerlab.sim.kernels.guided_closed_loop`;
+    ``sample_at``: :func:`steerlab.jit.loop_calls.loop_driver`)."""
     nx = x.shape[0]
     if NX != 0 and nx != NX:
         raise ValueError("plant state size differs from the one this loop was built for")
@@ -223,7 +232,7 @@ def run(x, z, ps, pg, pc, gd, gz, w, dt, nc, n_steps, rec_every, out_x, out_cmd,
     ref[REF_XTE] = np.nan
     ref[REF_LEG] = -1.0
     loop(x, z, ps, pg, pc, gd, gz, w, dt, nc, n_steps, rec_every, out_x, out_cmd, out_ref, acc,
-         rpm_slot, k1, k2, k3, k4, xt, ref)
+         rpm_slot, sample_at, k1, k2, k3, k4, xt, ref)
 
 
 # ---------------------------------------------------------------- the batch: groups of LANES runs
@@ -344,14 +353,16 @@ def scratch(n_ps, n_pg, n_w):
 
 @numba.njit(nogil=True, cache=CACHE)
 def group(X, Z, PS, PG, PC, GD, GZ, W, w_index, i0, n_act, dt, nc, n_steps, rec_every,
-          out_x, out_cmd, out_ref, ACC, rpm_slot):
+          out_x, out_cmd, out_ref, ACC, rpm_slot, sample_at):
     """Advance runs ``i0 .. i0 + n_act - 1`` of the batch arrays in place
-    (arguments: :func:`steerlab.sim.lanes.lane_loop`)."""
+    (arguments: :func:`steerlab.sim.lanes.lane_loop`; ``sample_at``:
+    :func:`steerlab.jit.loop_calls.loop_driver`)."""
     if W.shape[2] != N_CHANNELS:
         raise ValueError("disturbance rows must have N_CHANNELS channels")
     XL, PL, PGL, WL, K1, K2, K3, K4, XT, CMD, E, DPREV = scratch(PS.shape[1], PG.shape[1], W.shape[2])
     flat = flat_views(XL, K1, K2, K3, K4, XT)
     REF = np.zeros((G, NR))
+    XC = np.empty(NX)
     for g in range(G):
         REF[g, REF_RPM] = -1.0
         REF[g, REF_XTE] = np.nan
@@ -368,17 +379,17 @@ def group(X, Z, PS, PG, PC, GD, GZ, W, w_index, i0, n_act, dt, nc, n_steps, rec_
         CMD[g] = 0.0
     for k in range(n_steps + 1):
         t = k * dt
-        sample = kc == 0
+        sampled = kc == 0
         for g in range(n_act):
             i = i0 + g
-            if sample:
-                reference(t, XL[:, g], GD[i], GZ[i], REF[g], h)
-                if rpm_slot >= 0 and REF[g, RPM] >= 0.0:
+            if sampled:
+                for q in range(NX):         # run g's state, contiguous, for the guidance and the law
+                    XC[q] = XL[q, g]
+                CMD[g] = sample_row(sample_at, t, XC, GD, GZ, Z, PC, i, REF, g, h)
+                if rpm_slot >= 0 and REF[g, RPM] >= 0.0:      # the guidance's propeller order
                     PS[i, rpm_slot] = REF[g, RPM]
                     PL[rpm_slot, g] = REF[g, RPM]
             E[g] = wrap(REF[g, REF_PSI] - XL[IPSI, g])
-            if sample:
-                CMD[g] = update(Z[i], PC[i], t, XL[:, g], REF[g], h)
         kc += 1
         if kc == nc:
             kc = 0
@@ -488,6 +499,3 @@ def step_lanes(X, K, CMD, W, w_index, PS, PG, idx, dt, n_sub, step_rows):
         for g in range(n_act):
             K[idx[i0 + g]] += n_sub
 
-
-if SHIP_RHS is not None and (CTRL_UPDATE is not None or GUIDE is not None):
-    _share_the_plant()      # after every definition: the loops' globals resolve when they compile

@@ -24,7 +24,7 @@ from __future__ import annotations
 from typing import Any
 
 from numba import types
-from numba.core import cgutils
+from numba.core import cgutils, errors
 from numba.extending import intrinsic
 
 
@@ -60,3 +60,96 @@ def address_of(dispatcher: Any, argtypes: tuple) -> int:
     if types.unliteral(cres.signature.return_type) != types.int64:
         raise TypeError(f"{dispatcher.py_func.__name__} returns {cres.signature.return_type}, call_at reads int64")
     return int(cres.library.get_pointer_to_function(cres.fndesc.llvm_func_name))
+
+
+def typed_call(restype, argtypes: tuple):
+    """A :func:`call_at` for callees of one fixed signature ``restype(*argtypes)``:
+    ``call(address, args)`` returns the callee's ``restype`` value (``none`` for a function
+    without one). Each argument at the call site is cast to its declared type (e.g. a C-ordered
+    array to a layout-``'A'`` one), so a caller whose arrays differ in layout still calls the
+    one compiled callee; an argument that cannot be cast is a typing error of the caller (not
+    undefined behaviour). ``address`` must come from :func:`typed_address` with the same
+    ``argtypes``."""
+    declared = tuple(argtypes)
+
+    @intrinsic
+    def call(typingctx, address, args):
+        if not isinstance(address, types.Integer) or not isinstance(args, types.BaseTuple):
+            return None
+        site = tuple(args.types)
+        if len(site) != len(declared) or any(typingctx.can_convert(a, b) is None
+                                             for a, b in zip(site, declared)):
+            raise errors.TypingError(f"call by address: arguments {site} cannot be cast to {declared}")
+
+        def codegen(context, builder, signature, llargs):
+            addr, tup = llargs
+            fnty = context.call_conv.get_function_type(restype, declared)
+            callee = builder.inttoptr(addr, fnty.as_pointer())
+            values = [context.cast(builder, v, a, b)
+                      for v, a, b in zip(cgutils.unpack_tuple(builder, tup, len(site)), site, declared)]
+            status, result = context.call_conv.call_function(builder, callee, restype, declared, values)
+            with cgutils.if_unlikely(builder, status.is_error):
+                context.call_conv.return_status_propagate(builder, status)
+            return result if restype != types.none else context.get_dummy_value()
+
+        return restype(address, args), codegen
+
+    return call
+
+
+def typed_address(dispatcher: Any, restype, argtypes: tuple) -> int:
+    """The machine-code address of ``dispatcher``'s overload for ``argtypes`` (compiled, or
+    loaded from numba's cache, first if needed), for a :func:`typed_call` of that signature;
+    ``TypeError`` if it returns another type. Keep the dispatcher referenced."""
+    dispatcher.compile(tuple(argtypes))
+    cres = dispatcher.overloads[tuple(argtypes)]
+    if types.unliteral(cres.signature.return_type) != restype:
+        raise TypeError(f"{dispatcher.py_func.__name__} returns {cres.signature.return_type}, "
+                        f"its callers read {restype}")
+    return int(cres.library.get_pointer_to_function(cres.fndesc.llvm_func_name))
+
+
+@intrinsic
+def data_address(typingctx, arr):
+    """The address (int64) of the first element of a C-contiguous array; a typing error for any
+    other layout (whose elements are not one block from there)."""
+    if not isinstance(arr, types.Array) or arr.layout != "C":
+        if isinstance(arr, types.Array):
+            raise errors.TypingError(f"data_address: the array must be C-contiguous, not {arr}")
+        return None
+
+    def codegen(context, builder, signature, llargs):
+        ary = context.make_array(arr)(context, builder, llargs[0])
+        return builder.ptrtoint(ary.data, context.get_value_type(types.int64))
+
+    return types.int64(arr), codegen
+
+
+@intrinsic
+def row_address(typingctx, arr, i):
+    """The address (int64) of row ``i`` of a C-contiguous 2-D array (no view is made)."""
+    if not isinstance(arr, types.Array) or arr.ndim != 2 or not isinstance(i, types.Integer):
+        return None
+    if arr.layout != "C":
+        raise errors.TypingError(f"row_address: the array must be C-contiguous, not {arr}")
+
+    def codegen(context, builder, signature, llargs):
+        ary = context.make_array(arr)(context, builder, llargs[0])
+        i64 = context.get_value_type(types.int64)
+        row = context.cast(builder, llargs[1], i, types.int64)
+        stride = cgutils.unpack_tuple(builder, ary.strides, 2)[0]
+        return builder.add(builder.ptrtoint(ary.data, i64), builder.mul(row, stride))
+
+    return types.int64(arr, i), codegen
+
+
+@intrinsic
+def float64_pointer(typingctx, address):
+    """``address`` (int64) as a pointer to float64, for ``numba.carray(pointer, n)``."""
+    if not isinstance(address, types.Integer):
+        return None
+
+    def codegen(context, builder, signature, llargs):
+        return builder.inttoptr(llargs[0], context.get_value_type(types.CPointer(types.float64)))
+
+    return types.CPointer(types.float64)(address), codegen

@@ -145,29 +145,36 @@ def guided_closed_loop(ship_rhs, ctrl_update, guide, nx: int | None = None):
 
     ``nx`` (the plant state size, ship states + rudder), when given, specialises the loop on
     it (faster); ``run`` then raises ``ValueError`` for a state of another size.
-    """
-    from steerlab.jit.drivers import driver
 
-    d = driver(ship_rhs, ctrl_update, guide, 0 if nx is None else int(nx))
-    return _Announced(d, "run")
+    The loop is the ship's (compiled once per ship and plant size); it calls the guidance and
+    the controller through one address (:mod:`steerlab.jit.loop_calls`), which this callable
+    appends to the arguments.
+    """
+    from steerlab.jit.loop_calls import loop_driver
+
+    d, address = loop_driver(ship_rhs, ctrl_update, guide, 0 if nx is None else int(nx))
+    return _Announced(d, "run", address)
 
 
 class _Announced:
     """A driver's entry point that says (through :data:`steerlab.jit.drivers.on_compile`)
-    when its first call compiles, then calls the compiled kernel directly."""
+    when its first call compiles, then calls the compiled kernel directly, with the address
+    of the law's and the guidance's sample (``address()``, taken at the first call) appended
+    to the arguments."""
 
-    __slots__ = ("_mod", "_name", "_fn")
+    __slots__ = ("_mod", "_name", "_fn", "_address", "_at")
 
-    def __init__(self, mod, name):
-        self._mod, self._name, self._fn = mod, name, None
+    def __init__(self, mod, name, address):
+        self._mod, self._name, self._fn, self._address, self._at = mod, name, None, address, 0
 
     def __call__(self, *args):
         fn = self._fn
         if fn is None:
             from steerlab.jit.drivers import entry
 
+            self._at = self._address()
             fn = self._fn = entry(self._mod, self._name)
-        return fn(*args)
+        return fn(*args, self._at)
 
     @property
     def dispatcher(self):

@@ -61,8 +61,9 @@ def lane_loop(ship_rhs, ctrl_update, guide, nx: int, lanes: int = LANES):
     Same kernels and the same operations, in the same order, per run as
     :func:`~steerlab.sim.kernels.guided_closed_loop` (so each run's numbers are bit-identical
     to its single run); only the schedule and the memory layout differ (module docstring).
-    It is the ``group`` entry point of the combination's driver
-    (:mod:`steerlab.jit.driver_template`, cached on disk by :mod:`steerlab.jit.drivers`).
+    It is the ``group`` entry point of the ship's driver (:mod:`steerlab.jit.driver_template`,
+    cached on disk by :mod:`steerlab.jit.drivers`), with the address of the law's and the
+    guidance's sample (:mod:`steerlab.jit.loop_calls`) appended to the arguments.
 
     ``group(X, Z, PS, PG, PC, GD, GZ, W, w_index, i0, n_act, dt, nc, n_steps, rec_every,
     out_x, out_cmd, out_ref, ACC, rpm_slot)`` advances runs ``i0 .. i0 + n_act - 1`` of the
@@ -71,9 +72,16 @@ def lane_loop(ship_rhs, ctrl_update, guide, nx: int, lanes: int = LANES):
     as a function of its own, called once per group: its scratch arrays are allocated inside
     it, with shapes the compiler sees (which the vectoriser needs).
     """
-    from steerlab.jit.drivers import driver
+    from steerlab.jit.loop_calls import loop_driver
 
-    return driver(ship_rhs, ctrl_update, guide, int(nx), int(lanes)).group
+    mod, address = loop_driver(ship_rhs, ctrl_update, guide, int(nx), int(lanes))
+    at = address()
+    group = mod.group
+
+    def call(*args):
+        return group(*args, at)
+
+    return call
 
 
 PROGRESS_PERIOD = 0.5
@@ -162,9 +170,11 @@ def batch_loop(ship_rhs, ctrl_update, nx: int, lanes: int = LANES, guide=None):
     runs in the same sea store it once); ``PS`` (at ``rpm_slot``, when >= 0) and ``GZ`` are
     modified in place; ``progress(done, n)``: see :func:`_run_groups`.
     """
-    from steerlab.jit.drivers import driver, entry
+    from steerlab.jit.drivers import entry
+    from steerlab.jit.loop_calls import loop_driver
 
-    mod = driver(ship_rhs, ctrl_update, course_guide if guide is None else guide, int(nx), int(lanes))
+    mod, address = loop_driver(ship_rhs, ctrl_update, course_guide if guide is None else guide,
+                               int(nx), int(lanes))
     G = int(lanes)
     NX = int(nx)
 
@@ -172,9 +182,10 @@ def batch_loop(ship_rhs, ctrl_update, nx: int, lanes: int = LANES, guide=None):
                   out_x, out_cmd, out_ref, ACC, rpm_slot, progress=None):
         if X.shape[1] != NX:
             raise ValueError("plant state size differs from the one this loop was built for")
+        at = address()
         group = entry(mod, "group")
         _run_groups(lambda i0, n_act: group(X, Z, PS, PG, PC, GD, GZ, W, w_index, i0, n_act, dt, nc,
-                                            n_steps, rec_every, out_x, out_cmd, out_ref, ACC, rpm_slot),
+                                            n_steps, rec_every, out_x, out_cmd, out_ref, ACC, rpm_slot, at),
                     X.shape[0], G, progress)
 
     return run_batch
@@ -213,8 +224,10 @@ def plant_lanes_report(ship_rhs, nx: int, lanes: int = LANES) -> dict:
 
 def _report(ship_rhs, ctrl_update, guide, nx: int, lanes: int, name: str, not_compiled: str) -> dict:
     from steerlab.jit.drivers import cached_signatures, driver, in_memory_twin
+    from steerlab.jit.loop_calls import bound
     from steerlab.jit.vector_reports import report_from_ir, stored
 
+    ship_rhs, ctrl_update, guide = bound(ship_rhs, ctrl_update, guide)
     disp = getattr(driver(ship_rhs, ctrl_update, guide, nx, lanes), name)
     sigs = list(disp.signatures) or cached_signatures(disp)
     if not sigs:

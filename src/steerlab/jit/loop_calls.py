@@ -1,0 +1,106 @@
+r"""The closed loops call the law and the guidance through their addresses: one loop per ship.
+
+A single run's loop and a batch group's loop (:mod:`steerlab.jit.driver_template`) spend
+their compile on the ship's plant (its right-hand side, inlined four times into the RK4
+step, vectorised across the group); the law's ``update`` and the guidance's ``reference`` are
+called once per run and sample, outside the RK4 stages. So the loops are compiled once per
+ship, plant size and group size, and call the law and the guidance through the machine-code
+addresses of their entry points (:mod:`steerlab.jit.loop_call_template`: one small module per
+kernel, compiled once for every ship): a second law on a ship compiles no loop, a law
+already used with another ship compiles nothing. Both are kept in numba's disk cache as
+before; the loop's machine code no longer depends on the law, so a process loads the
+ship's loop once for every law it runs.
+
+The numbers are the same as with the law inlined into the loop: the same fused kernels
+(:func:`steerlab.sim.kernels._fused`), the same operations in the same order, no fast-math
+(so no reassociation across the call): tests/test_loop_calls.py compares both ways.
+
+The call is numba's own calling convention at an address (:mod:`steerlab.jit.numba_call_at`),
+a numba internal: on a numba outside the tested versions (:mod:`steerlab.jit.numba_gate`), or
+with ``NUMBA_DISABLE_JIT=1``, each (ship, law, guidance) combination gets its own loop with the
+law and the guidance inlined, as before (slower to compile, the same numbers).
+"""
+
+from __future__ import annotations
+
+import threading
+from typing import Any
+
+TEMPLATE_NAME = "loop_call_template.py"
+
+try:
+    from numba import types as _t
+
+    from steerlab.jit.numba_call_at import data_address, row_address, typed_address, typed_call
+
+    _P, _N = _t.int64, _t.int64
+    SAMPLE_ARGS = (_t.float64, _P, _N, _P, _N, _P, _N, _P, _N, _P, _N, _P, _N, _t.float64)
+    """The sample entry's arguments: ``t`` [s], ``x`` (plant state), ``gd``, ``gz`` (guidance
+    record and state), ``z``, ``p`` (controller state and record), ``ref`` (reference, written),
+    ``h`` (sample time [s]); each array as the address of its first element and its length
+    (C-contiguous float64: no array object crosses the call, whose reference count, shape and
+    strides would travel as seven values each)."""
+    call_sample = typed_call(_t.float64, SAMPLE_ARGS)
+except ImportError:  # pragma: no cover - a numba without these internals: loops inline the law
+    SAMPLE_ARGS = ()
+    call_sample = data_address = row_address = None
+
+
+def by_address() -> bool:
+    """Whether the loops call the law and the guidance by address in this process (module
+    docstring): on the tested numba versions, with the JIT on."""
+    import numba
+
+    from steerlab.jit import numba_gate
+
+    return call_sample is not None and not numba.config.DISABLE_JIT and numba_gate.internals_allowed()
+
+
+_LOCK = threading.RLock()
+_ADDRESSES: dict = {}
+
+
+def _address(ctrl_update: Any, guide: Any) -> int:
+    """The address of the (law, guidance) pair's sample entry, from its module in the driver
+    cache (compiled or loaded first; memoised per process)."""
+    key = (ctrl_update, guide)
+    at = _ADDRESSES.get(key)
+    if at is None:
+        from pathlib import Path
+
+        from numba import types as t
+
+        from steerlab.jit.drivers import driver, entry
+
+        with _LOCK:
+            at = _ADDRESSES.get(key)
+            if at is None:
+                mod = driver(None, ctrl_update, guide, template=Path(__file__).with_name(TEMPLATE_NAME))
+                at = _ADDRESSES[key] = typed_address(entry(mod, "sample_entry"), t.float64, SAMPLE_ARGS)
+    return at     # the module stays loaded (drivers memoises it): its code stays alive
+
+
+def loop_driver(ship_rhs, ctrl_update, guide, nx: int, lanes: int = 16):
+    """``(module, address)``: the driver whose ``run`` and ``group`` run the combination, and a
+    function giving the last argument those entry points take (the address of the law's and
+    the guidance's sample entry, compiled or loaded on the first call; 0 where the loop
+    inlines them)."""
+    from steerlab.jit.drivers import driver
+
+    if by_address():
+        def address() -> int:
+            return _address(ctrl_update, guide)
+
+        return driver(*bound(ship_rhs, ctrl_update, guide), nx, lanes), address
+    return driver(*bound(ship_rhs, ctrl_update, guide), nx, lanes), _no_address
+
+
+def bound(ship_rhs, ctrl_update, guide) -> tuple:
+    """The kernels bound into the driver that runs the combination: the ship alone where the
+    loops call by address, else all three."""
+    return (ship_rhs, None, None) if by_address() else (ship_rhs, ctrl_update, guide)
+
+
+def _no_address() -> int:
+    return 0
+
