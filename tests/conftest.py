@@ -93,6 +93,17 @@ def unnamed_ship(rhs):
     return closure_rhs
 
 
+def unnamed_law(update):
+    """A controller kernel that calls ``update`` from a closure: the same orders, no importable
+    name (its loops' sample entry is built in memory, new for every call of this function)."""
+    import numba
+
+    @numba.njit
+    def closure_update(z, p, t, x, ref, h):
+        return update(z, p, t, x, ref, h)
+    return closure_update
+
+
 def make_scenario_dict(**over) -> dict:
     """The base dict with top-level / nested overrides (``controller`` is replaced whole)."""
     return _merge(BASE, over)

@@ -168,7 +168,7 @@ def test_a_ships_one_loop_runs_every_law_and_a_law_compiles_once_for_every_ship(
     """The single run's loop is the ship's: a second law on the ship compiles only that law's
     entry (no loop, no plant), the first law on a second ship only that ship's loop (its entry
     is already compiled), and every run's numbers are those of the readable engine."""
-    from conftest import make_scenario, unnamed_ship
+    from conftest import make_scenario, unnamed_law, unnamed_ship
     from numba.core import event
 
     from steerlab.jit import loop_calls
@@ -178,12 +178,14 @@ def test_a_ships_one_loop_runs_every_law_and_a_law_compiles_once_for_every_ship(
     if not loop_calls.by_address():
         pytest.skip("this numba is outside the tested versions: every loop inlines its law")
     compiled = []
-    ships = {}
+    ships, laws = {}, {}
     for ship, law in (("a", "pid"), ("a", "sliding_mode"), ("b", "pid")):
         setup = build(make_scenario(duration=20.0, ship={"model": "nomoto1", "speed_kn": 10.0},
                                     controller={"type": law}))
-        rhs = ships.setdefault(ship, unnamed_ship(setup.ship.rhs))   # a new kernel: new loops, in memory
-        setup = replace(setup, ship=replace(setup.ship, rhs=rhs))
+        # new kernels, never compiled before in this process nor on disk: their code is built in memory
+        rhs = ships.setdefault(ship, unnamed_ship(setup.ship.rhs))
+        update = laws.setdefault(law, unnamed_law(setup.controller.update))
+        setup = replace(setup, ship=replace(setup.ship, rhs=rhs), controller=replace(setup.controller, update=update))
         with event.install_recorder("numba:compile") as rec:
             result = simulate(setup)
         compiled.append({e.data["dispatcher"].py_func.__name__ for _, e in rec.buffer if e.is_start})
