@@ -75,6 +75,9 @@ def assert_within_gear(res) -> None:
     assert np.max(np.abs(np.diff(delta))) / DT <= rad(GEAR["rate_max_deg_s"]) * (1 + 1e-9)
 
 
+# one worker runs every law's case: each compiles every ship's plant step (the readable engine's)
+# once, where two workers starting two laws at once on a cold cache would both compile them
+@pytest.mark.xdist_group("every-ship-readable")
 @pytest.mark.parametrize("controller", CONTROLLER_NAMES)
 def test_runs_on_every_ship_or_refuses_clearly(controller):
     ran = []

@@ -9,7 +9,14 @@ DOC = Path(__file__).resolve().parent.parent / "docs" / "components.md"
 BLOCKS = re.findall(r"```python\n(.*?)```", DOC.read_text(encoding="utf-8"), re.S)
 
 
-@pytest.mark.parametrize("i", range(len(BLOCKS)))
+ESSO_GYM = "esso-gymnasium"
+"""The ``xdist_group`` of the tests that compile the Esso's Gymnasium environments into the
+suite's cache (here, and ``steerlab cache warm --gym`` in tests/test_examples_commands.py): one
+worker compiles them, the other test loads them (on two workers at once both would compile)."""
+
+
+@pytest.mark.parametrize("i", [pytest.param(i, marks=pytest.mark.xdist_group(ESSO_GYM)) if "make_vec" in b else i
+                               for i, b in enumerate(BLOCKS)])
 def test_example_runs(i, capsys):
     src = BLOCKS[i]
     if "gymnasium" in src:

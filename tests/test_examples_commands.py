@@ -329,8 +329,16 @@ def all_examples():
     return out
 
 
+def _grouped(examples):
+    """``cache warm --gym`` in the group of the other test that compiles the Esso's Gymnasium
+    environments into the suite's cache (tests/test_docs_components.py, ``ESSO_GYM``)."""
+    from test_docs_components import ESSO_GYM
+
+    return [pytest.param(*e, marks=pytest.mark.xdist_group(ESSO_GYM)) if "--gym" in e[2] else e for e in examples]
+
+
 @pytest.mark.slow
-@pytest.mark.parametrize("label,env,argv", all_examples(),
+@pytest.mark.parametrize("label,env,argv", _grouped(all_examples()),
                          ids=lambda v: v if isinstance(v, str) else None)
 def test_example_command_runs(label, env, argv, workdir):
     ran, proc = _run(label, env, argv, workdir)
