@@ -28,10 +28,12 @@ def _clear():
 
 
 def _both(monkeypatch, fn):
-    """``fn()`` with the loops calling by address, then with the law and the guidance inlined."""
+    """``fn()`` with the loops calling by address, then with the law and the guidance inlined
+    (``STEERLAB_INLINE_LAWS=1``)."""
     _clear()
     by_address = fn()
-    monkeypatch.setattr(loop_calls, "by_address", lambda: False)
+    monkeypatch.setenv(loop_calls.INLINE_ENV, "1")
+    assert not loop_calls.by_address()
     _clear()
     try:
         inlined = fn()

@@ -35,6 +35,7 @@ from typing import Callable, Optional
 import numba
 import numpy as np
 
+from steerlab.jit import loop_calls
 from steerlab.jit.dispatch import is_dispatcher
 from steerlab.sim.batch import simulate_batch, vary_controller
 from steerlab.sim.engine import simulate_compiled, simulate_readable
@@ -250,4 +251,5 @@ def run_bench(n_batch: int = 1000, duration: float = 3000.0, repeats: int = 5,
         "python_version": platform.python_version(),
         "machine": f"{platform.machine()} {platform.processor() or ''}".strip(),
         "jit_disabled": bool(numba.config.DISABLE_JIT),
+        "laws_called_by_address": loop_calls.by_address(),
     }

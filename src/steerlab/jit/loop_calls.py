@@ -15,10 +15,19 @@ The numbers are the same as with the law inlined into the loop: the same fused k
 (:func:`steerlab.sim.kernels._fused`), the same operations in the same order, no fast-math
 (so no reassociation across the call): tests/test_loop_calls.py compares both ways.
 
+What it costs: the call, and what the compiler could do with the law's code inside the loop,
+take a few nanoseconds per sample. On cheap ships (nomoto1, the Esso: a few hundred
+nanoseconds per RK4 step) a run takes about 1.05-1.10 of the inlined loop's time, on heavy ones
+(the KVLCC2's MMG model) about the same (``benchmarks/bench_loop_calls.py``,
+benchmarks/RESULTS.md); a new combination compiles in seconds less, and a ship or a law seen
+before compiles nothing. ``STEERLAB_INLINE_LAWS=1`` gives every combination a loop of its own
+with the law and the guidance inlined (for hours of runs of one combination: the compile is
+paid once, then kept in the disk cache).
+
 The call is numba's own calling convention at an address (:mod:`steerlab.jit.numba_call_at`),
 a numba internal: on a numba outside the tested versions (:mod:`steerlab.jit.numba_gate`), or
-with ``NUMBA_DISABLE_JIT=1``, each (ship, law, guidance) combination gets its own loop with the
-law and the guidance inlined, as before (slower to compile, the same numbers).
+with ``NUMBA_DISABLE_JIT=1``, each combination gets its own loop with the law and the guidance
+inlined, as with the switch (slower to compile, the same numbers).
 """
 
 from __future__ import annotations
@@ -46,14 +55,21 @@ except ImportError:  # pragma: no cover - a numba without these internals: loops
     call_sample = data_address = row_address = None
 
 
+INLINE_ENV = "STEERLAB_INLINE_LAWS"
+"""``1``: every combination gets a loop with its law and guidance inlined (module docstring)."""
+
+
 def by_address() -> bool:
     """Whether the loops call the law and the guidance by address in this process (module
-    docstring): on the tested numba versions, with the JIT on."""
+    docstring): on the tested numba versions, with the JIT on, unless ``STEERLAB_INLINE_LAWS=1``."""
+    import os
+
     import numba
 
     from steerlab.jit import numba_gate
 
-    return call_sample is not None and not numba.config.DISABLE_JIT and numba_gate.internals_allowed()
+    return (call_sample is not None and os.environ.get(INLINE_ENV, "0") != "1"
+            and not numba.config.DISABLE_JIT and numba_gate.internals_allowed())
 
 
 _LOCK = threading.RLock()
