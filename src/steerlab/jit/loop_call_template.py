@@ -17,9 +17,9 @@ arrays of them, ``numba.carray``):
   then ``CTRL_UPDATE`` returns the rudder order [rad]: what a loop does at a sample, in one call.
 
 It calls the kernels fused as inside the loops (:func:`steerlab.sim.kernels._fused`: the same
-error model, no reference counting): the same operations as when the loop inlined it, so the
-same numbers (arrays made from an address have no reference count). They have no Python entry (``no_cpython_wrapper``): they are called from the
-loops' machine code only.
+error model, no reference counting): the same operations as when the loop inlined them, so
+the same numbers (arrays made from an address have no reference count to keep). The entry has
+no Python entry (``no_cpython_wrapper``): it is called from the loops' machine code only.
 
 This file is importable as it is (the placeholder bindings bind nothing).
 """

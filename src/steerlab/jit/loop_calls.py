@@ -1,15 +1,15 @@
-r"""The closed loops call the law and the guidance through their addresses: one loop per ship.
+r"""The closed loops call the guidance and the law through one address: one loop per ship.
 
 A single run's loop and a batch group's loop (:mod:`steerlab.jit.driver_template`) spend
 their compile on the ship's plant (its right-hand side, inlined four times into the RK4
-step, vectorised across the group); the law's ``update`` and the guidance's ``reference`` are
+step, vectorised across the group); the guidance's ``reference`` and the law's ``update`` are
 called once per run and sample, outside the RK4 stages. So the loops are compiled once per
-ship, plant size and group size, and call the law and the guidance through the machine-code
-addresses of their entry points (:mod:`steerlab.jit.loop_call_template`: one small module per
-kernel, compiled once for every ship): a second law on a ship compiles no loop, a law
-already used with another ship compiles nothing. Both are kept in numba's disk cache as
-before; the loop's machine code no longer depends on the law, so a process loads the
-ship's loop once for every law it runs.
+ship, plant size and group size, and at each sample call the machine code of the (law,
+guidance) pair's sample entry (:mod:`steerlab.jit.loop_call_template`: one small module per
+pair, compiled once for every ship) through its address: a second law on a ship compiles no
+loop, a law already used with another ship compiles nothing. Both are kept in numba's disk
+cache as before; the loop's machine code no longer depends on the law, so a process loads
+the ship's loop once for every law it runs.
 
 The numbers are the same as with the law inlined into the loop: the same fused kernels
 (:func:`steerlab.sim.kernels._fused`), the same operations in the same order, no fast-math
