@@ -19,9 +19,10 @@ The matrix uses the compiled single-run loop (``sl.simulate``), whose compile to
 CPU per combination where the batch engine's vectorised group loop took 4.3-6.7 s (four
 combinations measured); a combination has 6-18 runs of 1-8 thousand simulated seconds, too few
 for the vectorised loop to pay its compile back. The numbers are the same either way (the
-engines are bit-identical, tests/test_engine.py). Combinations are spread over ``workers``
-processes (default: 2, or the machine's cores if fewer), one combination per task, so no two
-processes compile the same loop.
+engines are bit-identical, tests/test_engine.py). The loops are the ships' (they call each
+law by address, :mod:`steerlab.jit.loop_calls`): the cases are spread over ``workers``
+processes (default: 2, or the machine's cores if fewer) one ship per task, so no two
+processes compile the same loop (only the laws' small sample entries, once in each).
 
 What is run, by default: every operating point (:mod:`~steerlab.conformance.points`) in calm
 water; the sea-state-5 leg at the points of ``sea_points`` (default: all three).
@@ -231,18 +232,25 @@ def _run_task(task: list[Case]) -> list[Outcome]:
 
 
 def _kernel_key(case: Case) -> tuple:
-    """The compiled loop a case needs: its ship's and its law's kernels (by name); calm water
-    runs the sea leg's ``"+wf"`` loop (:func:`one_loop`)."""
+    """The compiled loop a case needs: its ship's (by name), which calls every law by address
+    (:mod:`steerlab.jit.loop_calls`; a law's sample entry is compiled once for all ships);
+    where the loops inline the law, its ship's and its law's (calm water runs the sea leg's
+    ``"+wf"`` loop, :func:`one_loop`)."""
     from steerlab.control.registry import get_controller
+    from steerlab.jit.loop_calls import by_address
     from steerlab.ships.registry import get_ship
 
-    rhs, update = get_ship(case.ship).rhs, get_controller(controller_type(case.controller, SEA5)).update
-    return (getattr(rhs, "__module__", ""), getattr(rhs, "__name__", repr(rhs)),
-            getattr(update, "__module__", ""), getattr(update, "__name__", repr(update)))
+    rhs = get_ship(case.ship).rhs
+    key = (getattr(rhs, "__module__", ""), getattr(rhs, "__name__", repr(rhs)))
+    if by_address():
+        return key
+    update = get_controller(controller_type(case.controller, SEA5)).update
+    return key + (getattr(update, "__module__", ""), getattr(update, "__name__", repr(update)))
 
 
 def tasks(all_cases: list[Case]) -> list[list[Case]]:
-    """The cases grouped by compiled loop (one task per combination), biggest first."""
+    """The cases grouped by compiled loop (one task per ship, or per combination where the
+    loops inline the law: :func:`_kernel_key`), biggest first."""
     groups: dict[tuple, list[Case]] = {}
     for c in all_cases:
         groups.setdefault(_kernel_key(c), []).append(c)
