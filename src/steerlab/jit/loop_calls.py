@@ -80,8 +80,8 @@ def _address(ctrl_update: Any, guide: Any) -> int:
     """The address of the (law, guidance) pair's sample entry, from its module in the driver
     cache (compiled or loaded first; memoised per process)."""
     key = (ctrl_update, guide)
-    at = _ADDRESSES.get(key)
-    if at is None:
+    kept = _ADDRESSES.get(key)
+    if kept is None:
         from pathlib import Path
 
         from numba import types as t
@@ -89,11 +89,14 @@ def _address(ctrl_update: Any, guide: Any) -> int:
         from steerlab.jit.drivers import driver, entry
 
         with _LOCK:
-            at = _ADDRESSES.get(key)
-            if at is None:
+            kept = _ADDRESSES.get(key)
+            if kept is None:
                 mod = driver(None, ctrl_update, guide, template=Path(__file__).with_name(TEMPLATE_NAME))
-                at = _ADDRESSES[key] = typed_address(entry(mod, "sample_entry"), t.float64, SAMPLE_ARGS)
-    return at     # the module stays loaded (drivers memoises it): its code stays alive
+                disp = entry(mod, "sample_entry")
+                # the dispatcher is kept with its address: its machine code lives as long as it
+                # does (a cleared driver cache drops the module from its memo, not from here)
+                kept = _ADDRESSES[key] = (typed_address(disp, t.float64, SAMPLE_ARGS), disp)
+    return kept[0]
 
 
 def loop_driver(ship_rhs, ctrl_update, guide, nx: int, lanes: int = 16):
