@@ -40,34 +40,35 @@ def call_at(typingctx, address, args):
 
     def codegen(context, builder, signature, llargs):
         addr, tup = llargs
-        fnty = context.call_conv.get_function_type(types.int64, argtys)
-        callee = builder.inttoptr(addr, fnty.as_pointer())
-        values = cgutils.unpack_tuple(builder, tup, len(argtys))
-        status, result = context.call_conv.call_function(builder, callee, types.int64, argtys, values)
-        with cgutils.if_unlikely(builder, status.is_error):
-            context.call_conv.return_status_propagate(builder, status)
-        return result
+        return _call(context, builder, addr, types.int64, argtys, cgutils.unpack_tuple(builder, tup, len(argtys)))
 
     return sig, codegen
+
+
+def _call(context, builder, addr, restype, argtys, values):
+    """Call the function at ``addr`` in numba's calling convention; an exception it raised
+    propagates to the caller."""
+    fnty = context.call_conv.get_function_type(restype, argtys)
+    callee = builder.inttoptr(addr, fnty.as_pointer())
+    status, result = context.call_conv.call_function(builder, callee, restype, argtys, values)
+    with cgutils.if_unlikely(builder, status.is_error):
+        context.call_conv.return_status_propagate(builder, status)
+    return result
 
 
 def address_of(dispatcher: Any, argtypes: tuple) -> int:
     """The machine-code address of ``dispatcher``'s overload for the numba types ``argtypes``
     (compiled, or loaded from numba's cache, first if needed); its return type must be int64
     (what :func:`call_at` reads). The dispatcher keeps the code alive: keep it referenced."""
-    dispatcher.compile(tuple(argtypes))
-    cres = dispatcher.overloads[tuple(argtypes)]
-    if types.unliteral(cres.signature.return_type) != types.int64:
-        raise TypeError(f"{dispatcher.py_func.__name__} returns {cres.signature.return_type}, call_at reads int64")
-    return int(cres.library.get_pointer_to_function(cres.fndesc.llvm_func_name))
+    return typed_address(dispatcher, types.int64, argtypes)
 
 
 def typed_call(restype, argtypes: tuple):
     """A :func:`call_at` for callees of one fixed signature ``restype(*argtypes)``:
     ``call(address, args)`` returns the callee's ``restype`` value (``none`` for a function
-    without one). Each argument at the call site is cast to its declared type (e.g. a C-ordered
-    array to a layout-``'A'`` one), so a caller whose arrays differ in layout still calls the
-    one compiled callee; an argument that cannot be cast is a typing error of the caller (not
+    without one). Each argument at the call site is cast to its declared type (e.g. an integer
+    to a float), so callers whose argument types differ a little still call the one compiled
+    callee; an argument that cannot be cast is a typing error of the caller (not
     undefined behaviour). ``address`` must come from :func:`typed_address` with the same
     ``argtypes``."""
     declared = tuple(argtypes)
@@ -83,13 +84,9 @@ def typed_call(restype, argtypes: tuple):
 
         def codegen(context, builder, signature, llargs):
             addr, tup = llargs
-            fnty = context.call_conv.get_function_type(restype, declared)
-            callee = builder.inttoptr(addr, fnty.as_pointer())
             values = [context.cast(builder, v, a, b)
                       for v, a, b in zip(cgutils.unpack_tuple(builder, tup, len(site)), site, declared)]
-            status, result = context.call_conv.call_function(builder, callee, restype, declared, values)
-            with cgutils.if_unlikely(builder, status.is_error):
-                context.call_conv.return_status_propagate(builder, status)
+            result = _call(context, builder, addr, restype, declared, values)
             return result if restype != types.none else context.get_dummy_value()
 
         return restype(address, args), codegen
