@@ -257,16 +257,16 @@ def reset_one(i, KEY, EP, S, Z, scale, offset_max, X, K, J, cmd, PS, GZ, REF, x0
     flag zeroed), gets its first reference from the guidance kernel at ``t = 0`` (a propeller
     order to ``PS[i, rpm_slot]`` as in :func:`finish`) and its observation (:func:`observe`)."""
     offset, sea_seed = draw_episode(i, KEY, EP, S, Z, scale, offset_max)
-    X[i, :] = x0
+    copy_row(X[i], x0)
     X[i, IPSI] += offset
     K[i] = 0
     J[i] = 0
     cmd[i] = 0.0
     rew[i] = 0.0
     bad[i] = False
-    PS[i, :] = ps
-    GZ[i, :] = gz0
-    REF[i, :] = ref0
+    copy_row(PS[i], ps)
+    copy_row(GZ[i], gz0)
+    copy_row(REF[i], ref0)
     GUIDE(0.0, X[i], gd, GZ[i], REF[i], h_env)
     if rpm_slot >= 0 and REF[i, REF_RPM] >= 0.0:
         PS[i, rpm_slot] = REF[i, REF_RPM]
@@ -285,6 +285,17 @@ def reset(idx, KEY, EP, S, Z, scale, offset_max, X, K, J, cmd, PS, GZ, REF, x0, 
         sea_seeds[q] = reset_one(idx[q], KEY, EP, S, Z, scale, offset_max, X, K, J, cmd, PS, GZ, REF, x0, ps,
                                  gz0, ref0, gd, h_env, rpm_slot, obs, rew, bad)
     return np.int64(idx.shape[0])
+
+
+@numba.njit(inline="always")
+def copy_row(dst, src):
+    """``dst[:] = src`` for two vectors of one size, element by element (the same values). numba's
+    slice assignment compiles a shape-mismatch message with its string formatting: 3-9 s of a
+    first environment compile per process, for an error the sizes here never raise."""
+    if dst.shape[0] != src.shape[0]:
+        raise ValueError("reset: a design vector and its lane row differ in size")
+    for q in range(dst.shape[0]):
+        dst[q] = src[q]
 
 
 @numba.njit
