@@ -17,6 +17,8 @@ worker; each log is switched on by its variable)::
   compile started, whose seconds include those it started; sum depth 0 for the total), so that a suite's compile time can be
   traced to its tests and combinations compiled by both workers found (``sort -k4 FILE``);
   what ``.ci/warm-cache`` should warm.
+* ``STEERLAB_TEST_TIMELINE=FILE``: ``start end worker nodeid`` (Unix times [s]) for every test
+  of at least 0.05 s: which worker ran what when, and what ran alone at the end of the run.
 
 The timings are for finding work to cut; no test decides anything by them.
 """
@@ -50,15 +52,19 @@ def _cpu_seconds() -> tuple[float, float]:
 @pytest.hookimpl(hookwrapper=True)
 def pytest_runtest_protocol(item, nextitem):
     path = os.environ.get("STEERLAB_TEST_CPU")
-    if not path or os.name != "posix":
+    timeline = os.environ.get("STEERLAB_TEST_TIMELINE")
+    if not (path or timeline) or os.name != "posix":
         yield
         return
-    (c0, k0), t0 = _cpu_seconds(), time.perf_counter()
+    (c0, k0), t0, start = _cpu_seconds(), time.perf_counter(), time.time()
     yield
     (c1, k1), wall = _cpu_seconds(), time.perf_counter() - t0
-    if wall >= 0.05:
+    if wall >= 0.05 and path:
         with open(path, "a", encoding="utf-8") as f:
             f.write(f"{c1 - c0:.2f} {wall:.2f} {item.nodeid} {k1 - k0:.2f}\n")
+    if wall >= 0.05 and timeline:
+        with open(timeline, "a", encoding="utf-8") as f:
+            f.write(f"{start:.2f} {start + wall:.2f} {os.environ.get('PYTEST_XDIST_WORKER', '-')} {item.nodeid}\n")
 
 
 def _listen_to_compiles(path: str) -> None:
