@@ -269,8 +269,8 @@ def pytest_collection_modifyitems(config, items):
         if is_realtime(item.nodeid):
             item.add_marker(pytest.mark.realtime)
             item.add_marker(pytest.mark.xdist_group("realtime"))
-        elif group := shared_result_group(item):
-            item.add_marker(pytest.mark.xdist_group(group))
+        elif not item.get_closest_marker("xdist_group") and (group := shared_result_group(item)):
+            item.add_marker(pytest.mark.xdist_group(group))     # a group the test names itself wins
 
 
 # ------------------------------------------------- one expensive result for every worker

@@ -42,6 +42,11 @@ def test_default_group_fills_a_vector():
     assert LANES % 4 == 0
 
 
+#: the tests that compile the sea runs' batch group of 3 lanes: one worker (the second loads it)
+SEA_RUNS_3 = "sea-runs-lanes-3"
+
+
+@pytest.mark.xdist_group(SEA_RUNS_3)
 @pytest.mark.parametrize("lanes", [3, LANES])
 def test_every_run_equals_its_single_run(sea_runs, lanes):
     batch = simulate_batch(sea_runs, record_every=7, lanes=lanes)
@@ -123,6 +128,7 @@ def test_the_four_rk4_stages_are_vectorised_across_runs(ship):
     assert report["vectorised_stages"] >= 4 and report["per_run_library_calls"] == []
 
 
+@pytest.mark.xdist_group(SEA_RUNS_3)
 def test_a_forked_child_runs_batches_too(sea_runs):
     """The thread pool is per process: a child forked after a batch must not wait on the
     parent's (threadless) pool."""

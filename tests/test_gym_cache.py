@@ -18,6 +18,8 @@ import pytest
 
 pytest.importorskip("gymnasium")
 
+from test_docs_components import ESSO_GYM  # noqa: E402  (the group that fills the suite's cache with the Esso's)
+
 SRC = Path(__file__).resolve().parent.parent / "src"
 
 ENTRIES = ("step", "step_serial", "reset", "step_parallel", "reset_parallel")
@@ -109,7 +111,12 @@ def warmed(tmp_path_factory) -> dict:
     """One cold compile of the environments' module for the two tests that need one: on a
     driver cache without it (:func:`_seed_without_the_env_module`), a process runs ``steerlab
     cache warm --gym`` and then the environments (``first``); then a fresh process runs them on
-    that cache (``fresh``). Made once per test session (shared by the pytest-xdist workers)."""
+    that cache (``fresh``). Made once per test session (shared by the pytest-xdist workers).
+
+    Its tests run in the group (:data:`ESSO_GYM`) of the two tests that compile the Esso's loops
+    and environments into the suite's cache, after them (file order): the seed then holds all
+    but the module under test, which is all the first process compiles (on a cold suite cache it
+    compiled the Esso's loops and its other environment too: 39 s of CPU against about 15)."""
     from conftest import once_per_session
 
     def make(cache: Path) -> dict:
@@ -119,6 +126,7 @@ def warmed(tmp_path_factory) -> dict:
     return once_per_session(tmp_path_factory, "gym-cache-warmed", make)
 
 
+@pytest.mark.xdist_group(ESSO_GYM)
 def test_a_fresh_process_loads_the_env_step_and_reset_and_compiles_nothing(warmed):
     first, second = warmed["first"], warmed["fresh"]
     assert first["cached"] and first["compiles_before"] > 0
@@ -162,6 +170,7 @@ def test_kernels_that_cannot_be_named_step_and_reset_from_an_in_memory_module():
         assert flags[0][0].all() == (k == 3)          # all episodes end at the 4th step, reset at the 5th
 
 
+@pytest.mark.xdist_group(ESSO_GYM)
 def test_cache_warm_gym_leaves_the_default_envs_step_and_reset_on_disk(warmed):
     first, after = warmed["first"], warmed["fresh"]
     assert first["compiles"] == 0                     # after the warm: no compile, so the warm wrote all
