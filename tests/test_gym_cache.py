@@ -116,7 +116,7 @@ def warmed(tmp_path_factory) -> dict:
     Its tests run in the group (:data:`ESSO_GYM`) of the two tests that compile the Esso's loops
     and environments into the suite's cache, after them (file order): the seed then holds all
     but the module under test, which is all the first process compiles (on a cold suite cache it
-    compiled the Esso's loops and its other environment too: 39 s of CPU against about 15)."""
+    compiled the Esso's loops and its other environment too: 39 s of CPU, 18 s after it)."""
     from conftest import once_per_session
 
     def make(cache: Path) -> dict:
