@@ -16,6 +16,7 @@ the checkout's ``src``, a driver cache of its own, warmed first; bytecode compil
 * ``import``: ``python -c "import steerlab"``;
 * ``library``: ``python -c "import steerlab as sl; sl.simulate(sl.default_scenario())"`` (a
   library user's first simulation, warm cache);
+* ``help``: ``python -m steerlab --help`` (a command that needs no kernel);
 
 and once the reference ``python -c "import numpy, numba, matplotlib.pyplot"``. Reported: medians of
 the CPU time (user + system of the process and the children it waited for, ``getrusage``) and
@@ -42,6 +43,7 @@ CASES = {
     "run": None,     # filled in with the output directory
     "import": ["-c", "import steerlab"],
     "library": ["-c", "import steerlab as sl; sl.simulate(sl.default_scenario())"],
+    "help": ["-m", "steerlab", "--help"],
 }
 
 

@@ -42,13 +42,38 @@ def test_a_run_and_a_batch_import_no_heavy_optional_library(mode, imported):
     assert json.loads(out.stdout.strip().splitlines()[-1]) == imported
 
 
-def test_import_steerlab_imports_only_numpy_and_numba():
-    """(numba itself imports scipy's top package; not its submodules.)"""
+def test_import_steerlab_imports_neither_numpy_nor_numba():
+    """``import steerlab`` is the package's name space only: the kernels' modules (and numba with
+    them, through steerlab.jit.numba_stamped) come with the first API name used."""
     out = subprocess.run([sys.executable, "-c", "import json, sys, steerlab; print(json.dumps(sorted("
-                          "m for m in %r if m in sys.modules)))" % (HEAVY + ("pydantic",),)],
+                          "m for m in %r if m in sys.modules)))" % (HEAVY + ("pydantic", "numba", "numpy", "scipy"),)],
                          capture_output=True, text=True, timeout=120)
     assert out.returncode == 0, out.stderr
     assert json.loads(out.stdout) == []
+
+
+def _imported_by_command(*argv: str) -> set:
+    """The top-level packages a ``steerlab`` command process imported (``python -X importtime``)."""
+    out = subprocess.run([sys.executable, "-X", "importtime", "-m", "steerlab", *argv], capture_output=True,
+                         text=True, timeout=300)
+    assert out.returncode == 0, out.stderr[-2000:]
+    names = {line.rsplit("|", 1)[-1].strip() for line in out.stderr.splitlines() if line.startswith("import time:")}
+    assert "steerlab.cli" in names          # the reading works: the command's own module is there
+    return names
+
+
+@pytest.mark.parametrize("argv", [("--help",), ("run", "--help"), ("autopilot-command", "--help"),
+                                  ("experiment", "--help")], ids=" ".join)
+def test_a_command_that_needs_no_kernel_starts_without_numba(argv):
+    """Help and the runtime's command client define no kernel: numba (0.3 s of CPU to import)
+    is not imported, and neither are numpy's and numba's friends."""
+    imported = _imported_by_command(*argv)
+    assert not {"numba", "llvmlite", "scipy"} & imported, sorted(imported)
+
+
+def test_a_command_that_runs_a_kernel_still_imports_numba_through_the_stamp():
+    imported = _imported_by_command("trial", "zigzag", "--ship", "nomoto1", "--json")
+    assert {"numba", "steerlab.jit.numba_stamped"} <= imported
 
 
 BLAS_SCRIPT = """

@@ -15,6 +15,7 @@ from steerlab.jit.drivers import cached_signatures, driver, in_memory_twin
 from steerlab.jit.loop_calls import bound
 from steerlab.sim.lanes import vectorisation_report
 from steerlab.sim.setup import build
+from steerlab.sincos import VECTORISED_MARKER
 from steerlab.warm import warm_scenario
 
 pytestmark = pytest.mark.skipif(not numba.config.LOOP_VECTORIZE, reason="numba's loop vectoriser is switched off")
@@ -32,7 +33,8 @@ def nomoto1_pid():
     twin = in_memory_twin(*key).group
     for sig in sigs:
         twin.compile(sig)
-    from_ir = vector_reports.report_from_ir("\n".join(twin.inspect_llvm().values()))
+    from_ir = vector_reports.report_from_ir("\n".join(twin.inspect_llvm().values()),
+                                           VECTORISED_MARKER)
     return s, disp, sigs, from_ir
 
 

@@ -8,8 +8,10 @@ Conventions (everywhere inside the library)
 * Every heading error goes through :func:`steerlab.angles.wrap_to_pi`.
 
 The public API (``import steerlab as sl``) is loaded lazily: ``import steerlab`` imports
-numpy and numba only and changes nothing outside steerlab; ``sl.simulate`` and friends import their module on first use
-(PEP 562 module ``__getattr__``), so a command pays only for what it uses.
+neither numpy nor numba and changes nothing outside steerlab; ``sl.simulate`` and friends
+import their module on first use (PEP 562 module ``__getattr__``), so a command pays only for
+what it uses (``steerlab --help`` starts without numba). The first module with a numba kernel
+puts the package stamp of steerlab's cached kernels in place (:mod:`steerlab.jit.numba_stamped`).
 """
 
 from __future__ import annotations
@@ -19,19 +21,15 @@ from typing import TYPE_CHECKING, Any
 
 __version__ = "0.1.0"
 
-# Nothing here changes anything outside steerlab (tests/test_import_side_effects.py). Two
-# settings must come first: in the steerlab command's own process only, numpy's OpenBLAS on one
-# thread, which works only before numpy is imported (blas_threads: a no-op in a user's program);
-# and before any kernel is defined, the package stamp of steerlab's own cached kernels, which
-# claims steerlab's files only (numba_cache). The command's other process-wide settings are
-# made by its entry point (steerlab.jit.command, from steerlab.cli.console_main).
+# Nothing here changes anything outside steerlab (tests/test_import_side_effects.py). One
+# setting must come first: in the steerlab command's own process only, numpy's OpenBLAS on one
+# thread, which works only before numpy is imported (blas_threads: a no-op in a user's program).
+# The package stamp of steerlab's cached kernels is put in place by the first module that
+# defines a kernel (steerlab.jit.numba_stamped); the command's other process-wide settings are
+# asked for by its entry point (steerlab.jit.command, from steerlab.cli.console_main).
 from steerlab.jit import blas_threads  # noqa: E402  (isort: skip)
 
 blas_threads.one_thread_for_commands()
-from steerlab.jit import numba_cache  # noqa: E402  (isort: skip)
-
-numba_cache.install()
-from steerlab.angles import wrap_to_pi  # noqa: F401
 from steerlab.errors import InputError  # noqa: F401
 
 _LAZY = {
@@ -43,6 +41,7 @@ _LAZY = {
     "simulate": "steerlab.sim.engine:simulate",
     "simulate_batch": "steerlab.sim.batch:simulate_batch",
     "vary": "steerlab.sim.vary:vary",
+    "wrap_to_pi": "steerlab.angles:wrap_to_pi",
     # components for other people's loops (steerlab.components)
     "controller": "steerlab.components.controller:controller",
     "controllers": "steerlab.components.controller:controllers",
@@ -57,6 +56,7 @@ if TYPE_CHECKING:   # what type checkers see of the lazy names above (keep in st
     from steerlab.components.controller import controllers as controllers
     from steerlab.components.linear import linearize as linearize
     from steerlab.components.linear import transfer_function as transfer_function
+    from steerlab.angles import wrap_to_pi as wrap_to_pi
     from steerlab.components.ship import ship as ship
     from steerlab.control.registry import register_controller as register_controller
     from steerlab.ships.registry import register_ship as register_ship
@@ -85,4 +85,4 @@ def __dir__() -> list[str]:
     return sorted((set(globals()) | set(_LAZY)) - _NOT_API)
 
 
-__all__ = ["InputError", "wrap_to_pi", *_LAZY]
+__all__ = ["InputError", *_LAZY]

@@ -5,7 +5,7 @@ from __future__ import annotations
 import math
 from typing import TYPE_CHECKING, Any, overload
 
-import numba
+from steerlab.jit.numba_stamped import numba
 
 if TYPE_CHECKING:
     import numpy as np

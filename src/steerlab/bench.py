@@ -32,11 +32,11 @@ import types
 from functools import lru_cache
 from typing import Callable, Optional
 
-import numba
 import numpy as np
 
 from steerlab.jit import loop_calls
 from steerlab.jit.dispatch import is_dispatcher
+from steerlab.jit.numba_stamped import numba
 from steerlab.sim.batch import simulate_batch, vary_controller
 from steerlab.sim.engine import simulate_compiled, simulate_readable
 from steerlab.sim.kernels import plant_step

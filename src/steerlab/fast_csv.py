@@ -39,7 +39,7 @@ def _compile():
     global _kernel
     if _kernel is not None:
         return _kernel
-    import numba
+    from steerlab.jit.numba_stamped import numba
 
     @numba.njit(cache=True)
     def format_g10(flat, slots, lens):

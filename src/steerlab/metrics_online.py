@@ -9,10 +9,10 @@ from typing import TYPE_CHECKING
 
 import math
 
-import numba
 import numpy as np
 
 from steerlab.angles import wrap_to_pi_array
+from steerlab.jit.numba_stamped import numba
 from steerlab.records import Field, Layout
 
 if TYPE_CHECKING:   # Layout.export below writes this module's index constants: ints, for type checkers

@@ -38,7 +38,7 @@ from __future__ import annotations
 
 import math
 
-import numba
+from steerlab.jit.numba_stamped import numba
 
 _TWO_OVER_PI = 0.636619772367581382433   # 2/pi
 _ROUND = 6755399441055744.0              # 1.5 * 2**52: x + _ROUND - _ROUND rounds x to an integer
@@ -57,6 +57,11 @@ _C3 = 2.48015872894767294178e-05
 _C4 = -2.75573143513906633035e-07
 _C5 = 2.08757232129817482790e-09
 _C6 = -1.13596475577881948265e-11
+
+VECTORISED_MARKER = _S1
+"""The sine polynomial's first coefficient: where its ``<N x double>`` form appears in a compiled
+loop's LLVM IR, a kinematics stage was vectorised (:func:`steerlab.jit.vector_reports.report_from_ir`;
+the generated drivers carry it as a global, so the compile package need not import this module)."""
 
 
 @numba.njit(cache=True, inline="always")

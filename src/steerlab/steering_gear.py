@@ -19,10 +19,10 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, NamedTuple
 
-import numba
 import numpy as np
 
 from steerlab.errors import require_finite_range
+from steerlab.jit.numba_stamped import numba
 from steerlab.records import Field, Layout
 from steerlab.units import rad
 

@@ -73,7 +73,7 @@ def _allocates(dispatcher) -> bool:
     Inspected on a fresh, uncached compile of the same function: numba returns no IR for code
     it loaded from its disk cache (a ``cache=True`` kernel compiled in an earlier process), which
     would let an allocating kernel pass."""
-    import numba
+    from steerlab.jit.numba_stamped import numba
 
     fresh = numba.njit(dispatcher.py_func)
     for sig in dispatcher.signatures:
@@ -136,7 +136,7 @@ def _vectorisation(kind, name, setup, strict: bool) -> tuple[int | None, list]:
     """The ``vectorises`` rule (module docstring): ``(vectorised stages, warning lines)``."""
     import warnings
 
-    import numba
+    from steerlab.jit.numba_stamped import numba
 
     from steerlab.sim.batch import simulate_batch
     from steerlab.sim.lanes import vectorisation_report

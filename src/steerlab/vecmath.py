@@ -25,7 +25,7 @@ from __future__ import annotations
 
 import math
 
-import numba
+from steerlab.jit.numba_stamped import numba
 
 @numba.njit(cache=True, inline="always")
 def _atan_small(z):

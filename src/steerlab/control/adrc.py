@@ -62,7 +62,6 @@ from __future__ import annotations
 import math
 from typing import Literal, NamedTuple, Optional, Union
 
-import numba
 import numpy as np
 from pydantic import Field, field_validator
 
@@ -70,6 +69,7 @@ from steerlab.angles import wrap_to_pi
 from steerlab.config_base import FrozenConfig
 from steerlab.control.estimators import (ESO, PAPER_L, check_discrete_eso, eso_gains_bandwidth,
                                          eso_gains_lqr, eso_step)
+from steerlab.jit.numba_stamped import numba
 from steerlab.control.design_context import observer_multiple
 from steerlab.control.law_design import GAINS, GainsMode, band_gain, law_bandwidth
 from steerlab.control.registry import ControllerSpec

@@ -78,7 +78,6 @@ from __future__ import annotations
 import math
 from typing import Literal, NamedTuple, Optional
 
-import numba
 import numpy as np
 from pydantic import Field
 
@@ -92,6 +91,7 @@ from steerlab.control.asa_layout import (N_STATE, PARAMS, P_ALPHA, P_ALPHA_ID, P
                                          Z_KD, Z_KI, Z_KI_MEAN, Z_KP, Z_MODE, Z_OMEGA, Z_PD, Z_PR,
                                          Z_PSI_M, Z_PSI_SET, Z_R_M, Z_RM_ID, Z_SAT, Z_T_REACHED,
                                          Z_T_START)
+from steerlab.jit.numba_stamped import numba
 from steerlab.control.asa_modes import MODE_CHANGING, asa_mode_step
 from steerlab.control.asa_mras import mras_gain_step, mras_identify_step
 from steerlab.control.asa_reference import lyapunov_p12_p22, reference_model_step

@@ -26,12 +26,11 @@ from __future__ import annotations
 
 import math
 
-import numba
-
 from steerlab.angles import wrap_to_pi
 from steerlab.control.asa_layout import (P_KP_CC, P_N_HOLD, P_R_MAX, P_THRESHOLD, Z_KD, Z_KI, Z_KI_MEAN,
                                          Z_KP, Z_MODE, Z_OMEGA, Z_PSI_M, Z_PSI_SET, Z_R_M, Z_T_REACHED,
                                          Z_T_START)
+from steerlab.jit.numba_stamped import numba
 from steerlab.control.asa_schedule import closed_loop_omega, kd_damping
 
 REACHED_TOL = math.radians(0.5)

@@ -48,9 +48,8 @@ from __future__ import annotations
 
 import math
 
-import numba
-
 from steerlab.angles import wrap_to_pi
+from steerlab.jit.numba_stamped import numba
 
 
 @numba.njit(cache=True)

@@ -36,10 +36,9 @@ taking into account the sampled-data character", 4.4.2 Note 5).
 
 from __future__ import annotations
 
-import numba
-
 from steerlab.angles import wrap_to_pi
 from steerlab.guidance.series_model import series_model_step
+from steerlab.jit.numba_stamped import numba
 
 
 @numba.njit(cache=True)

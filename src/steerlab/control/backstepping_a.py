@@ -96,7 +96,6 @@ from __future__ import annotations
 import math
 from typing import Literal, NamedTuple, Optional
 
-import numba
 import numpy as np
 from pydantic import Field, create_model
 
@@ -106,6 +105,7 @@ from steerlab.control.registry import ControllerSpec
 from steerlab.control.design_model import ZETA
 from steerlab.control.heading_integral import (INTEGRAL_BAND, INTEGRAL_DIVISOR, TURN_RATE_FRACTION,
                                                integral_step)
+from steerlab.jit.numba_stamped import numba
 from steerlab.control.law_design import GAINS, law_bandwidth
 from steerlab.control.van_leeuwen_design import design_model, design_mu, yaw_accel
 from steerlab.errors import InputError

@@ -51,7 +51,6 @@ gains and either sign of ``T``. Integral action with anti-windup as version A (d
 
 from __future__ import annotations
 
-import numba
 from pydantic import create_model
 
 from steerlab.config_base import FrozenConfig
@@ -59,6 +58,7 @@ from steerlab.control.backstepping_a import (B_IRDOT, B_K1, B_K2, B_K3, B_K4, B_
                                              B_TR,
                                              B_TU, B_UMAX, N_STATE, Z_R_PREV, Z_RDF, Z_XI, backstepping_errors,
                                              config_fields, make)
+from steerlab.jit.numba_stamped import numba
 from steerlab.control.heading_integral import integral_step
 from steerlab.control.registry import ControllerSpec
 from steerlab.control.backstepping_a import PARAMS as A_PARAMS

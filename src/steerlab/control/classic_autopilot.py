@@ -63,7 +63,6 @@ from __future__ import annotations
 import math
 from typing import Literal, NamedTuple, Optional
 
-import numba
 import numpy as np
 from pydantic import Field, create_model
 
@@ -72,6 +71,7 @@ from steerlab.config_base import FrozenConfig
 from steerlab.control.pole_placement import fill_gains
 from steerlab.control.registry import ControllerSpec
 from steerlab.errors import InputError
+from steerlab.jit.numba_stamped import numba
 from steerlab.records import Field as RecordField
 from steerlab.records import Layout
 from steerlab.units import rad

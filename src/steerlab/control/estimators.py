@@ -17,10 +17,10 @@ weights, Section 5), or computed here by python-control: LQR on the dual system
 
 from __future__ import annotations
 
-import numba
 import numpy as np
 
 from steerlab.angles import wrap_to_pi
+from steerlab.jit.numba_stamped import numba
 from steerlab.records import Field, Layout
 
 ESO = Layout("ESO state", "E_", [

@@ -27,7 +27,7 @@ whose error is small but still closing faster than ``r_band``, charged the integ
 
 from __future__ import annotations
 
-import numba
+from steerlab.jit.numba_stamped import numba
 
 #: ``k_i = omega_n Kp / INTEGRAL_DIVISOR`` with ``Kp = omega_n^2 / b`` (Fossen 2011, Sec. 12.2.7).
 INTEGRAL_DIVISOR = 10.0

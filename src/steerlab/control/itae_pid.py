@@ -82,7 +82,6 @@ from __future__ import annotations
 import math
 from typing import Literal, NamedTuple, Optional
 
-import numba
 import numpy as np
 from pydantic import Field, create_model
 
@@ -91,6 +90,7 @@ from steerlab.config_base import FrozenConfig
 from steerlab.control.design_model import bandwidth, design_model
 from steerlab.control.registry import ControllerSpec
 from steerlab.errors import InputError, require_finite_range
+from steerlab.jit.numba_stamped import numba
 from steerlab.records import Field as RecordField
 from steerlab.records import Layout
 from steerlab.units import knots_to_ms, rad

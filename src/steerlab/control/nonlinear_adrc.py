@@ -71,7 +71,6 @@ from __future__ import annotations
 import math
 from typing import Literal, NamedTuple, Optional, Union
 
-import numba
 import numpy as np
 from pydantic import Field, create_model, field_validator
 
@@ -83,6 +82,7 @@ from steerlab.control.nonlinear_eso import NLESO, fal, nleso_gains_bandwidth, nl
 from steerlab.control.registry import ControllerSpec
 from steerlab.control.tracking_differentiator import TD, td_step
 from steerlab.errors import InputError, require_finite_range
+from steerlab.jit.numba_stamped import numba
 from steerlab.records import Field as RecordField
 from steerlab.records import Layout
 from steerlab.ships.state import IPSI, IR

@@ -22,11 +22,11 @@ from __future__ import annotations
 
 import math
 
-import numba
 import numpy as np
 
 from steerlab.angles import wrap_to_pi
 from steerlab.control.estimators import eso_gains_bandwidth
+from steerlab.jit.numba_stamped import numba
 from steerlab.records import Field, Layout
 
 NLESO = Layout("NLESO state", "E_", [

@@ -44,7 +44,6 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Literal, Optional
 
-import numba
 import numpy as np
 from pydantic import Field, create_model
 
@@ -52,6 +51,7 @@ from steerlab.angles import wrap_to_pi
 from steerlab.config_base import FrozenConfig
 from steerlab.control.pole_placement import fill_gains, pid_pole_placement
 from steerlab.control.registry import ControllerSpec
+from steerlab.jit.numba_stamped import numba
 from steerlab.records import Field as RecordField
 from steerlab.records import Layout
 from steerlab.units import rad

@@ -30,7 +30,6 @@ import math
 from pathlib import Path
 from typing import TYPE_CHECKING, Literal, Optional
 
-import numba
 import numpy as np
 from pydantic import Field
 
@@ -39,6 +38,7 @@ from steerlab.control.policy_file import ACTIVATIONS, MAX_HIDDEN, load_policy
 from steerlab.control.policy_observation import N_POLICY_OBS, observe_policy
 from steerlab.control.registry import ControllerSpec
 from steerlab.guidance.reference_vector import REF_PSI, REF_R
+from steerlab.jit.numba_stamped import numba
 from steerlab.records import Field as RecordField
 from steerlab.records import Layout
 from steerlab.ships.state import IPSI, IR

@@ -21,10 +21,10 @@ from __future__ import annotations
 
 import math
 
-import numba
 import numpy as np
 
 from steerlab.angles import wrap_to_pi
+from steerlab.jit.numba_stamped import numba
 
 E_SCALE = 0.35          #: [rad] heading-error scale (20 deg)
 R_SCALE = 0.01          #: [rad/s] yaw-rate and reference-rate scale

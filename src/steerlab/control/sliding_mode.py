@@ -57,7 +57,6 @@ from __future__ import annotations
 
 from typing import Literal, NamedTuple, Optional
 
-import numba
 import numpy as np
 from pydantic import Field, field_validator
 
@@ -67,6 +66,7 @@ from steerlab.control.registry import ControllerSpec
 from steerlab.control.design_model import DESIGN_TURN
 from steerlab.control.heading_integral import (INTEGRAL_BAND, TURN_RATE_FRACTION, integral_gain,
                                                integral_step)
+from steerlab.jit.numba_stamped import numba
 from steerlab.control.law_design import GAINS, GainsMode, law_bandwidth, law_model
 from steerlab.control.van_leeuwen_design import design_model, design_mu, linear_design_matrices, yaw_accel
 from steerlab.errors import InputError

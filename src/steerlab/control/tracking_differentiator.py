@@ -20,9 +20,8 @@ from __future__ import annotations
 
 import math
 
-import numba
-
 from steerlab.angles import wrap_to_pi
+from steerlab.jit.numba_stamped import numba
 from steerlab.records import Field, Layout
 
 TD = Layout("TD state", "TD_", [

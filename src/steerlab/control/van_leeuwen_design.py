@@ -35,11 +35,11 @@ from __future__ import annotations
 
 import math
 
-import numba
 import numpy as np
 
 from steerlab.control.law_design import law_model
 from steerlab.errors import InputError
+from steerlab.jit.numba_stamped import numba
 from steerlab.ships import van_leeuwen as vl
 from steerlab.ships.state import IR
 

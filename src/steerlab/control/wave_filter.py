@@ -87,12 +87,12 @@ from __future__ import annotations
 
 import math
 
-import numba
 import numpy as np
 from pydantic import create_model
 
 from steerlab.angles import wrap_to_pi
 from steerlab.config_base import FrozenConfig
+from steerlab.jit.numba_stamped import numba
 from steerlab.records import Field as RecordField
 from steerlab.records import Layout
 

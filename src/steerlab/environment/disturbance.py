@@ -4,11 +4,11 @@ from __future__ import annotations
 
 from dataclasses import dataclass, replace
 
-import numba
 import numpy as np
 
 from steerlab.environment.channels import (N_CHANNELS, W_RUDDER, W_WIND_DIR, W_WIND_SPEED,
                                            set_current)
+from steerlab.jit.numba_stamped import numba
 from steerlab.environment.iir_filter import _padded, _transposed_df2
 from steerlab.environment.waves import band_pass_eq39, coloured_noise, white_samples_rows
 from steerlab.errors import require_finite_range

@@ -13,7 +13,7 @@ wave and gust sequences of every run need only this loop.
 
 from __future__ import annotations
 
-import numba
+from steerlab.jit.numba_stamped import numba
 import numpy as np
 
 

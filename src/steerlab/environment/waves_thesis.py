@@ -25,10 +25,10 @@ from __future__ import annotations
 
 import math
 
-import numba
 import numpy as np
 
 from steerlab.errors import require_finite_range
+from steerlab.jit.numba_stamped import numba
 
 ZETA_THESIS = 0.05
 """Damping ratio of the thesis' wave filter ("about 0.05")."""

@@ -42,10 +42,10 @@ from __future__ import annotations
 import math
 from typing import NamedTuple
 
-import numba
 import numpy as np
 
 from steerlab.errors import require_finite_range
+from steerlab.jit.numba_stamped import numba
 from steerlab.sincos import sincos
 
 RHO_AIR = 1.226

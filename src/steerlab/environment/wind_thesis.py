@@ -37,11 +37,11 @@ from __future__ import annotations
 
 import math
 
-import numba
 import numpy as np
 
 from steerlab.environment.wind_fujiwara import RHO_AIR, relative_wind
 from steerlab.errors import require_finite_range
+from steerlab.jit.numba_stamped import numba
 
 CX_DEFAULT = 0.7
 CY_DEFAULT = 0.825

@@ -47,13 +47,13 @@ from __future__ import annotations
 
 import math
 
-import numba
 import numpy as np
 
 from steerlab.angles import wrap_to_pi
 from steerlab.errors import InputError, require_finite_range
 from steerlab.guidance.reference_vector import REF_PSI, REF_R, REF_RDOT
 from steerlab.guidance.series_model import series_model_step
+from steerlab.jit.numba_stamped import numba
 from steerlab.records import Field, Layout
 
 KIND_RATE_LIMITED = 1

@@ -40,12 +40,12 @@ import csv
 import math
 from pathlib import Path
 
-import numba
 import numpy as np
 
 from steerlab.angles import wrap_to_pi
 from steerlab.errors import InputError, require_finite_range
 from steerlab.guidance.reference_vector import REF_LEG, REF_PSI, REF_R, REF_RDOT, REF_RPM, REF_XTE
+from steerlab.jit.numba_stamped import numba
 from steerlab.records import Field, Layout
 from steerlab.ships.state import IX, IY
 

@@ -16,12 +16,12 @@ from __future__ import annotations
 
 import math
 
-import numba
 import numpy as np
 
 from steerlab.angles import wrap_to_pi
 from steerlab.errors import InputError, require_finite_range
 from steerlab.guidance.reference_vector import REF_PSI, REF_R
+from steerlab.jit.numba_stamped import numba
 from steerlab.records import Field, Layout
 
 SCHEDULE = Layout("guidance", "G_", [

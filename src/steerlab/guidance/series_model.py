@@ -16,7 +16,7 @@ layer, so that guidance does not import a controller.
 
 from __future__ import annotations
 
-import numba
+from steerlab.jit.numba_stamped import numba
 
 
 @numba.njit(cache=True)

@@ -228,7 +228,7 @@ class Episodes:
         message of :func:`steerlab.jit.drivers.entry` comes only when it is compiled."""
         got = self._par.get(name)
         if got is None:
-            import numba
+            from steerlab.jit.numba_stamped import numba
 
             from steerlab.jit.numba_call_at import address_of
             from steerlab.jit.drivers import entry

@@ -27,11 +27,11 @@ whole sequence at once (``tests/test_gym_lanes.py``).
 
 from __future__ import annotations
 
-import numba
 import numpy as np
 
 from steerlab.environment.channels import N_CHANNELS
 from steerlab.environment.iir_filter import df2_step2
+from steerlab.jit.numba_stamped import numba
 from steerlab.jit.philox import STREAM_HEADER, STREAM_NORMAL, normals, philox_block, uniform
 
 _S33 = np.uint64(33)

@@ -13,11 +13,11 @@ from __future__ import annotations
 
 import math
 
-import numba
 import numpy as np
 
 from steerlab.control.policy_observation import N_POLICY_OBS, obs_bounds, observe_policy
 from steerlab.guidance.reference_vector import REF_PSI, REF_R
+from steerlab.jit.numba_stamped import numba
 from steerlab.ships.state import IPSI, IR
 
 OBSERVATIONS = ("raw", "normalised")

@@ -23,13 +23,42 @@ the numba versions the tests cover (:mod:`~steerlab.jit.numba_gate`).
 
 from __future__ import annotations
 
+import sys
+
 
 def settings() -> dict[str, bool]:
-    """Make the command's settings (module docstring); returns which took effect, by module name."""
-    from steerlab.jit import numba_blas_probe, numba_gate, threading_layer
+    """Make the command's settings (module docstring); returns which took effect, by module name.
 
-    allowed = numba_gate.internals_allowed()
-    return {
-        "numba_blas_probe": allowed and numba_blas_probe.preload(),
-        "threading_layer": threading_layer.prefer_fork_safe(),
-    }
+    Both concern numba, so they are made when numba is first imported for a kernel
+    (:mod:`steerlab.jit.numba_stamped` calls :func:`apply_deferred`), not before: a command that
+    needs no kernel (``--help``, a runtime client) never imports numba. If numba is already
+    imported they are made now. Until then the result says ``False`` for both."""
+    global _ASKED
+    _ASKED = True
+    if "numba" not in sys.modules:
+        return dict.fromkeys(NAMES, False)
+    return apply_deferred()
+
+
+NAMES = ("numba_blas_probe", "threading_layer")
+"""The settings :func:`settings` makes, by module name."""
+
+_ASKED = False
+_MADE: dict[str, bool] | None = None
+
+
+def apply_deferred() -> dict[str, bool]:
+    """Make the settings :func:`settings` asked for, once (a no-op in a process that is not
+    the command: a user's program); returns which took effect."""
+    global _MADE
+    if not _ASKED:
+        return dict.fromkeys(NAMES, False)
+    if _MADE is None:
+        from steerlab.jit import numba_blas_probe, numba_gate, threading_layer
+
+        allowed = numba_gate.internals_allowed()
+        _MADE = {
+            "numba_blas_probe": allowed and numba_blas_probe.preload(),
+            "threading_layer": threading_layer.prefer_fork_safe(),
+        }
+    return dict(_MADE)

@@ -25,7 +25,7 @@ from __future__ import annotations
 
 from typing import Any
 
-import numba
+from steerlab.jit.numba_stamped import numba
 import numpy as np
 
 # ---- bindings: replaced in every generated driver ----

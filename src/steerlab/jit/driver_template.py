@@ -41,17 +41,18 @@ fingerprint covers it like any other source file.
 # flake8: noqa: E402
 from __future__ import annotations
 
-import numba
 import numpy as np
 
 from steerlab.angles import wrap_to_pi
 from steerlab.environment.channels import N_CHANNELS
 from steerlab.guidance.reference_vector import N_REF, REF_LEG, REF_PSI, REF_RPM, REF_XTE
 from steerlab.jit.loop_calls import call_sample, data_address, row_address
+from steerlab.jit.numba_stamped import numba
 from steerlab.metrics_online import accumulate
 from steerlab.sim.kernels import _fused, _jit_fused, rk4_stage, rk4_update
 from steerlab.steering_gear import gear_clamp, gear_rate
 from steerlab.ships.state import IPSI, IR
+from steerlab.sincos import VECTORISED_MARKER  # noqa: F401 (read by steerlab.jit.vector_reports)
 
 # ---- bindings: replaced in every generated driver ----
 SHIP_RHS = None       # ship kernel rhs(t, x, delta, w, ps, dx)

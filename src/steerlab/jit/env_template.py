@@ -35,7 +35,6 @@ This file is importable as it is (the placeholder bindings bind nothing).
 # flake8: noqa: E402
 from __future__ import annotations
 
-import numba
 import numpy as np
 
 from steerlab.angles import wrap_to_pi
@@ -43,6 +42,7 @@ from steerlab.guidance.reference_vector import REF_PSI, REF_RPM
 from steerlab.gym.lane_seas import draw_episode, fill_rows
 from steerlab.gym.plant_batch import OBS_DELTA, OBS_E, OBS_R, R_MAX, REWARD_ITAE, REWARD_SPEED_LOSS
 from steerlab.jit.numba_call_at import call_at
+from steerlab.jit.numba_stamped import numba
 from steerlab.sim.kernels import _fused, _jit_fused, plant_step
 from steerlab.ships.state import IPSI, IR
 

@@ -24,7 +24,7 @@ import threading
 import types
 from typing import Callable, Optional
 
-import numba
+from steerlab.jit.numba_stamped import numba
 
 _REFS: dict = {}          # id(kernel) -> (kernel, reference) for bound kernels
 _BOUND: dict = {}         # (template, name, bindings) -> kernel

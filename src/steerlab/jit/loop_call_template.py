@@ -29,10 +29,9 @@ from __future__ import annotations
 
 from typing import Any
 
-import numba
-
 from steerlab.jit.dispatch import supported_options
 from steerlab.jit.numba_call_at import float64_pointer as f64
+from steerlab.jit.numba_stamped import numba
 from steerlab.sim.kernels import _fused
 
 # ---- bindings: replaced in every generated driver ----

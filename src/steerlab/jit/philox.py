@@ -31,7 +31,7 @@ from __future__ import annotations
 
 import math
 
-import numba
+from steerlab.jit.numba_stamped import numba
 import numpy as np
 from llvmlite import ir
 from numba.core import types

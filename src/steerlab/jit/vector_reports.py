@@ -43,11 +43,11 @@ _CHEAP_VECTOR_INTRINSICS = frozenset({
     "minimum", "maximum", "smax", "smin", "umax", "umin", "masked"})
 
 
-def report_from_ir(ir: str) -> dict:
-    """The vectorisation report of LLVM IR text (module docstring)."""
-    from steerlab import sincos as sincos_module
-
-    s1 = "0x%016X" % struct.unpack("<Q", struct.pack("<d", sincos_module._S1))[0]
+def report_from_ir(ir: str, marker: float) -> dict:
+    """The vectorisation report of LLVM IR text (module docstring); ``marker``: the sine
+    polynomial's first coefficient, :data:`steerlab.sincos.VECTORISED_MARKER` (a cached driver
+    carries it as its global ``VECTORISED_MARKER``)."""
+    s1 = "0x%016X" % struct.unpack("<Q", struct.pack("<d", marker))[0]
     stages = sum(1 for line in ir.splitlines() if s1 in line and "x double>" in line)
     calls = set(re.findall(r"@llvm\.(\w+)\.[\w.]*v\d+f64", ir)) - _CHEAP_VECTOR_INTRINSICS
     return {"vectorised_stages": stages, "per_run_library_calls": sorted(calls)}
@@ -118,9 +118,10 @@ def on_compiled(dispatcher, args) -> None:
     if path is None:
         return
     cres = dispatcher.overloads.get(tuple(args))
-    if cres is None:
+    marker = dispatcher.py_func.__globals__.get("VECTORISED_MARKER")
+    if cres is None or marker is None:
         return
-    _store(path, cres.signature.args, report_from_ir(cres.library.get_llvm_str()))
+    _store(path, cres.signature.args, report_from_ir(cres.library.get_llvm_str(), marker))
 
 
 def _on_end(dispatcher, args) -> None:

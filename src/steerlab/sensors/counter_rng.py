@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import math
 
-import numba
+from steerlab.jit.numba_stamped import numba
 import numpy as np
 
 GOLDEN = np.uint64(0x9E3779B97F4A7C15)

@@ -31,12 +31,12 @@ import math
 from functools import lru_cache
 from typing import NamedTuple
 
-import numba
 import numpy as np
 
 from steerlab.control.registry import ControllerSpec
 from steerlab.errors import InputError
 from steerlab.jit.kernel_refs import bound_kernel
+from steerlab.jit.numba_stamped import numba
 from steerlab.records import Field as RecordField
 from steerlab.records import Layout
 from steerlab.sensors.counter_rng import make_key, normal, split_seed, uniform

@@ -35,12 +35,12 @@ from __future__ import annotations
 
 import math
 
-import numba
 import numpy as np
 from pydantic import Field
 
 from steerlab.config_base import FrozenConfig
 from steerlab.environment.channels import W_RUDDER, W_YAW_MOMENT
+from steerlab.jit.numba_stamped import numba
 from steerlab.records import Field as RecordField
 from steerlab.records import Layout
 from steerlab.ships.kinematics import earth_velocity

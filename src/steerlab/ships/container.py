@@ -58,11 +58,11 @@ from __future__ import annotations
 import math
 from functools import lru_cache
 
-import numba
 import numpy as np
 
 from steerlab.environment.channels import W_RUDDER, W_YAW_MOMENT
 from steerlab.errors import InputError
+from steerlab.jit.numba_stamped import numba
 from steerlab.records import Field as RecordField
 from steerlab.records import Layout
 from steerlab.ships.kinematics import earth_velocity

@@ -37,9 +37,9 @@ from __future__ import annotations
 import math
 from typing import NamedTuple
 
-import numba
 import numpy as np
 
+from steerlab.jit.numba_stamped import numba
 from steerlab.records import Field, Layout
 from steerlab.ships.kinematics import planar_start
 from steerlab.units import knots_to_ms

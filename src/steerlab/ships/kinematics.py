@@ -16,9 +16,8 @@ speed and direction by :func:`steerlab.environment.channels.set_current`).
 branches), so that the batch engine can vectorise this kernel across runs.
 """
 
-import numba
-
 from steerlab.environment.channels import W_CURRENT_E, W_CURRENT_N, W_RUDDER
+from steerlab.jit.numba_stamped import numba
 from steerlab.ships.state import IPSI, IR, IU, IV, IX, IY
 from steerlab.sincos import sincos
 

@@ -36,10 +36,10 @@ from __future__ import annotations
 import math
 from functools import lru_cache
 
-import numba
 import numpy as np
 
 from steerlab.environment.channels import W_YAW_MOMENT
+from steerlab.jit.numba_stamped import numba
 from steerlab.records import Field as RecordField
 from steerlab.records import Layout
 from steerlab.ships.kinematics import planar_start

@@ -56,13 +56,13 @@ from functools import lru_cache
 from importlib import resources
 from typing import Literal, Optional
 
-import numba
 import numpy as np
 from pydantic import Field, ValidationError, field_validator
 
 from steerlab.config_base import FrozenConfig
 from steerlab.environment.channels import (W_CURRENT_E, W_CURRENT_N, W_WIND_DIR,
                                            W_WIND_SPEED, W_YAW_MOMENT)
+from steerlab.jit.numba_stamped import numba
 from steerlab.environment.wind_fujiwara import (RHO_AIR, WindGeometry, fujiwara_coefficients,
                                                 air_velocity_arith, wind_force_arith)
 from steerlab.errors import InputError

@@ -51,13 +51,13 @@ from functools import lru_cache
 from importlib import resources  # noqa: F401 (the data folder; tests read it through this module)
 from typing import Literal, Optional
 
-import numba
 import numpy as np
 from pydantic import Field, ValidationError
 
 from steerlab.config_base import FrozenConfig
 from steerlab.environment.channels import W_YAW_MOMENT
 from steerlab.errors import InputError
+from steerlab.jit.numba_stamped import numba
 from steerlab.records import Field as RecordField
 from steerlab.records import Layout
 from steerlab.ships.kinematics import planar_start

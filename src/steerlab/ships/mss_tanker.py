@@ -47,7 +47,6 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-import numba
 import numpy as np
 from pydantic import Field
 
@@ -56,6 +55,7 @@ from pydantic import field_validator
 from steerlab.config_base import FrozenConfig
 from steerlab.environment.channels import W_YAW_MOMENT
 from steerlab.errors import InputError
+from steerlab.jit.numba_stamped import numba
 from steerlab.records import Field as RecordField
 from steerlab.records import Layout
 from steerlab.ships.kinematics import planar_start

@@ -22,12 +22,12 @@ In a scenario::
 from __future__ import annotations
 
 
-import numba
 import numpy as np
 from pydantic import Field, field_validator
 
 from steerlab.config_base import FrozenConfig
 from steerlab.environment.channels import W_RUDDER
+from steerlab.jit.numba_stamped import numba
 from steerlab.records import Field as RecordField
 from steerlab.records import Layout
 from steerlab.ships.kinematics import earth_velocity

@@ -20,9 +20,9 @@ from __future__ import annotations
 
 import math
 
-import numba
 import numpy as np
 
+from steerlab.jit.numba_stamped import numba
 from steerlab.records import Field, Layout
 
 MAX_SCHEDULE = 256

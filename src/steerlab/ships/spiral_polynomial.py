@@ -15,7 +15,7 @@ steerlab kernels ``r`` is in rad/s.
 
 from __future__ import annotations
 
-import numba
+from steerlab.jit.numba_stamped import numba
 import numpy as np
 
 

@@ -75,12 +75,12 @@ from functools import lru_cache
 from pathlib import Path
 from typing import Literal, NamedTuple, Optional
 
-import numba
 import numpy as np
 from pydantic import Field, model_validator
 
 from steerlab.config_base import FrozenConfig
 from steerlab.environment.channels import W_RUDDER, W_YAW_RATE
+from steerlab.jit.numba_stamped import numba
 from steerlab.records import Field as RecordField
 from steerlab.records import Layout
 from steerlab.ships.kinematics import earth_velocity

@@ -33,10 +33,9 @@ from __future__ import annotations
 import types
 from functools import lru_cache
 
-import numba
-
 from steerlab.guidance.reference_models import course_guide
 from steerlab.jit.dispatch import is_dispatcher, supported_options
+from steerlab.jit.numba_stamped import numba
 
 @lru_cache(maxsize=None)
 def _fuse_options() -> dict:

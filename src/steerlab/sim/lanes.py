@@ -226,6 +226,7 @@ def _report(ship_rhs, ctrl_update, guide, nx: int, lanes: int, name: str, not_co
     from steerlab.jit.drivers import cached_signatures, driver, in_memory_twin
     from steerlab.jit.loop_calls import bound
     from steerlab.jit.vector_reports import report_from_ir, stored
+    from steerlab.sincos import VECTORISED_MARKER
 
     ship_rhs, ctrl_update, guide = bound(ship_rhs, ctrl_update, guide)
     disp = getattr(driver(ship_rhs, ctrl_update, guide, nx, lanes), name)
@@ -240,4 +241,4 @@ def _report(ship_rhs, ctrl_update, guide, nx: int, lanes: int, name: str, not_co
         for sig in sigs:
             twin.compile(sig)
         disp = twin
-    return report_from_ir("\n".join(disp.inspect_llvm().values()))
+    return report_from_ir("\n".join(disp.inspect_llvm().values()), VECTORISED_MARKER)

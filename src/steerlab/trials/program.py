@@ -29,13 +29,13 @@ from __future__ import annotations
 import math
 from typing import Literal, Optional
 
-import numba
 import numpy as np
 from pydantic import Field
 
 from steerlab.config_base import FrozenConfig
 from steerlab.control.registry import ControllerSpec
 from steerlab.errors import InputError
+from steerlab.jit.numba_stamped import numba
 from steerlab.trials.rate_hold import pack_rate_hold, rate_hold_gains, rate_hold_update
 from steerlab.trials.rudder_schedule import pack_schedule, schedule_update
 from steerlab.trials.zigzag_logic import pack_zigzag, zigzag_update

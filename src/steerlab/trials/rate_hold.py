@@ -21,9 +21,9 @@ from __future__ import annotations
 
 import math
 
-import numba
 import numpy as np
 
+from steerlab.jit.numba_stamped import numba
 from steerlab.ships.state import IR
 
 R_KP, R_KI, R_UMAX, R_N, R_TABLE = 1, 2, 3, 4, 5

@@ -15,7 +15,7 @@ ideal rudder of ``--no-gear``) turns it into the rudder angle.
 
 from __future__ import annotations
 
-import numba
+from steerlab.jit.numba_stamped import numba
 import numpy as np
 
 S_N = 1

@@ -19,10 +19,10 @@ every controller sample, so the switch lags the crossing by at most one sample).
 
 from __future__ import annotations
 
-import numba
 import numpy as np
 
 from steerlab.angles import wrap_to_pi
+from steerlab.jit.numba_stamped import numba
 from steerlab.ships.state import IPSI
 
 Z_T0, Z_DELTA, Z_PSI_S, Z_PSI0 = 1, 2, 3, 4
