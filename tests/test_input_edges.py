@@ -215,6 +215,54 @@ def test_a_python_result_says_whether_it_can_be_reported(tmp_path):
     assert bad.time == pytest.approx(5.7) and bad.what.startswith("v = nan") and "validity range" in bad.hint
 
 
+@pytest.mark.parametrize("toml, line", [
+    ("duration = nan\n", "duration: Input should be a finite number (allowed: gt 0.0, le 1000000.0)"),
+    ("[ship]\nspeed_kn = inf\n", "ship.speed_kn: Input should be a finite number (allowed: ge 0.01, le 40.0)"),
+    ("[gear]\nT_sg = -inf\n", "gear.T_sg: Input should be a finite number (allowed: ge 0.001, le 100.0)"),
+    ("[guidance]\nchanges = [{ t = 10.0, psi_deg = nan }]\n",
+     "guidance.changes.0.psi_deg: Input should be a finite number (allowed: ge -360.0, le 360.0)"),
+    ('[controller]\ntype = "pid"\nKp = nan\n',
+     "controller.Kp: Input should be a finite number (allowed: ge 0.0, le 10000.0)"),
+], ids=["duration", "speed", "gear", "guidance-list", "controller"])
+def test_a_nan_or_inf_names_the_fields_allowed_range(toml, line):
+    """pydantic refuses NaN and inf before it compares with the bounds, so its message gave none;
+    the line now names the range declared on the field (nested tables, lists, the controller's
+    own config)."""
+    with pytest.raises(InputError) as e:
+        scenario_from_dict(__import__("tomllib").loads(toml))
+    assert str(e.value) == line
+
+
+@pytest.mark.parametrize("text", ["", "# only a comment\n\n"], ids=["empty", "comments-only"])
+def test_a_scenario_file_that_sets_nothing_is_refused(tmp_path, capsys, text):
+    """An empty file ran a 3000 s run of the built-in defaults with every metric 0, silently."""
+    p = _write(tmp_path, text)
+    assert main(["run", str(p), "--out", str(tmp_path / "o"), "--quiet"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("steerlab: error: scenario: s.toml sets nothing") and len(err.splitlines()) == 1
+    assert not (tmp_path / "o").exists()
+
+
+def test_a_spin_before_an_overflow_is_reported_as_the_spin():
+    """An open-loop course-unstable ship (Nomoto K 0.1 1/s, T -5 s, zero gains) spins from
+    about t = 50 s and its state overflows minutes later: the report names the spin and when it
+    began (the cause), and says when the state left the finite numbers; it blamed the step."""
+    from steerlab.sim.divergence import divergence
+    from steerlab.sim.engine import simulate
+
+    setup = build(scenario_from_dict({
+        "dt": 0.1, "duration": 600.0, "ship": {"model": "nomoto1", "speed_kn": 12.0, "options": {"K": 0.1, "T": -5.0}},
+        "controller": {"type": "pid", "Kp": 0.0, "Kd": 0.0, "Ki": 0.0},
+        "guidance": {"psi0_deg": 0.0, "changes": [{"t": 50.0, "psi_deg": 20.0}]}, "environment": {"waves": True}}))
+    res = simulate(setup)
+    assert not np.isfinite(res.states).all()          # the case: it does overflow, later
+    err = divergence(res, setup)
+    assert "the ship spun" in err.what and err.time < 120.0
+    assert "left the finite numbers at t = " in err.what and "controller does not suit" in err.hint
+    first_bad = res.time[np.argmax(~np.isfinite(res.states).all(axis=1))]
+    assert first_bad > err.time + 60.0
+
+
 def test_kosoko_at_10_kn_diverges_and_says_so(tmp_path):
     """The issue's case: catalogued 0.1-2.9 kn, run at 10 kn with dt 0.5 s; it exited 0 with metrics."""
     out = tmp_path / "o"

@@ -10,7 +10,8 @@ and on-line accumulators of a batch:
   (time and state) raises :class:`~steerlab.errors.DivergedError`; so does a *spin*, the
   heading leaving its reference by more than a full turn,
   ``max_t |unwrap(psi - psi_ref)| > 2 pi`` (a closed loop that is unstable on this ship: the
-  heading error wraps, so its metrics would look bounded);
+  heading error wraps, so its metrics would look bounded). A spin that began before the first
+  non-finite sample is the one reported (the cause), with the time the state overflowed;
 * :func:`diverged_rows` (batches): a run whose final state or on-line accumulator is not
   finite. Sweeps treat such runs as failed (no metrics, infinite cost).
 """
@@ -57,19 +58,25 @@ def divergence(result, setup=None) -> Optional[DivergedError]:
     """
     X = result.states
     bad = ~np.isfinite(X)
-    if bad.any():
-        k, j = np.argwhere(bad)[0]
+    first_bad = int(np.argmax(bad.any(axis=1))) if bad.any() else X.shape[0]
+    # a spin among the finite samples comes first: a ship that spun for minutes before its
+    # state overflowed diverged because the loop is unstable, not because of the step
+    off = np.abs(np.unwrap(result.psi[:first_bad] - result.psi_ref[:first_bad]))
+    if off.size and float(off.max()) > SPIN_LIMIT:
+        k = int(np.argmax(off > SPIN_LIMIT))
+        later = (f" (its state left the finite numbers at t = {float(result.time[first_bad]):g} s)"
+                 if first_bad < X.shape[0] else "")
+        return DivergedError(float(result.time[k]), "the ship spun: its heading left the reference by more "
+                             f"than a full turn{later}", "the closed loop is unstable: the controller does not "
+                             "suit this ship (check its design model and gains); for open-loop turns use "
+                             "'steerlab trial'" + (f"; or {likely_cause(setup)[len('likely cause: '):]}"
+                                                  if later and setup is not None else ""))
+    if first_bad < X.shape[0]:
+        k, j = first_bad, int(np.argmax(bad[first_bad]))
         name = result.state_names[j] if j < len(result.state_names) else f"state {j}"
         hint = likely_cause(setup) if setup is not None else ("likely cause: a speed outside the ship's "
                                                                 "validity range, or a dt too large for the model")
         return DivergedError(float(result.time[k]), f"{name} = {float(X[k, j])!r}", hint)
-    off = np.abs(np.unwrap(result.psi - result.psi_ref))
-    if off.size and float(off.max()) > SPIN_LIMIT:
-        k = int(np.argmax(off > SPIN_LIMIT))
-        return DivergedError(float(result.time[k]), "the ship spun: its heading left the reference by more "
-                             "than a full turn", "the closed loop is unstable: the controller does not suit "
-                             "this ship (check its design model and gains); for open-loop turns use "
-                             "'steerlab trial'")
     return None
 
 

@@ -294,7 +294,50 @@ def _tag_message(error: Mapping[str, Any]) -> str:
     return f"unknown type {ctx.get('tag')!r}; known: {known}"
 
 
-def _format_validation_error(err: ValidationError) -> InputError:
+def _field_bounds(model: Any, loc: list, data: Any = None) -> list[str]:
+    """The declared bounds (``gt 0.0``, ``le 1000000.0``) of the field at ``loc`` in the pydantic
+    ``model`` (nested models, optional and list fields followed; list indices skipped; the
+    ``[controller]`` table's config found by its ``type`` in ``data``, the input), for the
+    error line of a value pydantic refused before it compared it with them (NaN, inf). Empty
+    if the field is not found or declares none."""
+    field = None
+    for part in loc:
+        if isinstance(part, int):
+            continue
+        fields = getattr(model, "model_fields", None)
+        if not isinstance(fields, dict) or part not in fields:
+            return []
+        field = fields[part]
+        model = next((a for a in _annotation_types(field.annotation) if hasattr(a, "model_fields")), None)
+        table = data.get(part) if isinstance(data, dict) else None
+        if model is None and part == "controller" and isinstance(table, dict) and isinstance(table.get("type"), str):
+            try:                                          # the config its type names (_controller_config)
+                spec = CONTROLLERS.find(table["type"])
+            except InputError:
+                return []
+            model = spec.config if spec is not None else None
+        data = table
+    if field is None:
+        return []
+    out = []
+    for m in field.metadata:
+        out += [f"{k} {getattr(m, k)}" for k in ("gt", "ge", "lt", "le") if getattr(m, k, None) is not None]
+    return out
+
+
+def _annotation_types(annotation: Any) -> list:
+    """``annotation`` and the types inside it (``Optional[X]``, ``list[X]``, ``tuple[X, ...]``)."""
+    import typing
+
+    out, todo = [], [annotation]
+    while todo:
+        a = todo.pop()
+        out.append(a)
+        todo.extend(x for x in typing.get_args(a) if x is not Ellipsis)
+    return out
+
+
+def _format_validation_error(err: ValidationError, data: Any = None) -> InputError:
     first = err.errors()[0]
     if first["type"] == _REGISTRY_ERROR:                     # raised as it was, with its own field
         return InputError(first["ctx"]["field"], first["ctx"]["message"])
@@ -302,6 +345,8 @@ def _format_validation_error(err: ValidationError) -> InputError:
     msg = first["msg"]
     ctx = first.get("ctx") or {}
     bounds = [f"{k.replace('_', ' ')} {v}" for k, v in ctx.items() if k in ("gt", "ge", "lt", "le")]
+    if not bounds and first["type"] == "finite_number":      # NaN/inf: pydantic names no range
+        bounds = _field_bounds(Scenario, [p for p in first["loc"] if not _is_union_member_tag(p)], data)
     if bounds:
         msg += f" (allowed: {', '.join(bounds)})"
     if first["type"] in ("union_tag_invalid", "union_tag_not_found"):
@@ -318,14 +363,15 @@ def scenario_from_dict(data: dict) -> Scenario:
     try:
         return Scenario.model_validate(data)
     except ValidationError as err:
-        raise _format_validation_error(err) from None
+        raise _format_validation_error(err, data) from None
 
 
 MAX_SCENARIO_BYTES = 16 << 20   #: largest scenario file [bytes]
 
 
 def load_scenario(path: str | os.PathLike[str]) -> Scenario:
-    """Load and validate a scenario TOML file; raises :class:`InputError` on any problem.
+    """Load and validate a scenario TOML file; raises :class:`InputError` on any problem,
+    also when the file sets nothing (empty, or comments only).
 
     The file is read as bytes and decoded strictly (:func:`steerlab.textfile.read_user_text`:
     regular file, at most 16 MiB, no NUL, valid UTF-8) and parsed with bounded nesting
@@ -336,6 +382,9 @@ def load_scenario(path: str | os.PathLike[str]) -> Scenario:
 
     p = Path(path)
     data = parse_toml(read_user_text(p, "scenario", MAX_SCENARIO_BYTES), "scenario", p.name)
+    if not data:       # every field has a default, but a file without one is a mistake, not a scenario
+        raise InputError("scenario", f"{p.name} sets nothing (an empty file or comments only): give at least "
+                         "[ship] and [controller] (examples/scenarios/), or no file for the bundled default")
     g = data.get("guidance") if isinstance(data, dict) else None
     if isinstance(g, dict) and isinstance(g.get("route_file"), str) and not Path(g["route_file"]).is_absolute():
         g["route_file"] = str(p.parent / g["route_file"])     # relative to the scenario file
