@@ -59,6 +59,27 @@ def test_los_follows_a_dogleg_and_switches_at_the_acceptance_circle():
     assert abs(x[-1] - 2000.0) < 5.0
 
 
+def test_a_route_run_has_no_step_metrics_and_a_course_change_keeps_them():
+    """On a route the set heading moves with the cross-track error and turns at each waypoint:
+    a dogleg reported an overshoot of several hundred per cent of the last small correction and
+    took the turns for the sea's yaw. Those are n/a (None) on a route; the route's indices judge
+    it. The same ship and law with a course change keeps its step metrics."""
+    from steerlab.metrics import compute_metrics
+
+    route = compute_metrics(simulate(los_scenario(duration=1400.0, start=[0.0, 0.0],
+                                                  route=[[0.0, 0.0], [2000.0, 0.0], [2000.0, 3000.0]],
+                                                  accept_radius_m=200.0)))
+    step_keys = ("overshoot_deg", "overshoot_pct", "rise_time_s", "settling_time_2pct_s", "settling_time_1deg_s",
+                 "wave_yaw_std_deg", "step_lowpass_s")
+    assert all(route[k] is None for k in step_keys)
+    assert route["time_on_route_s"] > 0.0 and route["max_abs_xte_m"] > 0.0 and route["iae_deg_s"] > 0.0
+    change = compute_metrics(simulate(scenario_from_dict({
+        "dt": 0.5, "duration": 600.0, "ship": LOS_SHIP, "controller": LOS_PD,
+        "guidance": {"psi0_deg": 0.0, "changes": [{"t": 10.0, "psi_deg": 20.0}]}})))
+    assert change["overshoot_pct"] is not None and change["settling_time_1deg_s"] is not None
+    assert "max_abs_xte_m" not in change
+
+
 def test_los_parity_readable_compiled_and_batch():
     sc = los_scenario(duration=150.0)
     a = simulate(sc, "compiled")

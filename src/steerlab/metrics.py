@@ -184,16 +184,28 @@ def step_metrics_in_waves(time, psi, psi_ref) -> dict:
 
 
 def compute_metrics(res, lam: float = 0.1) -> dict:
-    """All indices of a recorded :class:`~steerlab.sim.result.Result` (JSON-ready dict)."""
+    """All indices of a recorded :class:`~steerlab.sim.result.Result` (JSON-ready dict).
+
+    A run that follows a route (LOS or berthing guidance) has no set-point step: its step
+    metrics (overshoot, rise and settling times) and the sea's wave yaw are ``None`` ("n/a"),
+    and the route's indices (:func:`steerlab.guidance.route_metrics.route_metrics`) judge it."""
     acc = res.meta.get("online_metrics")
     if acc is None:
         acc = online_metrics_from_result(res)
     m = integral_metrics(acc, lam)
-    m.update(step_metrics_in_waves(res.time, res.psi, res.psi_ref))
+    route = route_metrics(res)                # LOS / berthing runs only
+    step = step_metrics_in_waves(res.time, res.psi, res.psi_ref)
+    if route:
+        # the set heading moves with the cross-track error and turns at every waypoint: there is
+        # no set-point step to judge (an "overshoot" of several hundred per cent of the last
+        # small correction), and the sea's yaw cannot be told from the turns; n/a, and the
+        # route's own indices (cross-track error, time on route) judge the run
+        step = dict.fromkeys(step)
+    m.update(step)
     m["final_error_deg"] = float(res.heading_error[-1] * R2D)
     m["max_abs_rudder_deg"] = float(np.max(np.abs(res.delta)) * R2D)
     if "u" in res.state_names:
         speed = np.hypot(res.col("u"), res.col("v"))
         m["min_speed_kn"] = float(np.min(speed) / (1852.0 / 3600.0))
-    m.update(route_metrics(res))              # LOS / berthing runs only
+    m.update(route)
     return {k: (float(v) if isinstance(v, (np.floating,)) else v) for k, v in m.items()}
