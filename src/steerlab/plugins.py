@@ -394,8 +394,21 @@ class Registry(Mapping[str, S]):
         :attr:`field` that lists the known names."""
         spec = self.find(name)
         if spec is None:
-            raise InputError(self.field, f"unknown {self.kind} {name!r}; known {self.kind}s: {sorted(self)}")
+            raise InputError(self.field, self._unknown(name))
         return spec
+
+    def _unknown(self, name: object) -> str:
+        """The message for an unknown name: the close names first, where the whole list is
+        printed, then the list (a long line is cut at its end by the command line, so what
+        matters comes first)."""
+        import difflib
+
+        names = sorted(self)
+        close = difflib.get_close_matches(str(name), names, n=3, cutoff=0.6)
+        hint = f" (did you mean {' or '.join(map(repr, close))}?)" if close else ""
+        lister = {"ship": "steerlab ships", "controller": "steerlab controllers"}.get(self.kind)
+        where = f" (`{lister}` prints them)" if lister else ""
+        return f"unknown {self.kind} {name!r}{hint}; known {self.kind}s{where}: {', '.join(names)}"
 
 
 def register_module(ref: str, replace: bool = False) -> list:
