@@ -3,9 +3,10 @@
 from __future__ import annotations
 
 EXAMPLES = """examples:
-  steerlab identify examples/data/zigzag.csv --model nomoto1
+  steerlab identify examples/data/trials.csv --model norrbin          # spiral + steps: a good fit
   steerlab identify examples/data/trials.csv --model norrbin --json
   steerlab identify examples/data/zigzag.csv --model nomoto2 --out out/fit   # fit.json + fit.png
+      (the Esso loses half its speed in that zig-zag: no constant-speed model fits it, BAD FIT)
 
 record columns (CSV with a header; see docs/ships.md):
   time [s] | rudder [deg] | heading [deg] and/or yaw_rate [deg/s] | speed [kn] or [m/s] (optional)
