@@ -96,8 +96,10 @@ def test_malformed_toml(tmp_path, capsys):
 
 
 def test_missing_file(tmp_path, capsys):
-    assert main(["run", str(tmp_path / "nope.toml"), "--out", str(tmp_path / "o")]) == 2
-    assert "cannot read" in capsys.readouterr().err
+    """The path as given: a missing file is often a wrong folder, which the name alone hides."""
+    missing = tmp_path / "scenarios" / "nope.toml"
+    assert main(["run", str(missing), "--out", str(tmp_path / "o")]) == 2
+    assert f"cannot read {str(missing)!r}: No such file or directory" in capsys.readouterr().err
 
 
 def test_existing_out_keeps_old_files_on_failure(tmp_path):

@@ -27,8 +27,8 @@ def read_user_text(path, field: str, max_bytes: int = 16 * MIB) -> str:
     p = Path(path)
     try:
         st = os.stat(p)
-    except OSError as err:
-        raise InputError(field, f"cannot read {p.name!r}: {err.strerror}") from None
+    except OSError as err:          # the path as given: a missing file is often a wrong folder
+        raise InputError(field, f"cannot read {str(p)!r}: {err.strerror}") from None
     except ValueError:              # a NUL in the path
         raise InputError(field, f"the path {str(p)[:80]!r} contains a NUL byte") from None
     if stat.S_ISDIR(st.st_mode):
@@ -41,7 +41,7 @@ def read_user_text(path, field: str, max_bytes: int = 16 * MIB) -> str:
         with open(p, "rb") as f:
             data = f.read(max_bytes + 1)
     except OSError as err:
-        raise InputError(field, f"cannot read {p.name!r}: {err.strerror}") from None
+        raise InputError(field, f"cannot read {str(p)!r}: {err.strerror}") from None
     if len(data) > max_bytes:
         raise InputError(field, f"{p.name}: more than {max_bytes} bytes; at most {max_bytes} bytes allowed")
     nul = data.find(b"\x00")
