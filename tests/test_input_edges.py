@@ -358,3 +358,15 @@ def test_montecarlo_leaves_diverged_runs_out_and_flags_them():
     assert res.diverged.tolist() == [False, True, False] and res.n_diverged == 1
     assert np.isnan(res.per_run["iae_deg_s"][1]) and np.isfinite(res.per_run["iae_deg_s"][[0, 2]]).all()
     assert res.stats["iae_deg_s"]["n"] == 2 and res.stats["iae_deg_s"]["n_undefined"] == 1
+
+
+def test_a_bad_runs_count_is_the_only_line_not_after_a_design_warning(tmp_path, capsys):
+    """``montecarlo --runs -5`` on a scenario whose design warns (ADRC without the wave filter in
+    a sea): the option's error alone, before any set-up; it came after the design's warning."""
+    p = _write(tmp_path, '[controller]\ntype = "adrc"\n[environment.wave]\nmodel = "spectrum"\n'
+                         'spectrum = "jonswap"\nsea_state = 5\n')
+    assert main(["run", str(p), "--out", str(tmp_path / "r"), "--quiet"]) == 0
+    assert "chases the wave yaw" in capsys.readouterr().err      # the case: its design does warn
+    assert main(["montecarlo", str(p), "--runs", "-5", "--out", str(tmp_path / "o")]) == 2
+    assert capsys.readouterr().err.strip() == "steerlab: error: --runs: must be in [2, 100000], got -5"
+    assert not (tmp_path / "o").exists()

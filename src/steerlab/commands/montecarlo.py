@@ -43,10 +43,10 @@ def cmd_montecarlo(args) -> int:
     scenario = load_scenario(args.scenario)
     from steerlab.commands._guard import design_checked
 
-    from steerlab.sweeps.montecarlo import MAX_RUNS, check_montecarlo_memory
+    from steerlab.sweeps.montecarlo import check_montecarlo_memory, check_runs
 
-    if 2 <= args.runs <= MAX_RUNS:            # (out of range: run_montecarlo names --runs)
-        check_montecarlo_memory(scenario, args.runs, args.record_every, args.max_memory)   # before any set-up
+    check_runs(args.runs)                     # the options first: no design warning before their error
+    check_montecarlo_memory(scenario, args.runs, args.record_every, args.max_memory)   # before any set-up
     design_checked(scenario, args.max_memory)
     executor = executor_from_args(args)
     try:

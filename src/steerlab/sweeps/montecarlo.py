@@ -136,6 +136,14 @@ def check_montecarlo_memory(scenario, n_runs: int, record_every: int | None = No
     return record_every
 
 
+def check_runs(n_runs) -> int:
+    """``n_runs`` as an int, or :class:`InputError` naming ``--runs`` and its range [2, MAX_RUNS]."""
+    n = int(n_runs)
+    if not (2 <= n <= MAX_RUNS):
+        raise InputError("--runs", f"must be in [2, {MAX_RUNS}], got {n}")
+    return n
+
+
 def run_montecarlo(scenario, n_runs: int, lam: float = 0.1, record_every: int | None = None,
                    executor=None, progress=None, max_memory: float | None = None) -> MonteCarloResult:
     """Run the scenario over ``n_runs`` seeds (see the module docstring).
@@ -146,9 +154,7 @@ def run_montecarlo(scenario, n_runs: int, lam: float = 0.1, record_every: int | 
     on the chunking (runs are independent; seed ``scenario.seed + i`` for run ``i``).
     """
     say = progress or (lambda msg: None)
-    n_runs = int(n_runs)
-    if not (2 <= n_runs <= MAX_RUNS):
-        raise InputError("--runs", f"must be in [2, {MAX_RUNS}], got {n_runs}")
+    n_runs = check_runs(n_runs)
     if not (math.isfinite(lam) and lam >= 0):
         raise InputError("--lambda", f"must be a finite number >= 0, got {lam}")
     sensors = scenario.sensors
