@@ -263,3 +263,24 @@ def test_cli_ships_list_and_show():
     assert d["catalogue"]["rows"][0][1] == 1.2322
     bad = _cli("ships", "show", "no-such-ship")
     assert bad.returncode == 2 and "ship.model" in bad.stderr and bad.stdout == ""
+
+
+def test_every_ship_shows_the_record_its_equations_use():
+    """``ships show`` promises "parameters with units": every ship, built-in or catalogued, shows
+    the record ``pack`` makes at its design speed, one row per field of the ship's layout (name,
+    SI unit, meaning), finite; the values are the kernel's (the Nomoto 1 example ship's K and T,
+    the Esso's propeller rate from its Table 1)."""
+    from steerlab.commands.ships import show
+    from steerlab.ships.registry import SHIPS
+
+    for name in sorted(SHIPS):
+        spec = SHIPS[name]
+        record = show(name)["record"]
+        assert [r["name"] for r in record] == list(spec.params.names), name
+        assert all(np.isfinite(r["value"]) and r["unit"] and r["description"] for r in record), name
+    nomoto = {r["name"]: r for r in show("nomoto1")["record"]}
+    assert (nomoto["K"]["value"], nomoto["K"]["unit"]) == (SHIPS["nomoto1"].options(None).K, "1/s")
+    esso = {r["name"]: r["value"] for r in show("esso")["record"]}
+    assert esso["n"] == pytest.approx(80.0 / 60.0, rel=1e-3)
+    text = _cli("ships", "show", "esso")
+    assert text.returncode == 0 and "record at the design speed" in text.stdout and "rev/s" in text.stdout

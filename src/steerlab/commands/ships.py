@@ -72,7 +72,24 @@ def show(ship_id: str) -> dict:
     if spec.options_model is not None:
         d["options"] = [{"name": k, "default": f.default, "description": f.description or ""}
                         for k, f in spec.options_model.model_fields.items()]
+    if spec.params is not None:
+        d["record"] = record_at_design_speed(spec)
     return d
+
+
+def record_at_design_speed(spec) -> list[dict]:
+    """The ship record its kernel reads, as ``pack`` makes it at the design speed with the
+    default options: ``[{"name", "value", "unit", "description"}]`` in SI units, from the
+    ship's :class:`~steerlab.records.Layout` (the values the equations use, which for some
+    models are derived from the source's: e.g. divided through by a mass term)."""
+    import numpy as np
+
+    values = np.asarray(spec.pack(spec.design_speed, None, spec.options(None)), dtype=float)
+    layout = spec.params
+    if values.shape != (layout.size,):
+        raise ValueError(f"ship {spec.name!r}: pack made {values.shape[0]} values, its layout has {layout.size}")
+    return [{"name": f.name, "value": float(v), "unit": f.unit, "description": f.doc}
+            for f, v in zip(layout.fields, values)]
 
 
 def _print_list(rows):
@@ -114,6 +131,13 @@ def _print_show(d):
             say("vessel notes", cat["vessel_notes"])
     for o in d.get("options", []):
         say(f"option {o['name']} = {o['default']!r}", o["description"])
+    record = d.get("record")
+    if record:
+        print(f"  record at the design speed (the values its equations use, SI):")
+        table = render_table(("name", "value", "unit", "what"),
+                             ((r["name"], f"{r['value']:.6g}", r["unit"], r["description"]) for r in record),
+                             align="lrll", width=width - 2)
+        print("\n".join("    " + line for line in table.splitlines()))
 
 
 def run(args) -> int:

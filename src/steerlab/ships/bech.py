@@ -156,7 +156,7 @@ def _spec():
         name="bech",
         description="Bech nonlinear second-order ship, a, b, T3, c0..c3 (SI) from [ship.options]",
         rhs=bech_rhs, n_states=N_STATES, state_names=STATE_NAMES, state_units=STATE_UNITS,
-        pack=pack, b2_exact=lambda speed, options=None: b2_of(packed(options)),
+        pack=pack, params=PARAMS, b2_exact=lambda speed, options=None: b2_of(packed(options)),
         dims=(0.8, d.L, d.L / 6.5),
         source="Bech & Wagner Smitt (1969); van Amerongen (1982) Sec. 2.3.2",
         options_model=BechOptions,

@@ -86,9 +86,9 @@ FORMS = {
 """How each published form maps onto a kernel (see the data files' ``form``)."""
 
 _KERNELS = {
-    "nomoto1": (nomoto1.nomoto1_rhs, 6, PLANAR_NAMES, PLANAR_UNITS),
-    "norrbin": (norrbin.norrbin_rhs, 6, PLANAR_NAMES, PLANAR_UNITS),
-    "bech": (bech.bech_rhs, 7, STATE_NAMES_2, STATE_UNITS_2),
+    "nomoto1": (nomoto1.nomoto1_rhs, 6, PLANAR_NAMES, PLANAR_UNITS, nomoto1.PARAMS),
+    "norrbin": (norrbin.norrbin_rhs, 6, PLANAR_NAMES, PLANAR_UNITS, norrbin.PARAMS),
+    "bech": (bech.bech_rhs, 7, STATE_NAMES_2, STATE_UNITS_2, bech.PARAMS),
 }
 
 
@@ -235,7 +235,7 @@ def _rpm_options(entry: CatalogueEntry):
 def _make_spec(entry: CatalogueEntry):
     from steerlab.ships.ship_traits import TraitShipSpec
 
-    rhs, n_states, names, units = _KERNELS[entry.model]
+    rhs, n_states, names, units, layout = _KERNELS[entry.model]
     model = entry.model
     by_rpm = entry.index == "rpm"
     opts_model = _rpm_options(entry) if by_rpm else None
@@ -290,7 +290,7 @@ def _make_spec(entry: CatalogueEntry):
                        f"the eq-29 b2 estimate is unavailable; use c0 = \"exact\" or a number")
     return TraitShipSpec(
         name=entry.id, description=f"{entry.vessel}: {entry.model} ({entry.table})",
-        rhs=rhs, n_states=n_states, state_names=names, state_units=units, pack=pack,
+        rhs=rhs, n_states=n_states, state_names=names, state_units=units, pack=pack, params=layout,
         b2_exact=b2_exact, dims=dims, source=f"{entry.source}; {entry.table}",
         options_model=opts_model, nomoto_KT=nomoto_KT, speed_range=speed_range,
         equilibrium_rudder=eq_rudder, symmetric=symmetric, catalogue=entry.describe(),

@@ -362,6 +362,7 @@ def _spec():
         description="High-speed container ship (L = 175 m) with roll, Son & Nomoto (1981) as in MSS container.m "
                     "(4 DOF: surge, sway, roll, yaw; propeller and rudder model; shaft rate held)",
         rhs=container_rhs, n_states=N_STATES, state_names=STATE_NAMES, state_units=STATE_UNITS, pack=spec_pack,
+        params=PARAMS,
         b2_exact=lambda speed: float(linearise(speed)[1][1]), dims=(math.nan, L_CONTAINER, B_CONTAINER),
         source="Son & Nomoto, J. Soc. Nav. Arch. Japan 150 (1981); Naval Arch. Ocean Eng. 20 (1982) 73-83, "
                "as in Fossen's MSS VESSELS/container.m and Lcontainer.m (Fossen 2021, App. D)",

@@ -186,7 +186,7 @@ def _spec():
         description="De Keizer / van Amerongen multivariable model: Norrbin-type yaw with U/L scaling, "
                     "speed loss in turns and thrust dynamics (thesis 2.3.5)",
         rhs=de_keizer_rhs, n_states=N_STATES, state_names=STATE_NAMES, state_units=STATE_UNITS,
-        pack=pack, b2_exact=b2_exact, dims=(0.7, d.L, d.L / 6.5),
+        pack=pack, params=PARAMS, b2_exact=b2_exact, dims=(0.7, d.L, d.L / 6.5),
         source="van Amerongen (1982) Sec. 2.3.5, eqs (2.41)-(2.43), Figs. 2.10-2.11 (reconstructed; see docstring)",
         options_model=DeKeizerOptions, nomoto_KT=nomoto_KT)]
 

@@ -230,7 +230,7 @@ def _ship_specs():
         name="esso",
         description="Esso Bernicia 190 kdwt tanker, 3-DOF nonlinear (Zwierzewicz et al. 2021, Table 2)",
         rhs=esso_rhs, n_states=N_PLANAR, state_names=PLANAR_NAMES, state_units=PLANAR_UNITS,
-        pack=_spec_pack, b2_exact=_spec_b2, dims=(t.c_B, t.L, t.B),
+        pack=_spec_pack, params=PARAMS, b2_exact=_spec_b2, dims=(t.c_B, t.L, t.B),
         source="Zwierzewicz, Dorobczynski, Artyszuk, Energies 14 (2021) 7937, Sec. 3.1",
         linearise=linearise, service_speed=knots_to_ms(16.0))]   # Table 1: 16 kn service speed
 

@@ -204,7 +204,7 @@ def _spec():
         name="mss-mariner",
         description="Mariner class vessel (L = 160.93 m), Chislett & Strom-Tejsen (1965) PMM model as in MSS mariner.m",
         rhs=mariner_rhs, n_states=N_PLANAR, state_names=PLANAR_NAMES, state_units=PLANAR_UNITS,
-        pack=lambda speed, rpm=None, options=None: pack(speed),
+        pack=lambda speed, rpm=None, options=None: pack(speed), params=PARAMS,
         b2_exact=lambda speed: float(linearise(speed)[1][1]), dims=(math.nan, L_MARINER, B_MARINER),
         source="Chislett & Strom-Tejsen, Hydro- and Aerodynamics Laboratory Lyngby Report Hy-6 (1965), "
                "as in Fossen's MSS VESSELS/mariner.m and Fossen (2011) Sec. 7.1",

@@ -523,7 +523,7 @@ def _spec_for(data: MMGShipData):
 
     return ShipSpec(
         name=data.id, description=data.description, rhs=mmg_rhs, n_states=N_PLANAR,
-        state_names=PLANAR_NAMES, state_units=PLANAR_UNITS, pack=spec_pack, b2_exact=b2_exact,
+        state_names=PLANAR_NAMES, state_units=PLANAR_UNITS, pack=spec_pack, params=PARAMS, b2_exact=b2_exact,
         dims=(data.hull.C_b, data.hull.L, data.hull.B), source=data.source, linearise=linearise,
         options_model=MMGOptions, nomoto_KT=nomoto_KT, speed_range=tuple(data.speed_range_m_s),
         service_speed=float(data.design.speed_m_s), kernel_for_options=kernel_for_options,

@@ -441,7 +441,7 @@ def _spec_for(data: MMGStdShipData):
 
     return TraitShipSpec(
         name=data.id, description=data.description, rhs=mmgstd_rhs, n_states=N_PLANAR,
-        state_names=PLANAR_NAMES, state_units=PLANAR_UNITS, pack=spec_pack, b2_exact=b2_exact,
+        state_names=PLANAR_NAMES, state_units=PLANAR_UNITS, pack=spec_pack, params=PARAMS, b2_exact=b2_exact,
         dims=(data.hull.volume / (data.hull.L * data.hull.B * data.hull.d), data.hull.L, data.hull.B),
         source=data.source, linearise=linearise, nomoto_KT=nomoto_KT, speed_range=(lo, hi),
         service_speed=data.service_speed_m_s, model_scale=data.model_scale,

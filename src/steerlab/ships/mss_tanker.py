@@ -332,6 +332,7 @@ def _spec():
         description="Esso Osaka 190 kdwt tanker, original Van Berlekom & Goddard (1972) model as in MSS tanker.m "
                     "(slipstream rudder, thrust(u, n), drift x rudder, propeller side force, shallow water)",
         rhs=tanker_rhs, n_states=N_STATES, state_names=STATE_NAMES, state_units=STATE_UNITS, pack=spec_pack,
+        params=PARAMS,
         b2_exact=lambda speed, options=None: float(linearise(speed, options)[1][1]),
         dims=(c.c_B, c.L, c.B),
         source="Van Berlekom & Goddard, Trans. SNAME 80 (1972) 264-298, as in Fossen's MSS VESSELS/tanker.m",

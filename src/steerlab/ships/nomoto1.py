@@ -90,7 +90,7 @@ def _spec():
         name="nomoto1",
         description="first-order Nomoto ship, K and T from [ship.options] (default K=0.1 1/s, T=50 s)",
         rhs=nomoto1_rhs, n_states=N_PLANAR, state_names=PLANAR_NAMES, state_units=PLANAR_UNITS,
-        pack=pack, b2_exact=b2_exact, dims=(0.8, d.L, d.L / 6.5),
+        pack=pack, params=PARAMS, b2_exact=b2_exact, dims=(0.8, d.L, d.L / 6.5),
         source="Nomoto (1957); van Amerongen (1982) Sec. 2.3.1",
         options_model=Nomoto1Options, nomoto_KT=nomoto_KT)]
 

@@ -127,7 +127,7 @@ def _spec():
         name="nomoto2",
         description="second-order Nomoto ship, K, T1, T2, T3 from [ship.options]",
         rhs=nomoto2_rhs, n_states=N_STATES, state_names=STATE_NAMES, state_units=STATE_UNITS,
-        pack=pack, b2_exact=b2_exact, dims=(0.8, d.L, d.L / 6.5),
+        pack=pack, params=PARAMS, b2_exact=b2_exact, dims=(0.8, d.L, d.L / 6.5),
         source="Nomoto (1957); van Amerongen (1982) Sec. 2.3.1 eq 2.14",
         options_model=Nomoto2Options, nomoto_KT=nomoto_KT)]
 

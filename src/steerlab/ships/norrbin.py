@@ -131,7 +131,7 @@ def _spec():
         name="norrbin",
         description="Norrbin nonlinear ship, K, T, n0..n3 (SI) from [ship.options]",
         rhs=norrbin_rhs, n_states=6, state_names=PLANAR_NAMES, state_units=PLANAR_UNITS,
-        pack=pack, b2_exact=lambda speed, options=None: packed(options)[P_K] / packed(options)[P_T],
+        pack=pack, params=PARAMS, b2_exact=lambda speed, options=None: packed(options)[P_K] / packed(options)[P_T],
         dims=(0.8, d.L, d.L / 6.5),
         source="Norrbin (1963); van Amerongen (1982) Sec. 2.3.3; Morawski & Pomirski eq 12",
         options_model=NorrbinOptions,

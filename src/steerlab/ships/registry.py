@@ -83,6 +83,9 @@ class ShipSpec(PicklesByName):
     #: ``psi' = r + r_w``: for a manoeuvring model whose nonlinear spiral terms are fitted to
     #: steady turns and are not wave-frequency physics; :mod:`steerlab.environment.sea`)
     wave_motion: str = "through-hull"
+    #: the layout of the record ``pack`` makes (:class:`steerlab.records.Layout`: each field's
+    #: name, unit and meaning); ``steerlab ships show`` prints the record at the design speed
+    params: Any = field(default=None, compare=False, repr=False)
     #: ``(function, args)`` that made this spec from another one (:meth:`for_options`): it
     #: pickles as that (:class:`steerlab.plugins.PicklesByName`)
     recipe: tuple | None = field(default=None, compare=False, repr=False)

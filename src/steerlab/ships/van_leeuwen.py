@@ -278,7 +278,7 @@ def _spec_for(ship: VanLeeuwenShip):
 
     return ShipSpec(
         name=ship.name, description=ship.description, rhs=van_leeuwen_rhs, n_states=N_STATES,
-        state_names=STATE_NAMES, state_units=STATE_UNITS, pack=pack, b2_exact=b2_exact,
+        state_names=STATE_NAMES, state_units=STATE_UNITS, pack=pack, params=PARAMS, b2_exact=b2_exact,
         dims=(ship.c_B, ship.L, ship.B), source=ship.source, options_model=Options,
         nomoto_KT=nomoto_KT, speed_range=(0.5, 15.0), equilibrium_rudder=equilibrium_rudder,
         symmetric=lambda speed, options=None: False)
