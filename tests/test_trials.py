@@ -281,3 +281,14 @@ def test_every_ship_runs_a_20_20_zigzag_within_the_gear(ship):
     spec = get_ship(ship)
     limit = rad(2.33) * (1.0 if spec.model_scale is None else math.sqrt(spec.model_scale))
     assert np.max(rate) <= limit * (1.0 + 1e-9)
+
+
+def test_the_spiral_table_writes_each_sign_of_the_cubic_once():
+    """It printed ``-0.00468 + -9.319 r``."""
+    from steerlab.trials.tables import spiral_rows
+
+    m = {"verdict": "unstable", "slope_at_zero_deg_per_deg_s": -8.06, "loop_width_deg": 1.0,
+         "loop_height_deg_s": 0.1, "loop_width_direct_bounds_deg": [0.5, 1.5], "all_steady": True,
+         "cubic_deg": {"c0": -0.00468, "c1": -9.319, "c2": 0.0, "c3": 0.51}}
+    cubic = dict((r[0], r[1]) for r in spiral_rows(m))["cubic delta = H(r)"]
+    assert cubic == "-0.00468 - 9.319 r + 0 r^2 + 0.51 r^3"

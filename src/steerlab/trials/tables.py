@@ -45,6 +45,19 @@ def zigzag_rows(m: dict) -> list[tuple[str, str, str]]:
             ("L/V", _v(m["L_over_V_s"]), "s")]
 
 
+def _polynomial(terms: list[tuple[float, str, str]]) -> str:
+    """``a + b r - c r^2 ...`` from ``(coefficient, format, power)`` terms: each sign written once
+    (``- 9.319 r``, not ``+ -9.319 r``)."""
+    out = ""
+    for i, (value, fmt, power) in enumerate(terms):
+        text = format(abs(value), fmt) + power
+        if i == 0:
+            out = ("-" if value < 0 else "") + text
+        else:
+            out += (" - " if value < 0 else " + ") + text
+    return out
+
+
 def spiral_rows(m: dict) -> list[tuple[str, str, str]]:
     rows = [("verdict", m["verdict"], ""),
             ("reversed-spiral slope at r=0", _v(m["slope_at_zero_deg_per_deg_s"]), "deg/(deg/s)"),
@@ -52,7 +65,8 @@ def spiral_rows(m: dict) -> list[tuple[str, str, str]]:
             ("loop height", _v(m["loop_height_deg_s"]), "deg/s"),
             ("loop width, direct spiral", " .. ".join(_v(x) for x in m["loop_width_direct_bounds_deg"]), "deg")]
     c = m["cubic_deg"]
-    rows.append(("cubic delta = H(r)", f"{c['c0']:.3g} + {c['c1']:.4g} r + {c['c2']:.3g} r^2 + {c['c3']:.4g} r^3",
+    rows.append(("cubic delta = H(r)", _polynomial([(c["c0"], ".3g", ""), (c["c1"], ".4g", " r"),
+                                                   (c["c2"], ".3g", " r^2"), (c["c3"], ".4g", " r^3")]),
                  "deg, r in deg/s"))
     rows.append(("all steps steady", _v(m["all_steady"]), ""))
     return rows
