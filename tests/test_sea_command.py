@@ -62,3 +62,16 @@ def test_sea_without_wind_writes_no_wind_rose(tmp_path, capsys):
     assert main(["sea", "--out", str(out)]) == 0
     assert not (out / "wind_rose.png").exists() and (out / "sea_spectrum.png").exists()
     assert "no wind" in capsys.readouterr().err
+
+
+def test_sea_does_not_warn_about_the_autopilot(tmp_path, capsys):
+    """``sea`` draws the sea: the design's warning about the law (ADRC without the wave filter in
+    a spectrum) is for ``run``, which still gives it; a warning about the sea itself is kept."""
+    p = tmp_path / "s.toml"
+    p.write_text('[controller]\ntype = "adrc"\n[ship]\nmodel = "mss-mariner"\nspeed_kn = 25.0\n[environment.wave]\nmodel = "spectrum"\n'
+                 'spectrum = "jonswap"\nsea_state = 5\n', encoding="utf-8")
+    assert main(["run", str(p), "--out", str(tmp_path / "r"), "--quiet"]) in (0, 3)
+    assert "chases the wave yaw" in capsys.readouterr().err
+    assert main(["sea", str(p), "--out", str(tmp_path / "o"), "--quiet"]) == 0
+    err = capsys.readouterr().err
+    assert "chases the wave yaw" not in err and "ship.speed_kn" in err

@@ -35,11 +35,13 @@ def warn(lines) -> None:
         print_warning(line)
 
 
-def design_checked(scenario, max_memory: float | None = None):
+def design_checked(scenario, max_memory: float | None = None, ignore: tuple[str, ...] = ()):
     """``(setup, warnings)``: the scenario refused if impossible, built under :func:`design_guard`,
     its warnings printed (see :mod:`steerlab.sim.sanity`; with the settings its models do not
     feel, :class:`~steerlab.errors.InertSettingWarning`); refused first if its set-up would not fit
-    in memory (``max_memory`` [GB], :mod:`steerlab.resources`)."""
+    in memory (``max_memory`` [GB], :mod:`steerlab.resources`). ``ignore``: field prefixes
+    (``"controller."``) whose warnings do not concern the command (``steerlab sea`` draws the sea,
+    not the autopilot's answer to it)."""
     from steerlab.sim.sanity import check_scenario, scenario_warnings
     from steerlab.sim.setup import build
 
@@ -56,5 +58,6 @@ def design_checked(scenario, max_memory: float | None = None):
             warnings.append(str(w.message))
         else:
             _warnings.showwarning(w.message, w.category, w.filename, w.lineno)
+    warnings = [w for w in warnings if not w.startswith(ignore)] if ignore else warnings
     warn(warnings)
     return setup, warnings
