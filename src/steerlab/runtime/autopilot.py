@@ -51,6 +51,7 @@ from __future__ import annotations
 import asyncio
 import csv
 import math
+import os
 import time
 from collections import Counter, deque
 from dataclasses import dataclass
@@ -84,6 +85,42 @@ LOG_COLUMNS = ("t", "wall", "t_sim", "state_age", "link_ok", "mode", "psi_deg", 
 cross-track error [m], > 0 to starboard of the leg, and ``leg`` only with a route; ``accepted``,
 ``rejected``: link datagrams so far; ``nmea_rejected``, ``signalk_rejected``: NMEA lines and
 Signal K UDP deltas rejected so far, all reasons, rate limiting included)."""
+
+
+def open_log(path) -> tuple:
+    """``(file, csv.DictWriter)`` of the autopilot's CSV log at ``path``, opened to append: a
+    restart continues the log of the runs before it (the ``wall`` column tells them apart),
+    never truncates it. A new or empty file gets the header; a file whose first line is not
+    this log's header (another program's file, a log of other columns) is refused with
+    :class:`InputError` on ``--log``, untouched; a last row cut short (the process killed
+    mid-write) is ended before the new rows."""
+    header = ",".join(LOG_COLUMNS)
+    try:
+        with open(path, "rb") as f:
+            first = f.readline().decode("utf-8", "replace").rstrip("\r\n")
+            f.seek(0, os.SEEK_END)
+            size = f.tell()
+            if size:
+                f.seek(size - 1)
+            last = f.read(1)
+    except FileNotFoundError:
+        first, size, last = "", 0, b""
+    except OSError as err:
+        raise InputError("--log", f"cannot read {str(path)!r}: {err.strerror}") from None
+    if size and first != header:
+        raise InputError("--log", f"{str(path)!r} exists and is not an autopilot log (its first line is "
+                                  f"{first[:40]!r}); give a new file, or the log of an earlier run to continue it")
+    try:
+        file = open(path, "a", newline="", encoding="utf-8")
+    except OSError as err:
+        raise InputError("--log", f"cannot write {str(path)!r}: {err.strerror}") from None
+    if size and last != b"\n":
+        file.write("\n")
+    writer = csv.DictWriter(file, fieldnames=LOG_COLUMNS)
+    if not size:
+        writer.writeheader()
+    return file, writer
+
 
 
 def _csv_float(column: str, v: float) -> str:
@@ -798,12 +835,7 @@ class Autopilot:
     def _open_log(self):
         if self.log_path is None:
             return
-        try:
-            self._log_file = open(self.log_path, "w", newline="", encoding="utf-8")
-        except OSError as err:
-            raise InputError("--log", f"cannot write {str(self.log_path)!r}: {err.strerror}") from None
-        self._log = csv.DictWriter(self._log_file, fieldnames=LOG_COLUMNS)
-        self._log.writeheader()
+        self._log_file, self._log = open_log(self.log_path)
 
     def _write_log(self, row: dict) -> None:
         if self._log is not None:
