@@ -67,6 +67,25 @@ def test_unknown_ship_and_speed():
     assert ei.value.field == "speed_kn"
 
 
+@pytest.mark.parametrize("kwargs, field, range_text", [
+    ({"gear": {"rate_max_deg_s": -1.0}}, "gear.rate_max_deg_s", "(allowed: gt 0.0)"),
+    ({"gear": {"T_sg": math.nan}}, "gear.T_sg", "(allowed: ge 0.001, le 100.0)"),
+    ({"rpm": -80.0}, "rpm", "(allowed: gt 0.0)"),
+    ({"rpm": 1e6}, "rpm", "(allowed: le 1000.0)"),
+], ids=["gear-rate", "gear-nan", "rpm-negative", "rpm-huge"])
+def test_bad_gear_or_rpm_is_one_line_naming_the_field_and_its_range(kwargs, field, range_text):
+    """A bad gear value was pydantic's multi-line error with a web address; an rpm of -80 was
+    accepted, and 1e6 ran the surge speed to 81 km/s in one step. Now the scenario's checks,
+    one line each (also through ``controller(..., gear=...)``)."""
+    with pytest.raises(InputError) as ei:
+        ship("esso", 16.0, **kwargs)
+    assert ei.value.field == field and ei.value.message.endswith(range_text)
+    if "gear" in kwargs:
+        with pytest.raises(InputError) as ei:
+            controller("pid", ship="esso", speed_kn=16.0, **kwargs)
+        assert ei.value.field == field
+
+
 def test_functional_step_equals_the_stateful_one():
     s = ship("esso", 16.0).reset(heading=0.1, yaw_rate=0.001)
     x0 = s.state.copy()

@@ -99,6 +99,16 @@ def test_bad_settings():
     with pytest.raises(InputError) as ei:
         gym.make("steerlab/CourseKeeping-v0", ship="titanic")
     assert ei.value.field == "ship.model"
+    # a misspelt keyword was Python's TypeError from deep inside; now it is named, with the allowed ones
+    with pytest.raises(InputError) as ei:
+        gym.make("steerlab/CourseKeeping-v0", shipp="esso")
+    assert ei.value.field == "shipp" and "did you mean 'ship'?" in ei.value.message
+    assert "speed_kn" in ei.value.message and "render_mode" in ei.value.message
+    from steerlab.gym.vector_env import SteeringVectorEnv
+
+    with pytest.raises(InputError) as ei:
+        SteeringVectorEnv(num_envs=2, episode_seconds=100.0)
+    assert ei.value.field == "episode_seconds" and "did you mean 'episode_s'?" in ei.value.message
 
 
 def test_without_gymnasium_the_import_says_what_to_install():

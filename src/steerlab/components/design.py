@@ -134,9 +134,17 @@ def make_gear(gear: Union[SteeringGear, Mapping[str, float], None]) -> SteeringG
         bad = sorted(set(gear) - known)
         if bad:
             raise InputError(f"gear.{bad[0]}", f"unknown key; allowed: {sorted(known)}")
+        from pydantic import ValidationError
+
+        from steerlab.sim.scenario import _format_validation_error
         from steerlab.sim.setup import gear_from_config
 
-        return gear_from_config(GearConfig(**gear)).validated()
+        try:
+            config = GearConfig(**gear)
+        except ValidationError as err:       # one line naming gear.<key> and its range, as in a scenario
+            e = _format_validation_error(err, gear, GearConfig)
+            raise InputError(f"gear.{e.field}", e.message) from None
+        return gear_from_config(config).validated()
     raise InputError("gear", f"must be None, a SteeringGear or a dict of [gear] keys, got {type(gear).__name__}")
 
 

@@ -194,5 +194,21 @@ def ship(name: str, speed_kn: float, *, gear: Union[SteeringGear, Mapping[str, f
     if not lo <= speed <= hi:
         raise InputError("speed_kn", f"{speed_kn} kn is outside ship {name!r}'s validity range "
                                      f"[{lo / knots_to_ms(1.0):.4g}, {hi / knots_to_ms(1.0):.4g}] kn")
+    if rpm is not None:
+        _check_rpm(name, rpm)
     ps = np.asarray(spec.pack(speed, rpm, spec.options(ship_options)), dtype=np.float64)
     return Ship(spec, speed, ps, make_gear(gear))
+
+
+def _check_rpm(name: str, rpm: float) -> None:
+    """``rpm`` checked as a scenario's ``[ship] rpm`` is (:class:`steerlab.sim.scenario.ShipConfig`'s
+    range), or :class:`InputError` naming ``rpm`` and that range."""
+    from pydantic import ValidationError
+
+    from steerlab.sim.scenario import ShipConfig, _format_validation_error
+
+    try:
+        ShipConfig.model_validate({"model": name, "rpm": rpm})
+    except ValidationError as err:
+        e = _format_validation_error(err, {"rpm": rpm}, ShipConfig)
+        raise InputError("rpm", e.message) from None

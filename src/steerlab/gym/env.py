@@ -59,6 +59,7 @@ class SteeringEnv(gym.Env):
     metadata = {"render_modes": []}
 
     def __init__(self, task: str = "course_keeping", render_mode: Optional[str] = None, **kw: Any) -> None:
+        Episodes.check_keywords(kw, own=("render_mode",))
         self.core = Episodes(1, task=task, **kw)
         self.observation_space, self.action_space = spaces(self.core.observation, self.core.delta_max)
         self.render_mode = render_mode

@@ -89,6 +89,24 @@ def _scenario(task, ship, speed_kn, gear, environment, ship_options, dt, episode
 class Episodes:
     """N lanes (see the module docstring); all arrays SI."""
 
+    @classmethod
+    def check_keywords(cls, kw: Mapping[str, Any], own: tuple[str, ...] = ()) -> None:
+        """:class:`InputError` naming the first keyword of ``kw`` that neither :meth:`__init__`
+        nor the environment itself (``own``) takes, with the allowed ones (a misspelt keyword
+        to ``gym.make`` was Python's ``TypeError``)."""
+        import inspect
+
+        params = inspect.signature(cls.__init__).parameters
+        allowed = sorted({*params, *own} - {"self", "n", "vectorised"})
+        bad = sorted(k for k in kw if k not in allowed)
+        if bad:
+            import difflib
+
+            close = difflib.get_close_matches(bad[0], allowed, n=1)
+            hint = f" (did you mean {close[0]!r}?)" if close else ""
+            raise InputError(bad[0], f"unknown keyword of the steerlab environments{hint}; allowed: "
+                                     f"{', '.join(allowed)}")
+
     def __init__(self, n: int, task: str = "course_keeping", ship: str = "esso", speed_kn: float = 16.0,
                  gear: Optional[Mapping[str, float]] = None, environment: Optional[Mapping[str, Any]] = None,
                  ship_options: Optional[Mapping[str, Any]] = None, dt: float = 0.1, control_dt: float = 1.0,

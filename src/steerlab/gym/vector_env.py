@@ -46,6 +46,7 @@ class SteeringVectorEnv(VectorEnv):
     def __init__(self, num_envs: int = 1, task: str = "course_keeping", render_mode: Optional[str] = None,
                  autoreset_mode: Union[str, AutoresetMode] = AutoresetMode.NEXT_STEP, threads: Optional[int] = 1,
                  **kw: Any) -> None:
+        Episodes.check_keywords(kw, own=("num_envs", "render_mode", "autoreset_mode"))
         self.num_envs = int(num_envs)
         try:
             mode = AutoresetMode(autoreset_mode)

@@ -337,7 +337,10 @@ def _annotation_types(annotation: Any) -> list:
     return out
 
 
-def _format_validation_error(err: ValidationError, data: Any = None) -> InputError:
+def _format_validation_error(err: ValidationError, data: Any = None, model: Any = None) -> InputError:
+    """One :class:`InputError` line for pydantic's ``err`` (the first problem, and how many more);
+    ``data``, the input, and ``model``, the pydantic model it was validated against (default
+    :class:`Scenario`), find the declared range of a field pydantic refused as not finite."""
     first = err.errors()[0]
     if first["type"] == _REGISTRY_ERROR:                     # raised as it was, with its own field
         return InputError(first["ctx"]["field"], first["ctx"]["message"])
@@ -346,7 +349,7 @@ def _format_validation_error(err: ValidationError, data: Any = None) -> InputErr
     ctx = first.get("ctx") or {}
     bounds = [f"{k.replace('_', ' ')} {v}" for k, v in ctx.items() if k in ("gt", "ge", "lt", "le")]
     if not bounds and first["type"] == "finite_number":      # NaN/inf: pydantic names no range
-        bounds = _field_bounds(Scenario, [p for p in first["loc"] if not _is_union_member_tag(p)], data)
+        bounds = _field_bounds(model or Scenario, [p for p in first["loc"] if not _is_union_member_tag(p)], data)
     if bounds:
         msg += f" (allowed: {', '.join(bounds)})"
     if first["type"] in ("union_tag_invalid", "union_tag_not_found"):
