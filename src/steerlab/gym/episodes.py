@@ -90,6 +90,29 @@ class Episodes:
     """N lanes (see the module docstring); all arrays SI."""
 
     @classmethod
+    def _check_inert(cls, task: str, guidance, episode_s: float, **given: float) -> None:
+        """Settings the task does not read, given other than their defaults: an
+        :class:`~steerlab.errors.InertSettingWarning` each (the course change's ``change_deg``
+        and ``change_t`` outside the course-change task or with a ``guidance`` of its own, the
+        start offset outside course keeping); a course change at or after the episode's end:
+        :class:`InputError` (it would never happen)."""
+        import inspect
+        import warnings
+
+        from steerlab.errors import InertSettingWarning
+
+        defaults = {k: v.default for k, v in inspect.signature(cls.__init__).parameters.items()}
+        inert = [] if task == "course_change" and guidance is None else ["change_deg", "change_t"]
+        inert += [] if task == "course_keeping" else ["initial_offset_deg"]
+        for name in inert:
+            if given[name] != defaults[name]:
+                why = "a guidance of its own is given" if guidance is not None and name.startswith("change") \
+                    else f"task {task!r} does not read it"
+                warnings.warn(f"{name}: has no effect here ({why})", InertSettingWarning, stacklevel=4)
+        if task == "course_change" and guidance is None:
+            require_finite_range("change_t", given["change_t"], 0.0, episode_s, hi_open=True)
+
+    @classmethod
     def check_keywords(cls, kw: Mapping[str, Any], own: tuple[str, ...] = ()) -> None:
         """:class:`InputError` naming the first keyword of ``kw`` that neither :meth:`__init__`
         nor the environment itself (``own``) takes, with the allowed ones (a misspelt keyword
@@ -144,6 +167,8 @@ class Episodes:
         require_finite_range("initial_offset_deg", initial_offset_deg, 0.0, 180.0)
         if int(n) < 1:
             raise InputError("num_envs", f"must be >= 1, got {n}")
+        self._check_inert(task, guidance, episode_s, change_deg=change_deg, change_t=change_t,
+                          initial_offset_deg=initial_offset_deg)
         nc = int(round(control_dt / dt))
         if nc < 1 or abs(nc * dt - control_dt) > 1e-9 * max(control_dt, 1.0):
             raise InputError("control_dt", f"must be a positive multiple of dt={dt} s, got {control_dt} s")
