@@ -94,8 +94,7 @@ class Episodes:
         """Settings the task does not read, given other than their defaults: an
         :class:`~steerlab.errors.InertSettingWarning` each (the course change's ``change_deg``
         and ``change_t`` outside the course-change task or with a ``guidance`` of its own, the
-        start offset outside course keeping); a course change at or after the episode's end:
-        :class:`InputError` (it would never happen)."""
+        start offset outside course keeping, a ``change_t`` at or after the episode's end)."""
         import inspect
         import warnings
 
@@ -110,7 +109,10 @@ class Episodes:
                     else f"task {task!r} does not read it"
                 warnings.warn(f"{name}: has no effect here ({why})", InertSettingWarning, stacklevel=4)
         if task == "course_change" and guidance is None:
-            require_finite_range("change_t", given["change_t"], 0.0, episode_s, hi_open=True)
+            t = require_finite_range("change_t", given["change_t"], 0.0)
+            if t >= episode_s and t != defaults["change_t"]:     # (a short test episode with the default: quiet)
+                warnings.warn(f"change_t: the course change at {t:g} s comes after the episode's end "
+                              f"({episode_s:g} s): it never happens", InertSettingWarning, stacklevel=4)
 
     @classmethod
     def check_keywords(cls, kw: Mapping[str, Any], own: tuple[str, ...] = ()) -> None:

@@ -11,7 +11,8 @@ recompiles its cached kernels once. The generated drivers (:mod:`steerlab.jit.dr
 stamped with their file name: the hash of their text, in a directory named after the
 fingerprint.
 
-How: :func:`install` (called by ``import steerlab``, before any steerlab kernel is defined)
+How: :func:`install` (called by :mod:`steerlab.jit.numba_stamped`, through which every steerlab
+module with a kernel imports numba, so before any steerlab kernel is defined)
 puts :class:`PackageStampLocator` first among numba's cache locators
 (``numba.core.caching.CacheImpl._locator_classes``, an internal list). It claims only the
 files of this steerlab package and this steerlab's generated drivers; for any other file it
