@@ -34,5 +34,6 @@ h = ax[0, 1]
 h.hist(mc.per_run["iae_deg_s"], bins=20, color="C1")
 h.set_xlabel("IAE [deg s]")
 h.set_ylabel("runs")
+h.yaxis.get_major_locator().set_params(integer=True)      # a count of runs: whole numbers
 fig.suptitle(f"{scenario.name}: {n_runs} sea realisations")
 save(fig, args.out / "03_monte_carlo.png")

@@ -41,5 +41,6 @@ ax[1, 0].set_xlabel("time [s]")
 h = outcome.result.history
 ax[2, 0].plot([r["generation"] for r in h], [r["best"] for r in h], "o-")
 ax[2, 0].set_xlabel("generation")
+ax[2, 0].xaxis.get_major_locator().set_params(integer=True)   # generations are whole numbers
 ax[2, 0].set_ylabel("best cost [-]")
 save(fig, args.out / "06_tune_pid.png")

@@ -8,7 +8,7 @@ Equivalent command: ``steerlab robustness examples/scenarios/nomoto1-pid.toml --
 
 from _common import SCENARIOS, figure, parse_args, save
 from steerlab.sim.scenario import load_scenario
-from steerlab.sweeps.robustness import metric_label, parse_vary, quantity_label, run_robustness
+from steerlab.sweeps.robustness import parse_vary, quantity_label, run_robustness
 
 args = parse_args(__doc__)
 scenario = load_scenario(SCENARIOS / "nomoto1-pid.toml")
@@ -21,7 +21,7 @@ print(f"ITAE from {grid.min():.4g} to {grid.max():.4g} deg s^2 (nominal {res.nom
 fig, ax = figure(1, 1, figsize=(7, 4.5))
 a = ax[0, 0]
 im = a.pcolormesh(K.values, T.values, grid / grid.min(), shading="nearest", cmap="viridis")
-fig.colorbar(im, ax=a, label=f"{metric_label('itae')} / best on the grid")
+fig.colorbar(im, ax=a, label="ITAE / the best ITAE on the grid [-]")
 a.plot([0.1], [50.0], "r+", ms=14, mew=2, label="design ship (K 0.1, T 50)")
 a.set_xlabel(quantity_label(K, "nomoto1"))
 a.set_ylabel(quantity_label(T, "nomoto1"))
