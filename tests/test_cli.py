@@ -122,8 +122,8 @@ def test_linearize_json(capsys):
 
 
 def test_linearize_bad_input(capsys):
-    assert main(["linearize", "nessie"]) == 2
-    assert "ship.model" in capsys.readouterr().err
+    assert main(["linearize", "nessie"]) == 2               # named as given: the SHIP argument
+    assert capsys.readouterr().err.startswith("steerlab: error: SHIP: unknown ship 'nessie'")
     assert main(["linearize", "esso", "--speed-kn", "-3"]) == 2
     assert "--speed-kn" in capsys.readouterr().err
 

@@ -237,7 +237,8 @@ def test_cli_imo_writes_self_contained_report(tmp_path, capsys):
 
 
 @pytest.mark.parametrize("argv,field", [
-    (["trial", "zigzag", "--ship", "nosuchship"], "ship.model"),
+    (["trial", "zigzag", "--ship", "nosuchship"], "steerlab: error: --ship: unknown ship 'nosuchship'"),
+    (["imo", "--ship", "eso", "--out", "OUT"], "steerlab: error: --ship: unknown ship 'eso' (did you mean 'esso'?)"),
     (["trial", "zigzag", "--ship", "nomoto1", "--rudder", "40"], "--rudder"),
     (["trial", "turning", "--ship", "nomoto1", "--rudder", "nan"], "--rudder"),
     (["trial", "pullout", "--ship", "nomoto1", "--ship-option", "K=-1"], "ship.options.K"),

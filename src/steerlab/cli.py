@@ -132,10 +132,14 @@ def cmd_linearize(args) -> int:
 
     from steerlab.ships.registry import get_ship
 
+    try:
+        spec = get_ship(args.ship)
+    except InputError as err:                   # named as the user gave it: the SHIP argument
+        raise InputError("SHIP", err.message) from None
     if args.speed_kn is None:                   # the ship's design speed
         from steerlab.components.linear import default_speed_kn
 
-        args.speed_kn = default_speed_kn(get_ship(args.ship))
+        args.speed_kn = default_speed_kn(spec)
     if not (math.isfinite(args.speed_kn) and 0.0 < args.speed_kn <= 40.0):
         raise InputError("--speed-kn", f"must be in (0, 40] kn, got {args.speed_kn}")
     if get_ship(args.ship).linearise is None:   # Nomoto/Norrbin/Bech ...: the model's own linear form

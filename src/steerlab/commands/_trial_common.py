@@ -10,7 +10,7 @@ from steerlab.errors import InputError
 FLAG_NAMES = {"rudder": "--rudder", "heading": "--heading", "max_rudder": "--max-rudder", "step": "--step",
               "n_rates": "--points", "hold": "--hold-s", "speed_kn": "--speed-kn", "dt": "--dt",
               "side": "--side", "ship.rpm": "--propeller-rps", "ship.options.depth_m": "--depth",
-              "gear.T_sg": "--servo-lag", "gear.rate_max_deg_s": "--rudder-rate"}
+              "gear.T_sg": "--servo-lag", "gear.rate_max_deg_s": "--rudder-rate", "ship.model": "--ship"}
 
 
 def add_ship_arguments(p) -> None:
