@@ -125,6 +125,25 @@ def test_the_next_source_takes_over_with_an_alarm_naming_it():
     assert board.active("heading_nmea") and "implausible" in board.alarms["heading_nmea"].message
 
 
+def test_without_any_other_heading_the_alarm_says_so():
+    """On a boat there is no ship state to fall back on: the alarm said "steering by the state
+    heading" all the same."""
+    board = AlarmBoard()
+    nmea_h = HeadingHealth("nmea", timeout=2.0)
+    nmea_h.observe(1.0, 0.0)
+    assert select_heading(3.0, ("nmea",), {"nmea": nmea_h}, None, board) == (None, "state")
+    assert board.alarms["heading_nmea"].message.endswith(": no heading left to steer by")
+
+
+def test_true_from_magnetic_never_gives_360():
+    """3 deg magnetic with -3 deg variation (from radians) summed to -4e-16, which ``% 360``
+    rounds to 360.0; that is north: 0."""
+    from steerlab.runtime.nmea_magnetic import true_from_magnetic
+
+    assert true_from_magnetic(3.0, math.degrees(math.radians(-3.0))) == 0.0
+    assert true_from_magnetic(359.0, 2.0) == pytest.approx(1.0) and true_from_magnetic(10.0, -3.0) == 7.0
+
+
 # ---------------------------------------------------------------- streams
 def test_line_splitter_reassembles_and_bounds_lines():
     sp = LineSplitter(max_line=100)

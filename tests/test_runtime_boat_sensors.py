@@ -161,6 +161,12 @@ def test_compass_alone_steers_by_the_derived_yaw_rate_and_its_loss_is_the_link_a
     after = [r for r in rows if r["t"] >= raised]
     assert after and all(r["mode"] == "safe" and r["delta_cmd_deg"] == 0.0 for r in after)
     assert ap.alarms.active("heading_nmea")
+    # no ship state on a boat: the alarm does not claim a heading it does not have, and the page's
+    # status shows no frozen measurement (it kept the last sample's rudder, yaw rate and speed)
+    assert ap.alarms.alarms["heading_nmea"].message.endswith("no heading left to steer by")
+    status = ap.status()
+    assert not status["link_ok"] and status["yaw_rate"] is None and status["speed"] is None
+    assert status["rudder"] == status["actuator"]["rudder"]        # the drive's own feedback, live
 
 
 class _Drive:

@@ -312,3 +312,22 @@ def test_cli_connect_to_a_loopback_ship_binds_loopback_of_its_family(tmp_path, c
     ap, _ = build_autopilot(build_parser().parse_args(
         ["autopilot", "--connect", connect, "--scenario", str(sc), "--log", str(tmp_path / "l.csv")]))
     assert ap.connect == (host, 47110) and ap.bind == (bind, 0)
+
+
+@pytest.mark.parametrize("argv, flag", [
+    (["autopilot-command", "--to", "999.1.1.1:10111", "--key-file", "examples/data/demo-link.key", "--heading", "10"],
+     "--to"),
+    (["autopilot", "--connect", "999.1.1.1:47110", "--controller", "pid", "--heading", "10", "--duration", "3"],
+     "--connect"),
+], ids=["autopilot-command", "autopilot"])
+def test_a_host_that_does_not_resolve_is_one_line_naming_the_flag(argv, flag, capsys, monkeypatch):
+    """``autopilot-command --to 999.1.1.1:...`` ended in a socket.gaierror traceback (exit 1);
+    ``autopilot --connect`` with it sat in the safe state for the whole run and exited 0."""
+    from pathlib import Path
+
+    from steerlab.cli import main
+
+    monkeypatch.chdir(Path(__file__).resolve().parent.parent)        # examples/data/demo-link.key
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith(f"steerlab: error: {flag}: cannot resolve host '999.1.1.1'") and len(err.splitlines()) == 1

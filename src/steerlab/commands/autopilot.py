@@ -131,13 +131,15 @@ def build_autopilot(args):
     from steerlab.runtime.controller_runtime import ControllerRuntime
     from steerlab.runtime.keys import load_key
     from steerlab.runtime.route import route_guidance
-    from steerlab.runtime.udp import is_loopback, parse_hostport
+    from steerlab.runtime.udp import check_resolvable, is_loopback, parse_hostport
     from steerlab.sim.scenario import default_scenario, load_scenario
     from steerlab.units import rad
 
     from steerlab.commands.serve_ship import _origin
 
     connect = parse_hostport(args.connect, "--connect") if args.connect else None
+    if connect is not None:
+        check_resolvable(*connect, "--connect")
     if connect is not None and connect[1] == 0:
         raise InputError("--connect", "port must be in [1, 65535]")
     origin = _origin(args.origin) if args.origin is not None else None

@@ -120,9 +120,10 @@ def run(args) -> int:
     from steerlab.runtime.keys import load_key
     from steerlab.runtime.signalk import delta
     from steerlab.runtime.signalk_link import DeltaSigner
-    from steerlab.runtime.udp import local_bind_for, parse_hostport
+    from steerlab.runtime.udp import check_resolvable, local_bind_for, parse_hostport
 
     to = parse_hostport(args.to, "--to")
+    check_resolvable(*to, "--to")
     if to[1] == 0:
         raise InputError("--to", "port must be in [1, 65535]")
     key = load_key(args.key_file, args.key_env)

@@ -766,8 +766,11 @@ class Autopilot:
         """
         st = self.latest
         r = self.last_row
-        m = self.measured
-        boat = st is None and bool(m)          # no ship state: the sensors' measurement
+        # no ship state: the sensors' measurement of the last sample, but only while it was taken
+        # (without a heading none is, and the last one would freeze on the page, rudder too)
+        m = self.measured if r.get("link_ok") else {}
+        boat = st is None and bool(m)
+        live_rudder = self.actuator.rudder(r.get("t", 0.0))   # the drive's own feedback, or None
         return {
             "t": r.get("t", 0.0), "mode": self.mode, "link_ok": bool(r.get("link_ok", 0)),
             "state_age": r.get("state_age"),
@@ -777,7 +780,7 @@ class Autopilot:
             "set_course": None if self.psi_set is None else wrap_to_2pi(self.psi_set),
             "reference": None if self.gd is None else wrap_to_2pi(float(self.ref[REF_PSI])),
             "yaw_rate": m["r"] if boat else (None if st is None else st.r),
-            "rudder": m["delta"] if boat else (None if st is None else st.delta),
+            "rudder": m["delta"] if boat else (live_rudder if st is None else st.delta),
             "rudder_cmd": self.cmd_sent, "speed": m["u"] if boat else (None if st is None else st.u),
             "position": ((None if m["x_n"] is None else [m["x_n"], m["y_e"]]) if boat
                          else (None if st is None else [st.x_n, st.y_e])),
@@ -792,7 +795,7 @@ class Autopilot:
             "sensor_sources": self.sensors.status(r.get("t", 0.0)),
             "variation": self._variation_now(),
             "rudder_feedback": None if self.rudder_feedback is None else self.rudder_feedback[0],
-            "actuator": {"name": self.actuator.name, "rudder": self.actuator.rudder(r.get("t", 0.0)),
+            "actuator": {"name": self.actuator.name, "rudder": live_rudder,
                          "faults": self.actuator.faults(r.get("t", 0.0))},
             "steering_mode": self.steering_mode, "modes": list(self.available_modes()),
             "profile": self.settings.profile, "profiles": self.settings.names(),

@@ -108,6 +108,7 @@ def select_heading(t: float, order, sources: dict, fallback: float, alarms=None)
         for name in order:
             h = sources.get(name)
             if h is not None:
-                alarms.set(heading_alarm(name), h in bad, t,
-                           f"{h.describe(t)}: steering by the {chosen[1]} heading")
+                then = (f"steering by the {chosen[1]} heading" if chosen[0] is not None
+                        else "no heading left to steer by")       # (on a boat without a ship state)
+                alarms.set(heading_alarm(name), h in bad, t, f"{h.describe(t)}: {then}")
     return chosen

@@ -68,8 +68,11 @@ def signed_east(value, direction, what: str = "variation"):
 
 
 def true_from_magnetic(magnetic_deg: float, variation_deg: float) -> float:
-    """True direction [deg, 0..360) of a magnetic one: ``psi_true = psi_mag + var`` (var > 0 E)."""
-    return (magnetic_deg + variation_deg) % 360.0
+    """True direction [deg, 0..360) of a magnetic one: ``psi_true = psi_mag + var`` (var > 0 E).
+    Strictly below 360: ``x % 360`` rounds a tiny negative sum (3 deg + -3 deg from radians) up to
+    360, which is north, so it is returned as 0."""
+    d = (magnetic_deg + variation_deg) % 360.0
+    return 0.0 if d >= 360.0 else d
 
 
 def check_variation_option(variation_deg, field: str = "--variation") -> float | None:

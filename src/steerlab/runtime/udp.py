@@ -28,6 +28,20 @@ def parse_hostport(text: str, field: str, default_host: str = LOOPBACK) -> tuple
     return host, p
 
 
+def check_resolvable(host: str, port: int, field: str) -> None:
+    """:class:`InputError` naming ``field`` if ``host`` does not resolve to an address (a typo in
+    a peer's name or address: ``999.1.1.1``), before any socket is made; a peer that resolves
+    but does not answer is the link's alarm, not this."""
+    import socket
+
+    try:
+        socket.getaddrinfo(host, port, type=socket.SOCK_DGRAM)
+    except socket.gaierror as err:
+        raise InputError(field, f"cannot resolve host {host!r}: {err.strerror}") from None
+    except UnicodeError:
+        raise InputError(field, f"bad host {host!r}") from None
+
+
 def is_loopback(host: str) -> bool:
     """True for 127.0.0.0/8, ::1 and ``localhost``."""
     if host == "localhost":
