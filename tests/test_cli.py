@@ -149,3 +149,19 @@ def test_experiment_quick_via_cli(tmp_path, capsys):
     assert all(set(r) == {"quantity", "paper", "steerlab", "unit", "note"} for r in rows)
     assert "b2" in capsys.readouterr().out
     assert sorted(p.name for p in out.glob("*.png"))
+
+
+@pytest.mark.parametrize("argv, line", [
+    (["autopilot", "--safe-action", "stop"],
+     "steerlab: error: argument --safe-action: invalid choice: 'stop' (choose from 'midships', 'hold') "
+     "(see 'steerlab autopilot --help')"),
+    (["run"], "steerlab: error: the following arguments are required: --out (see 'steerlab run --help')"),
+    (["nosuchcommand"], "steerlab: error: argument COMMAND: invalid choice: 'nosuchcommand'"),
+], ids=["bad-choice", "missing", "unknown-command"])
+def test_a_usage_error_is_one_line_with_exit_2(argv, line, capsys):
+    """argparse printed its whole usage block before the error (28 lines for autopilot)."""
+    with pytest.raises(SystemExit) as exc:
+        main(argv)
+    assert exc.value.code == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and err.startswith(line)

@@ -319,7 +319,9 @@ def test_cli_connect_to_a_loopback_ship_binds_loopback_of_its_family(tmp_path, c
      "--to"),
     (["autopilot", "--connect", "999.1.1.1:47110", "--controller", "pid", "--heading", "10", "--duration", "3"],
      "--connect"),
-], ids=["autopilot-command", "autopilot"])
+    (["autopilot", "--connect", "127.0.0.1:47110", "--controller", "nosuch", "--heading", "10", "--duration", "1"],
+     "--controller"),
+], ids=["autopilot-command", "autopilot", "autopilot-controller"])
 def test_a_host_that_does_not_resolve_is_one_line_naming_the_flag(argv, flag, capsys, monkeypatch):
     """``autopilot-command --to 999.1.1.1:...`` ended in a socket.gaierror traceback (exit 1);
     ``autopilot --connect`` with it sat in the safe state for the whole run and exited 0."""
@@ -330,4 +332,5 @@ def test_a_host_that_does_not_resolve_is_one_line_naming_the_flag(argv, flag, ca
     monkeypatch.chdir(Path(__file__).resolve().parent.parent)        # examples/data/demo-link.key
     assert main(argv) == 2
     err = capsys.readouterr().err.strip()
-    assert err.startswith(f"steerlab: error: {flag}: cannot resolve host '999.1.1.1'") and len(err.splitlines()) == 1
+    what = "unknown type 'nosuch'" if flag == "--controller" else "cannot resolve host '999.1.1.1'"
+    assert err.startswith(f"steerlab: error: {flag}: {what}") and len(err.splitlines()) == 1

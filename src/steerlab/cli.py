@@ -206,16 +206,25 @@ EXAMPLES = {
 }
 
 
+class _OneLineParser(argparse.ArgumentParser):
+    """argparse's parser whose usage errors are one line, as every other bad input (exit 2):
+    argparse prints the whole usage block first, 28 lines for ``steerlab autopilot``."""
+
+    def error(self, message: str):  # type: ignore[override]
+        print(f"steerlab: error: {one_line(message)} (see '{self.prog} --help')", file=sys.stderr)
+        raise SystemExit(EXIT_BAD_INPUT)
+
+
 def build_parser() -> argparse.ArgumentParser:
     fmt = argparse.RawDescriptionHelpFormatter
-    p = argparse.ArgumentParser(
+    p = _OneLineParser(
         prog="steerlab", formatter_class=fmt,
         description="steerlab: design, tune, assess and run ship autopilots.",
         epilog="examples:\n  steerlab run --out out/default\n  steerlab experiment zwierzewicz2021 --out out/zw"
                "\n  steerlab linearize esso --speed-kn 16 --json\n  steerlab bench --json\n\n"
                "Run 'steerlab COMMAND --help' for a command's options.")
     p.add_argument("--version", action="version", version=_version())
-    sub = p.add_subparsers(dest="command", metavar="COMMAND")
+    sub = p.add_subparsers(dest="command", metavar="COMMAND", parser_class=_OneLineParser)
     sub.required = True
 
     r = sub.add_parser("run", help="run one scenario and write metrics, time series, figures and a report",

@@ -115,7 +115,12 @@ def _checked_settings(args, scenario):
         why = mode_refusal(args.mode, bool(args.route), bool(args.nmea_listen))
         if why is not None:
             raise InputError("--mode", why)
-    rt = runtime_scenario(scenario, args.controller, args.sample_time)
+    try:
+        rt = runtime_scenario(scenario, args.controller, args.sample_time)
+    except InputError as err:            # named as the user gave it
+        if err.field == "controller.type" and args.controller is not None:
+            raise InputError("--controller", err.message) from None
+        raise
     settings = ControllerSettings(rt.model_dump()["controller"], load_profiles(args.profiles) if args.profiles else None)
     settings.check(rt)
     if args.profile is not None and args.profile not in settings.names():
