@@ -24,7 +24,7 @@ SCENARIO_TOML = runtime_scenario_toml("cli-runtime", 60.0, waves=False)
     (["autopilot", "--connect", "127.0.0.1:47110", "--allow-origin", "plotter.local"], "--allow-origin"),
     (["autopilot", "--connect", "127.0.0.1:0"], "--connect"),
     (["autopilot", "--connect", "127.0.0.1:70000"], "--connect"),
-    (["autopilot", "--connect", "127.0.0.1:47110", "--controller", "nope"], "controller.type"),
+    (["autopilot", "--connect", "127.0.0.1:47110", "--controller", "nope"], "--controller: unknown type"),
     (["autopilot", "--connect", "127.0.0.1:47110", "--route", "missing.csv"], "--route"),
     (["autopilot", "--connect", "127.0.0.1:47110", "--heading", "nan"], "--heading"),
     (["autopilot", "--connect", "127.0.0.1:47110", "--watchdog", "-1"], "--watchdog"),
