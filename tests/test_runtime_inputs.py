@@ -334,3 +334,26 @@ def test_a_host_that_does_not_resolve_is_one_line_naming_the_flag(argv, flag, ca
     err = capsys.readouterr().err.strip()
     what = "unknown type 'nosuch'" if flag == "--controller" else "cannot resolve host '999.1.1.1'"
     assert err.startswith(f"steerlab: error: {flag}: {what}") and len(err.splitlines()) == 1
+
+
+def test_plotter_mode_with_any_nmea_input_as_the_autopilot_starts_in_it(tmp_path):
+    """``--mode plotter`` was refused at the command line unless ``--nmea-listen`` was given,
+    although the autopilot starts in plotter mode with any NMEA input (``--nmea-tcp`` too) and a
+    plotter's APB/RMB arrive on any of them."""
+    from runtime_scenario import runtime_scenario_toml
+    from steerlab.cli import build_parser
+    from steerlab.commands.autopilot import build_autopilot
+
+    sc = tmp_path / "s.toml"
+    sc.write_text(runtime_scenario_toml("plotter", 10.0))
+    base = ["autopilot", "--connect", "127.0.0.1:47110", "--scenario", str(sc), "--log", str(tmp_path / "l.csv")]
+    for extra in (["--nmea-tcp", "127.0.0.1:10110"], ["--nmea-listen", "127.0.0.1:10111"]):
+        ap, _ = build_autopilot(build_parser().parse_args(base + extra + ["--mode", "plotter"]))
+        assert ap.steering_mode == "plotter"
+        default, _ = build_autopilot(build_parser().parse_args(base + extra))
+        assert default.steering_mode == "plotter"                 # the start mode the same input implies
+    from steerlab.errors import InputError
+
+    with pytest.raises(InputError) as e:
+        build_autopilot(build_parser().parse_args(base + ["--mode", "plotter"]))
+    assert e.value.field == "--mode" and "--nmea-tcp" in e.value.message and "--nmea-listen" in e.value.message

@@ -112,7 +112,8 @@ def _checked_settings(args, scenario):
     from steerlab.runtime.steering_modes import mode_refusal
 
     if args.mode is not None:
-        why = mode_refusal(args.mode, bool(args.route), bool(args.nmea_listen))
+        nmea_input = bool(args.nmea_listen or args.nmea_tcp or args.nmea_serial or args.nmea_tcp_listen)
+        why = mode_refusal(args.mode, bool(args.route), nmea_input)     # as the autopilot decides (plotter_input)
         if why is not None:
             raise InputError("--mode", why)
     try:

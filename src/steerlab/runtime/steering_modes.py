@@ -27,7 +27,8 @@ PLOTTER = "plotter"
 MODES = (COMPASS, ROUTE, PLOTTER)
 
 _NEEDS = {ROUTE: "a route (start steerlab autopilot with --route FILE.csv)",
-          PLOTTER: "a chart plotter's NMEA input (start steerlab autopilot with --nmea-listen HOST:PORT)"}
+          PLOTTER: "a chart plotter's NMEA input (start steerlab autopilot with --nmea-listen, --nmea-tcp, "
+                   "--nmea-tcp-listen or --nmea-serial)"}
 
 
 def available_modes(has_route: bool, has_plotter: bool) -> tuple[str, ...]:
