@@ -269,3 +269,22 @@ def test_the_policy_autopilot_steers_the_esso_tanker_on_loopback_with_the_offlin
         assert kernel(z, off.pc, t, x, ref, h) == cmd
         assert float(r["delta_cmd_deg"]) == pytest.approx(np.degrees(cmd), rel=1e-5, abs=1e-5)
     assert len({round(c, 6) for _, _, _, c, _ in seen}) > 50          # orders that vary: a real comparison
+
+
+def test_a_busy_port_is_its_error_line_alone(tmp_path):
+    """``--web`` on a port another process holds: exit 2 and one line naming ``--web``; the run's
+    summary ("0 samples, mode standby, ...") came first, as if the autopilot had run."""
+    import socket
+    import subprocess
+    import sys
+
+    with socket.socket() as holder:
+        holder.bind(("127.0.0.1", 0))
+        holder.listen()
+        port = holder.getsockname()[1]
+        p = subprocess.run([sys.executable, "-m", "steerlab", "autopilot", "--connect", "127.0.0.1:47110",
+                            "--heading", "10", "--duration", "2", "--web", f"127.0.0.1:{port}",
+                            "--log", str(tmp_path / "l.csv")], capture_output=True, text=True, timeout=300)
+    assert p.returncode == 2, p.stderr
+    lines = [ln for ln in p.stderr.splitlines() if not ln.startswith(("steerlab: compiling", "  cached"))]
+    assert len(lines) == 1 and lines[0].startswith(f"steerlab: error: --web: cannot bind 127.0.0.1:{port}")

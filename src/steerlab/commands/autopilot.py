@@ -287,7 +287,10 @@ def run(args) -> int:
     ap, web = build_autopilot(args)
     freeze_startup_heap()
 
+    ran = []                                  # set once the autopilot is up (its ports bound)
+
     def started(a, bridge):
+        ran.append(True)
         if not args.quiet:
             page = f", bridge page {a.operator.url(*bridge.address)}" if bridge else ""
             if a.signalk_stream is not None:
@@ -316,7 +319,7 @@ def run(args) -> int:
     try:
         asyncio.run(run_with_web(ap, web, args.duration, started))
     finally:
-        if not args.quiet:
+        if not args.quiet and ran:            # (a port that could not be bound: its error line alone)
             print(f"autopilot: {ap.samples} samples, mode {ap.mode}, {ap.skipped} skipped after stalls, "
                   f"link {dict(ap.filter.counts)}, NMEA {dict(ap.nmea_counts)}, Signal K UDP {dict(ap.signalk_counts)}, "
                   f"alarms raised {[n for _, n, w in ap.alarms.history if w == 'raised']}",
