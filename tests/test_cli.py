@@ -157,7 +157,9 @@ def test_experiment_quick_via_cli(tmp_path, capsys):
      "(see 'steerlab autopilot --help')"),
     (["run"], "steerlab: error: the following arguments are required: --out (see 'steerlab run --help')"),
     (["nosuchcommand"], "steerlab: error: argument COMMAND: invalid choice: 'nosuchcommand'"),
-], ids=["bad-choice", "missing", "unknown-command"])
+    (["autopilot-command", "--to", "127.0.0.1:10111", "--mode", "sideways"],    # was sent, refused unseen
+     "steerlab: error: argument --mode: invalid choice: 'sideways' (choose from 'compass', 'route', 'plotter')"),
+], ids=["bad-choice", "missing", "unknown-command", "command-mode"])
 def test_a_usage_error_is_one_line_with_exit_2(argv, line, capsys):
     """argparse printed its whole usage block before the error (28 lines for autopilot)."""
     with pytest.raises(SystemExit) as exc:

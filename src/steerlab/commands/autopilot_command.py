@@ -26,7 +26,10 @@ def register(sub, formatter_class) -> None:
     p.add_argument("--profile", help="controller profile to steer with (its gains replace any given before)")
     p.add_argument("--gain", action="append", default=[], metavar="NAME=VALUE",
                    help="a controller setting on top of the profile, e.g. Kp=2.5 (repeatable)")
-    p.add_argument("--mode", help="steering mode: compass, route or plotter")
+    from steerlab.runtime.steering_modes import MODES
+
+    p.add_argument("--mode", choices=MODES, help="steering mode (checked here: a wrong one was sent, and "
+                                                 "refused by the autopilot unseen without --reply-on)")
     p.add_argument("--heading", type=float, help="set course [deg], in [0, 360]")
     p.add_argument("--state", choices=("auto", "standby"), help="engage or stand by")
     p.add_argument("--reply-on", metavar="HOST:PORT",
