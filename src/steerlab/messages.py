@@ -22,6 +22,15 @@ def one_line(text: str, limit: int = MAX_MESSAGE) -> str:
     return out if len(out) <= limit else out[:limit - 3] + "..."
 
 
+def did_you_mean(name: object, names, n: int = 3) -> str:
+    """`` (did you mean 'esso'?)`` for the up to ``n`` of ``names`` closest to a misspelt
+    ``name`` (:func:`difflib.get_close_matches`, its default cutoff 0.6), or ``""``."""
+    import difflib
+
+    close = difflib.get_close_matches(str(name), list(names), n=n)
+    return f" (did you mean {' or '.join(map(repr, close))}?)" if close else ""
+
+
 def close_progress(forget: bool = False) -> None:
     """End an open progress-bar line, so that what follows starts on a line of its own."""
     progress = sys.modules.get("steerlab.progress")

@@ -401,11 +401,10 @@ class Registry(Mapping[str, S]):
         """The message for an unknown name: the close names first, where the whole list is
         printed, then the list (a long line is cut at its end by the command line, so what
         matters comes first)."""
-        import difflib
+        from steerlab.messages import did_you_mean
 
         names = sorted(self)
-        close = difflib.get_close_matches(str(name), names, n=3, cutoff=0.6)
-        hint = f" (did you mean {' or '.join(map(repr, close))}?)" if close else ""
+        hint = did_you_mean(name, names)
         lister = {"ship": "steerlab ships", "controller": "steerlab controllers"}.get(self.kind)
         where = f" (`{lister}` prints them)" if lister else ""
         return f"unknown {self.kind} {name!r}{hint}; known {self.kind}s{where}: {', '.join(names)}"

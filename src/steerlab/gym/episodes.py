@@ -125,10 +125,9 @@ class Episodes:
         allowed = sorted({*params, *own} - {"self", "n", "vectorised"})
         bad = sorted(k for k in kw if k not in allowed)
         if bad:
-            import difflib
+            from steerlab.messages import did_you_mean
 
-            close = difflib.get_close_matches(bad[0], allowed, n=1)
-            hint = f" (did you mean {close[0]!r}?)" if close else ""
+            hint = did_you_mean(bad[0], allowed, 1)
             raise InputError(bad[0], f"unknown keyword of the steerlab environments{hint}; allowed: "
                                      f"{', '.join(allowed)}")
 
